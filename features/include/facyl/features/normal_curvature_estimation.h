@@ -1,0 +1,102 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#pragma once
+
+#include <facyl/features/local_geometry.h>
+#include <facyl/features/point_types.h>
+
+#include <pcl/features/feature.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+namespace facyl {
+
+/** \brief Surface normals and principal curvatures (c_max, k_max, k_min; paper III-C2) from a
+ * single neighbourhood query per point.
+ *
+ * PCL users get the same cues from pcl::NormalEstimation followed by
+ * pcl::PrincipalCurvaturesEstimation, which searches every neighbourhood twice. This class
+ * searches once, keeps the neighbour lists, computes PCA normals (oriented towards the view
+ * point), then projects the neighbours' normals on each tangent plane.
+ *
+ * Usage is that of any pcl::Feature: setInputCloud, optionally setIndices and
+ * setSearchSurface, then setKSearch(k) or setRadiusSearch(r), then compute(output). Points that
+ * are not finite or have fewer than 3 finite neighbours get NaN output and make
+ * output.is_dense false. Runs in parallel with OpenMP; the result does not depend on the
+ * number of threads.
+ *
+ * If the normals are known already, give them with setInputNormals (one per point of the
+ * search surface): only the curvatures are then computed.
+ *
+ * \tparam PointInT any point type with x, y, z
+ * \tparam PointOutT facyl::NormalCurvature (or a type with the same fields)
+ */
+template <typename PointInT, typename PointOutT = facyl::NormalCurvature>
+class NormalCurvatureEstimation : public pcl::Feature<PointInT, PointOutT> {
+public:
+  using Ptr = std::shared_ptr<NormalCurvatureEstimation<PointInT, PointOutT>>;
+  using ConstPtr = std::shared_ptr<const NormalCurvatureEstimation<PointInT, PointOutT>>;
+  using PointCloudOut = typename pcl::Feature<PointInT, PointOutT>::PointCloudOut;
+  using NormalCloudConstPtr = pcl::PointCloud<pcl::Normal>::ConstPtr;
+
+  NormalCurvatureEstimation() { this->feature_name_ = "NormalCurvatureEstimation"; }
+
+  /** \brief Point towards which the normals are flipped (default: the origin, a sensor). */
+  void
+  setViewPoint(float vpx, float vpy, float vpz)
+  {
+    view_point_ = Eigen::Vector3f(vpx, vpy, vpz);
+  }
+  /** \brief The view point (see setViewPoint). */
+  Eigen::Vector3f
+  getViewPoint() const
+  {
+    return view_point_;
+  }
+
+  /** \brief Known normals, one per point of the search surface (the input when no surface was
+   * set). Only the curvatures are then estimated. Pass nullptr to estimate normals again. */
+  void
+  setInputNormals(const NormalCloudConstPtr& normals)
+  {
+    input_normals_ = normals;
+  }
+  /** \brief The normals given with setInputNormals, or nullptr. */
+  NormalCloudConstPtr
+  getInputNormals() const
+  {
+    return input_normals_;
+  }
+
+  /** \brief Number of OpenMP threads; 0 (default) lets OpenMP choose. */
+  void
+  setNumberOfThreads(unsigned int threads)
+  {
+    threads_ = threads;
+  }
+  /** \brief Number of OpenMP threads (0: OpenMP's choice). */
+  unsigned int
+  getNumberOfThreads() const
+  {
+    return threads_;
+  }
+
+protected:
+  bool
+  initCompute() override;
+
+private:
+  void
+  computeFeature(PointCloudOut& output) override;
+
+  Eigen::Vector3f view_point_{Eigen::Vector3f::Zero()};
+  NormalCloudConstPtr input_normals_;
+  unsigned int threads_{0};
+};
+
+} // namespace facyl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <facyl/features/impl/normal_curvature_estimation.hpp>
+#endif

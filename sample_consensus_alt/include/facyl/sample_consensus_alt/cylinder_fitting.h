@@ -1,0 +1,165 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ *
+ * The numerics of the two-step Hough cylinder estimator (Rabbani & van den Heuvel 2005;
+ * Figueiredo et al., RAS 2019), as free functions on plain Eigen data. The PCL-style class
+ * HoughCylinderEstimation gathers a cloud into CylinderCues and calls fitCylinders.
+ */
+#pragma once
+
+#include <facyl/sample_consensus_alt/cylinder_model.h>
+#include <facyl/sample_consensus_alt/orientation_accumulator.h>
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace facyl {
+
+/** \brief How points vote for axis directions. */
+enum class VotingMode {
+  Rabbani,       ///< hard votes, normals only: +1 to cells with |d.n| < sin(cell radius) [6]
+  SoftNormal,    ///< soft votes (1 - |d.n|), normals only
+  SoftCurvature, ///< paper eq. 3: w (1 - |d.c_max|)(1 - |d.n|), w = (k_max-k_min)/(k_max+k_min)
+};
+
+/** \brief Parses "rabbani", "soft-normal", "soft-curvature". */
+bool
+parseVotingMode(const std::string& name, VotingMode& mode);
+/** \brief The name parseVotingMode accepts. */
+std::string
+toString(VotingMode mode);
+
+/** \brief Per-point voting cues in structure-of-arrays form (the hot loop is vectorised over
+ * points). c_* are only read by VotingMode::SoftCurvature. */
+struct VotingCues {
+  Eigen::ArrayXf nx, ny, nz; ///< unit normals
+  Eigen::ArrayXf cx, cy, cz; ///< unit c_max directions
+  Eigen::ArrayXf weight;     ///< per-point vote weight (eq. 3's curvature term; 1 otherwise)
+
+  Eigen::Index
+  size() const
+  {
+    return nx.size();
+  }
+  void
+  resize(Eigen::Index n);
+};
+
+/** \brief Casts the votes of all \a cues into the cells \a directions (3 x N_d): one inner
+ * product per cell and point, no trigonometry (paper III-C2).
+ *
+ * \param kernel_exponent p >= 1: soft votes are raised to the power p (p = 1 is eq. 3
+ *        exactly; larger p narrows each point's vote and so the spread of votes that planar
+ *        points put on the great circle orthogonal to their normal).
+ * \param hard_threshold Rabbani only: a cell gets a vote when |d.n| < hard_threshold.
+ * \param[out] votes A(i), one per cell.
+ */
+void
+castVotes(const Eigen::Matrix3Xf& directions, const VotingCues& cues, VotingMode mode,
+          int kernel_exponent, float hard_threshold, Eigen::VectorXf& votes);
+
+/** \brief Up to \a max_peaks cells in decreasing vote order, each at least
+ * \a min_separation (rad) from the cells already taken (non-maximum suppression on the
+ * sphere of axes). Cells without votes are never peaks. */
+std::vector<Eigen::Index>
+findPeaks(const Eigen::Matrix3Xf& directions, const Eigen::VectorXf& votes,
+          std::size_t max_peaks, float min_separation);
+
+/** \brief Sub-cell axis refinement: iteratively reweighted least squares on the normals.
+ *
+ * A cylinder's normals are orthogonal to its axis, so the axis is the eigenvector of the
+ * smallest eigenvalue of sum_s omega_s n_s n_s^T. omega_s is the point's vote weight times a
+ * Tukey biweight of |a.n_s| whose cut-off starts at \a initial_tolerance (rad) and shrinks to
+ * 3.5 robust standard deviations of the supporters' |a.n| (never below 1 deg). Points whose
+ * normal is near the axis (lids, tables under an upright can) get no weight.
+ * \return the refined unit axis (folded), or \a initial if there was no support.
+ */
+Eigen::Vector3f
+refineAxis(const VotingCues& cues, const Eigen::Vector3f& initial, float initial_tolerance,
+           int iterations = 10);
+
+/** \brief A circle in the plane. */
+struct Circle {
+  Eigen::Vector2f center{Eigen::Vector2f::Zero()};
+  float radius{0.f};
+};
+
+/** \brief Circle Hough transform with normals [43]: each point votes for the centres on its
+ * normal line at distances [r_min, r_max] from it, on a \a grid x \a grid accumulator over the
+ * points' bounding box grown by r_max; the radius is then the mode of the distances to the
+ * winning centre. Accuracy is the cell size; refine with fitCircle.
+ * \param normals unit 2-D normals, one per point (sign not needed)
+ * \return false if no centre got votes.
+ */
+bool
+houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, float r_min,
+            float r_max, int grid, Circle& circle);
+
+/** \brief Geometric circle fit (Gauss-Newton on sum (|p - c| - r)^2), robust: the points within
+ * \a threshold of the current circle are refitted, the threshold shrinking to 3 robust sigmas.
+ * \return false if fewer than 3 points support the circle. */
+bool
+fitCircle(const Eigen::Matrix2Xf& points, float threshold, Circle& circle, int iterations = 8);
+
+/** \brief Least-squares refinement of all 5 degrees of freedom of an infinite cylinder (axis
+ * direction, axis position, radius) on \a points (Gauss-Newton, analytic Jacobian).
+ * \return false if the system is degenerate (the model is then unchanged). */
+bool
+refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
+               Eigen::Vector3f& axis, float& radius, int iterations = 5);
+
+/** \brief How fast the inliers' normals turn with their position around the axis: the
+ * least-squares slope of (normal angle) against (position angle) over the inliers, about 1 on
+ * a cylinder and about 0 on a plane strip that a wide cylinder happens to fit (a lid seen from
+ * an axis in its plane). Angles are taken modulo pi, so strips on opposite sides (two lids)
+ * pool. Clamped to [0, 1]; 1 when the inliers spread over more than a quarter turn (modulo pi;
+ * no plane strip does) or are fewer than 3.
+ * \param normals unit normals of \a points (sign not needed)
+ */
+float
+normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                    const Eigen::Vector3f& point_on_axis, const Eigen::Vector3f& axis);
+
+/** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). */
+struct HoughCylinderParameters {
+  VotingMode voting_mode{VotingMode::SoftCurvature};
+  int kernel_exponent{2};               ///< >= 1; 1 is the paper's eq. 3
+  float radius_min{0.f};                ///< >= 0
+  float radius_max{std::numeric_limits<float>::infinity()}; ///< > radius_min; inf: data extent
+  float distance_threshold{0.f};        ///< > 0, or 0: estimated from the residuals
+  float normal_angle_threshold{0.6f};   ///< rad, in (0, pi/2]: normal vs surface normal
+  std::size_t orientation_candidates{3}; ///< peaks per accumulator that are fitted
+  bool refine{true};                    ///< sub-cell axis + 5-dof least squares
+  std::size_t max_cylinders{1};         ///< >= 1
+  std::size_t min_inliers{0};           ///< 0: max(10, 5% of the points)
+  std::size_t max_voting_points{1000};  ///< voters are subsampled above this; 0: all
+  int circle_grid{48};                  ///< CHT accumulator size per side, >= 8
+};
+
+/** \brief Checks \a params. \return an empty string, or what is wrong. */
+std::string
+validate(const HoughCylinderParameters& params);
+
+/** \brief The cloud in the form the estimator works on: finite points with finite normals. */
+struct CylinderCues {
+  Eigen::Matrix3Xf points;
+  Eigen::Matrix3Xf normals;     ///< unit
+  Eigen::Matrix3Xf curvature_directions; ///< unit c_max (empty: none given)
+  Eigen::VectorXf weights;      ///< eq. 3 curvature weights (empty: none given)
+};
+
+/** \brief Fits up to params.max_cylinders cylinders to \a cues, one after another: vote with
+ * every accumulator, refine the strongest peaks, fit position and radius, keep the candidate
+ * with most inliers, remove its inliers and the points inside it, and repeat while a cylinder
+ * has at least min_inliers inliers. Model inliers index the columns of cues.points.
+ * \a total_points is N_cluster of eq. 4 (the points given, finite or not).
+ */
+std::vector<CylinderModel>
+fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>& accumulators,
+             const HoughCylinderParameters& params, std::size_t total_points);
+
+} // namespace facyl

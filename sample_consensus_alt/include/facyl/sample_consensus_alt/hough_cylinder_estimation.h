@@ -1,0 +1,346 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#pragma once
+
+#include <facyl/features/point_types.h>
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/cylinder_model.h>
+#include <facyl/sample_consensus_alt/orientation_accumulator.h>
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/PointIndices.h>
+#include <pcl/pcl_base.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace facyl {
+
+/** \brief Two-step Hough cylinder estimator (Rabbani & van den Heuvel; Figueiredo et al. 2019)
+ * with a randomized Gaussian-mixture orientation accumulator, curvature-weighted soft voting,
+ * sub-cell refinement, and extraction of several cylinders.
+ *
+ * Step 1 votes for the axis direction on N_d cells drawn from an orientation prior (paper
+ * eq. 1-3). The strongest peaks are refined below the cell size (refineAxis). Step 2 aligns
+ * each axis with z, finds position and radius with a circle Hough transform, then refines all
+ * five parameters by least squares; the candidate with most inliers wins. Its goodness of fit
+ * is the inlier ratio of eq. 4.
+ *
+ * \code
+ * facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
+ * hough.setInputCloud(cloud);
+ * hough.setInputNormals(cues);            // from facyl::NormalCurvatureEstimation
+ * hough.setRadiusLimits(0.01f, 0.2f);
+ * pcl::PointIndices inliers;
+ * pcl::ModelCoefficients coefficients;    // SACMODEL_CYLINDER layout
+ * if (hough.segment(inliers, coefficients)) ...
+ * \endcode
+ *
+ * Inputs that cannot give an answer (no cloud, no normals, sizes that differ, no finite point,
+ * invalid parameters, SoftCurvature without curvatures) are reported with PCL_ERROR and make
+ * segment() return false with empty outputs. segment() is not reentrant on one object; distinct
+ * objects may run concurrently.
+ *
+ * \tparam PointT a point type with x, y, z
+ * \tparam PointNT a type with normal_x/y/z; if it also has principal_curvature_x/y/z, pc1 and
+ *         pc2 (facyl::NormalCurvature), those are the curvatures used by SoftCurvature voting.
+ */
+template <typename PointT, typename PointNT>
+class HoughCylinderEstimation : public pcl::PCLBase<PointT> {
+public:
+  using Ptr = std::shared_ptr<HoughCylinderEstimation<PointT, PointNT>>;
+  using ConstPtr = std::shared_ptr<const HoughCylinderEstimation<PointT, PointNT>>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using Normals = pcl::PointCloud<PointNT>;
+  using NormalsConstPtr = typename Normals::ConstPtr;
+  using Curvatures = pcl::PointCloud<pcl::PrincipalCurvatures>;
+  using CurvaturesConstPtr = Curvatures::ConstPtr;
+
+  HoughCylinderEstimation() = default;
+
+  /** \brief Normals, one per input point (required). */
+  void
+  setInputNormals(const NormalsConstPtr& normals)
+  {
+    normals_ = normals;
+  }
+  /** \brief The normals given, or nullptr. */
+  NormalsConstPtr
+  getInputNormals() const
+  {
+    return normals_;
+  }
+  /** \brief Principal curvatures, one per input point, for SoftCurvature voting when PointNT
+   * carries none (e.g. from pcl::PrincipalCurvaturesEstimation). Overrides PointNT's. */
+  void
+  setInputCurvatures(const CurvaturesConstPtr& curvatures)
+  {
+    curvatures_ = curvatures;
+  }
+  /** \brief The curvatures given, or nullptr. */
+  CurvaturesConstPtr
+  getInputCurvatures() const
+  {
+    return curvatures_;
+  }
+
+  /** \brief All numeric settings at once (see HoughCylinderParameters). */
+  void
+  setParameters(const HoughCylinderParameters& params)
+  {
+    params_ = params;
+  }
+  /** \brief All numeric settings. */
+  const HoughCylinderParameters&
+  getParameters() const
+  {
+    return params_;
+  }
+
+  /** \brief Voting mode (default SoftCurvature, paper eq. 3). */
+  void
+  setVotingMode(VotingMode mode)
+  {
+    params_.voting_mode = mode;
+  }
+  /** \brief Voting mode. */
+  VotingMode
+  getVotingMode() const
+  {
+    return params_.voting_mode;
+  }
+  /** \brief Radius interval [min, max] in cloud units (default [0, inf): inf is read as twice
+   * the extent of the points). */
+  void
+  setRadiusLimits(float min_radius, float max_radius)
+  {
+    params_.radius_min = min_radius;
+    params_.radius_max = max_radius;
+  }
+  /** \brief Radius interval. */
+  void
+  getRadiusLimits(float& min_radius, float& max_radius) const
+  {
+    min_radius = params_.radius_min;
+    max_radius = params_.radius_max;
+  }
+  /** \brief Inlier distance to the surface, > 0; 0 (default) estimates 3 robust sigmas of the
+   * residuals, clamped to [0.001, 0.1] x radius. */
+  void
+  setDistanceThreshold(float threshold)
+  {
+    params_.distance_threshold = threshold;
+  }
+  /** \brief Inlier distance threshold (0: estimated). */
+  float
+  getDistanceThreshold() const
+  {
+    return params_.distance_threshold;
+  }
+  /** \brief Largest angle (rad) between an inlier's normal and the cylinder's surface normal,
+   * in (0, pi/2] (default 0.6 rad, 34 deg). */
+  void
+  setNormalAngleThreshold(float radians)
+  {
+    params_.normal_angle_threshold = radians;
+  }
+  /** \brief Inlier normal angle threshold (rad). */
+  float
+  getNormalAngleThreshold() const
+  {
+    return params_.normal_angle_threshold;
+  }
+  /** \brief Extract up to n cylinders, one after another (default 1). */
+  void
+  setMaxCylinders(std::size_t n)
+  {
+    params_.max_cylinders = n;
+  }
+  /** \brief Largest number of cylinders extracted. */
+  std::size_t
+  getMaxCylinders() const
+  {
+    return params_.max_cylinders;
+  }
+  /** \brief A cylinder needs this many inliers; 0 (default): max(10, 5% of the points). */
+  void
+  setMinInliers(std::size_t n)
+  {
+    params_.min_inliers = n;
+  }
+  /** \brief Minimum inliers (0: automatic). */
+  std::size_t
+  getMinInliers() const
+  {
+    return params_.min_inliers;
+  }
+  /** \brief Accumulator peaks per accumulator that are refined and fitted (default 3). */
+  void
+  setOrientationCandidates(std::size_t n)
+  {
+    params_.orientation_candidates = n;
+  }
+  /** \brief Peaks fitted per accumulator. */
+  std::size_t
+  getOrientationCandidates() const
+  {
+    return params_.orientation_candidates;
+  }
+  /** \brief Power applied to soft votes, >= 1 (default 2; 1 is the paper's eq. 3). */
+  void
+  setKernelExponent(int p)
+  {
+    params_.kernel_exponent = p;
+  }
+  /** \brief Soft-vote power. */
+  int
+  getKernelExponent() const
+  {
+    return params_.kernel_exponent;
+  }
+  /** \brief Sub-cell axis and least-squares refinement (default true; false reproduces the
+   * paper's cell-quantised axis). */
+  void
+  setRefine(bool refine)
+  {
+    params_.refine = refine;
+  }
+  /** \brief Whether the model is refined. */
+  bool
+  getRefine() const
+  {
+    return params_.refine;
+  }
+
+  /** \brief Orientation prior from a preset (default Uniform). */
+  void
+  setOrientationPrior(OrientationPrior prior)
+  {
+    setOrientationMixture(GaussianMixture::fromPrior(prior));
+  }
+  /** \brief Orientation prior as an explicit Gaussian mixture, in the reference frame. */
+  void
+  setOrientationMixture(const GaussianMixture& mixture)
+  {
+    mixture_ = mixture;
+    drawn_.clear();
+  }
+  /** \brief The orientation prior. */
+  const GaussianMixture&
+  getOrientationMixture() const
+  {
+    return mixture_;
+  }
+  /** \brief Frame of the prior: its columns are the prior's x, y, z ("up") axes in cloud
+   * coordinates (default identity). */
+  void
+  setReferenceFrame(const Eigen::Matrix3f& frame)
+  {
+    frame_ = frame;
+    drawn_.clear();
+  }
+  /** \brief Sets the reference frame from its "up" axis only (e.g. a table normal). */
+  void
+  setUpDirection(const Eigen::Vector3f& up);
+  /** \brief Frame of the prior. */
+  const Eigen::Matrix3f&
+  getReferenceFrame() const
+  {
+    return frame_;
+  }
+  /** \brief Cells per accumulator, N_d (default 450, as in the paper). */
+  void
+  setNumberOfOrientations(std::size_t n)
+  {
+    num_orientations_ = n;
+    drawn_.clear();
+  }
+  /** \brief N_d. */
+  std::size_t
+  getNumberOfOrientations() const
+  {
+    return num_orientations_;
+  }
+  /** \brief Independent accumulators voted per fit (default 1); their peaks compete. */
+  void
+  setNumberOfAccumulators(std::size_t n)
+  {
+    num_accumulators_ = n;
+    drawn_.clear();
+  }
+  /** \brief Accumulators per fit. */
+  std::size_t
+  getNumberOfAccumulators() const
+  {
+    return num_accumulators_;
+  }
+  /** \brief Seed of the accumulator draws (default 0): equal seeds give equal results. */
+  void
+  setSeed(std::uint64_t seed)
+  {
+    seed_ = seed;
+    drawn_.clear();
+  }
+  /** \brief The seed. */
+  std::uint64_t
+  getSeed() const
+  {
+    return seed_;
+  }
+  /** \brief Explicit accumulators; they replace the drawn ones until cleared with {}. */
+  void
+  setAccumulators(const std::vector<OrientationAccumulator>& accumulators)
+  {
+    user_accumulators_ = accumulators;
+  }
+  /** \brief The accumulators the last segment() used (drawn lazily). */
+  const std::vector<OrientationAccumulator>&
+  getAccumulators()
+  {
+    return accumulators();
+  }
+
+  /** \brief Fits the best cylinder: its inliers and the 7 SACMODEL_CYLINDER coefficients.
+   * \return false (and empty outputs) on invalid input or when no cylinder was found. */
+  bool
+  segment(pcl::PointIndices& inliers, pcl::ModelCoefficients& coefficients);
+
+  /** \brief Fits up to getMaxCylinders() cylinders, best first; inlier indices refer to the
+   * input cloud. \return false on invalid input or when none was found. */
+  bool
+  segment(std::vector<CylinderModel>& cylinders);
+
+  /** \brief "HoughCylinderEstimation". */
+  std::string
+  getClassName() const
+  {
+    return "HoughCylinderEstimation";
+  }
+
+private:
+  const std::vector<OrientationAccumulator>&
+  accumulators();
+
+  NormalsConstPtr normals_;
+  CurvaturesConstPtr curvatures_;
+  HoughCylinderParameters params_;
+  GaussianMixture mixture_{GaussianMixture::fromPrior(OrientationPrior::Uniform)};
+  Eigen::Matrix3f frame_{Eigen::Matrix3f::Identity()};
+  std::size_t num_orientations_{450};
+  std::size_t num_accumulators_{1};
+  std::uint64_t seed_{0};
+  std::vector<OrientationAccumulator> user_accumulators_;
+  std::vector<OrientationAccumulator> drawn_;
+};
+
+} // namespace facyl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <facyl/sample_consensus_alt/impl/hough_cylinder_estimation.hpp>
+#endif
