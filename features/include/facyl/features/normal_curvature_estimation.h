@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/features/local_geometry.h>
+#include <facyl/features/neighbourhoods.h>
 #include <facyl/features/point_types.h>
 
 #include <pcl/features/feature.h>
@@ -21,7 +22,9 @@ namespace facyl {
  * point), then projects the neighbours' normals on each tangent plane.
  *
  * Usage is that of any pcl::Feature: setInputCloud, optionally setIndices and
- * setSearchSurface, then setKSearch(k) or setRadiusSearch(r), then compute(output). Points that
+ * setSearchSurface, then setKSearch(k) or setRadiusSearch(r), then compute(output). Unless a
+ * search method is given with setSearchMethod, neighbours come from an internal nanoflann
+ * kd-tree (exact, and several times faster than pcl::search::KdTree on small clouds). Points that
  * are not finite or have fewer than 3 finite neighbours get NaN output and make
  * output.is_dense false. Runs in parallel with OpenMP; the result does not depend on the
  * number of threads.
@@ -90,7 +93,15 @@ private:
   void
   computeFeature(PointCloudOut& output) override;
 
+  /** Neighbour lists of surface_queries (indices into the input if queries_are_input, else
+   * into the surface), from the PCL search method or the internal kd-tree. */
+  Neighbourhoods
+  neighbourhoods(const std::vector<int>& surface_queries, bool queries_are_input,
+                 int threads) const;
+
   Eigen::Vector3f view_point_{Eigen::Vector3f::Zero()};
+  bool use_pcl_search_{false};
+  std::unique_ptr<NeighbourSearch> search_;
   NormalCloudConstPtr input_normals_;
   unsigned int threads_{0};
 };

@@ -3,12 +3,14 @@
  */
 #pragma once
 
+#include <facyl/features/neighbourhoods.h>
 #include <facyl/features/normal_curvature_estimation.h>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/console/print.h>
 
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #ifdef _OPENMP
@@ -21,27 +23,103 @@ template <typename PointInT, typename PointOutT>
 bool
 NormalCurvatureEstimation<PointInT, PointOutT>::initCompute()
 {
-  if (!pcl::Feature<PointInT, PointOutT>::initCompute())
-    return false;
+  const char* name = this->getClassName().c_str();
+  use_pcl_search_ = static_cast<bool>(this->tree_);
+  if (use_pcl_search_) {
+    // A search method was given: PCL's own set-up (builds it on the surface).
+    if (!pcl::Feature<PointInT, PointOutT>::initCompute())
+      return false;
+  }
+  else {
+    // Same checks as pcl::Feature::initCompute, without building a FLANN tree that the
+    // internal kd-tree would not use.
+    if (!pcl::PCLBase<PointInT>::initCompute()) {
+      PCL_ERROR("[facyl::%s::compute] no input cloud or invalid indices.\n", name);
+      return false;
+    }
+    if (this->input_->empty()) {
+      PCL_ERROR("[facyl::%s::compute] the input cloud is empty.\n", name);
+      this->deinitCompute();
+      return false;
+    }
+    if (!this->surface_) {
+      this->fake_surface_ = true;
+      this->surface_ = this->input_;
+    }
+    if ((this->k_ != 0) == (this->search_radius_ != 0.0)) {
+      PCL_ERROR("[facyl::%s::compute] set exactly one of setKSearch (k = %d) and "
+                "setRadiusSearch (r = %g).\n",
+                name, this->k_, this->search_radius_);
+      this->deinitCompute();
+      return false;
+    }
+    this->search_parameter_ = this->k_ != 0 ? this->k_ : this->search_radius_;
+  }
   if (this->k_ != 0 && this->k_ < 3) {
-    PCL_ERROR("[facyl::%s::compute] k = %d: a normal needs at least 3 neighbours.\n",
-              this->getClassName().c_str(), this->k_);
+    PCL_ERROR("[facyl::%s::compute] k = %d: a normal needs at least 3 neighbours.\n", name,
+              this->k_);
     this->deinitCompute();
     return false;
   }
-  if (this->search_radius_ < 0.0) {
-    PCL_ERROR("[facyl::%s::compute] negative search radius %g.\n",
-              this->getClassName().c_str(), this->search_radius_);
+  if (this->k_ == 0 && !(this->search_radius_ > 0.0 && std::isfinite(this->search_radius_))) {
+    PCL_ERROR("[facyl::%s::compute] search radius %g is not positive.\n", name,
+              this->search_radius_);
     this->deinitCompute();
     return false;
   }
   if (input_normals_ && input_normals_->size() != this->surface_->size()) {
-    PCL_ERROR("[facyl::%s::compute] %zu input normals for %zu surface points.\n",
-              this->getClassName().c_str(), input_normals_->size(), this->surface_->size());
+    PCL_ERROR("[facyl::%s::compute] %zu input normals for %zu surface points.\n", name,
+              input_normals_->size(), this->surface_->size());
     this->deinitCompute();
     return false;
   }
   return true;
+}
+
+template <typename PointInT, typename PointOutT>
+Neighbourhoods
+NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
+    const std::vector<int>& surface_queries, bool queries_are_input, int threads) const
+{
+  const auto& input = *this->input_;
+  const auto& surface = *this->surface_;
+  const std::size_t n = surface_queries.size();
+  const auto query_point = [&](std::size_t i) -> const PointInT& {
+    return queries_are_input ? input[surface_queries[i]] : surface[surface_queries[i]];
+  };
+  Neighbourhoods out;
+  out.offsets.assign(n + 1, 0);
+  if (use_pcl_search_) {
+    std::vector<pcl::Indices> lists(n);
+#pragma omp parallel num_threads(threads)
+    {
+      std::vector<float> distances;
+#pragma omp for schedule(dynamic, 128)
+      for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+        const auto s = static_cast<std::size_t>(i);
+        if (!pcl::isFinite(query_point(s)))
+          continue;
+        if (queries_are_input)
+          this->searchForNeighbors(surface_queries[s], this->search_parameter_, lists[s],
+                                   distances);
+        else
+          this->searchForNeighbors(surface, surface_queries[s], this->search_parameter_,
+                                   lists[s], distances);
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      out.offsets[i + 1] = out.offsets[i] + lists[i].size();
+    out.indices.reserve(out.offsets[n]);
+    for (const auto& l : lists)
+      out.indices.insert(out.indices.end(), l.begin(), l.end());
+    return out;
+  }
+  Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i)
+    queries.col(static_cast<Eigen::Index>(i)) = query_point(i).getVector3fMap();
+  return this->k_ != 0 ? search_->nearest(queries, this->k_, threads)
+                       : search_->within(queries, static_cast<float>(this->search_radius_),
+                                         threads);
 }
 
 template <typename PointInT, typename PointOutT>
@@ -54,134 +132,107 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   const std::size_t n = indices.size();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(nan);
-  const int threads =
 #ifdef _OPENMP
-      threads_ > 0 ? static_cast<int>(threads_) : omp_get_max_threads();
+  const int threads = threads_ > 0 ? static_cast<int>(threads_) : omp_get_max_threads();
 #else
-      1;
+  const int threads = 1;
 #endif
-  (void)threads;
 
-  // Orientation towards the view point, so neighbouring normals agree in sign.
-  const auto orient = [this](const Eigen::Vector3f& p, Eigen::Vector3f& normal) {
-    if ((view_point_ - p).dot(normal) < 0.f)
+  Eigen::Matrix3Xf surface_points;
+  if (!use_pcl_search_) {
+    surface_points.resize(3, static_cast<Eigen::Index>(surface.size()));
+    for (std::size_t j = 0; j < surface.size(); ++j)
+      surface_points.col(static_cast<Eigen::Index>(j)) = surface[j].getVector3fMap();
+    search_ = std::make_unique<NeighbourSearch>(surface_points);
+  }
+
+  // Normals oriented towards the view point, so that neighbouring normals agree in sign.
+  const auto pcaNormal = [&](const Neighbourhoods& nb, std::size_t i, const Eigen::Vector3f& at,
+                             Eigen::Vector3f& normal, float& variation) {
+    const int* list = nb.begin(i);
+    if (nb.count(i) < 3 ||
+        !estimateNormal(
+            nb.count(i), [&](std::size_t j) { return surface[list[j]].getVector3fMap(); },
+            normal, variation))
+      return false;
+    if ((view_point_ - at).dot(normal) < 0.f)
       normal = -normal;
+    return true;
   };
 
-  // 1. One neighbourhood query per point; PCA normals of the query points.
-  std::vector<pcl::Indices> neighbours(n);
+  // 1. One neighbourhood query per point, and the query points' normals.
+  const std::vector<int> query_indices(indices.begin(), indices.end());
+  const Neighbourhoods nb = neighbourhoods(query_indices, true, threads);
   std::vector<Eigen::Vector3f> normals(n, nan3);
   std::vector<float> variation(n, nan);
-#pragma omp parallel num_threads(threads)
-  {
-    std::vector<float> distances;
-#pragma omp for schedule(dynamic, 128)
+  if (input_normals_) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& m = (*input_normals_)[indices[i]];
+      const Eigen::Vector3f v(m.normal_x, m.normal_y, m.normal_z);
+      const float len = v.norm();
+      if (this->fake_surface_ && std::isfinite(len) && len > 0.f) {
+        normals[i] = v / len;
+        variation[i] = m.curvature;
+      }
+      else if (!this->fake_surface_)
+        pcaNormal(nb, i, input[indices[i]].getVector3fMap(), normals[i], variation[i]);
+    }
+  }
+  else {
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      const auto& q = input[indices[i]];
-      if (!pcl::isFinite(q) ||
-          this->searchForNeighbors(indices[i], this->search_parameter_, neighbours[i],
-                                   distances) < 3) {
-        neighbours[i].clear();
-        continue;
-      }
-      if (input_normals_)
-        continue; // normals are known; only the neighbour lists are needed
-      const auto& nb = neighbours[i];
-      Eigen::Vector3f normal;
-      float sv;
-      if (estimateNormal(
-              nb.size(),
-              [&](std::size_t j) { return surface[nb[j]].getVector3fMap(); }, normal, sv)) {
-        orient(q.getVector3fMap(), normal);
-        normals[i] = normal;
-        variation[i] = sv;
-      }
+      const auto s = static_cast<std::size_t>(i);
+      if (pcl::isFinite(input[indices[s]]))
+        pcaNormal(nb, s, input[indices[s]].getVector3fMap(), normals[s], variation[s]);
     }
   }
 
-  // 2. Normals at every neighbour. When the neighbours are the query points themselves (no
-  //    search surface, no indices: the common case) nothing more is searched; otherwise the
-  //    missing neighbours get their own PCA normal.
-  std::vector<Eigen::Vector3f> surface_normals;
+  // 2. A normal at every neighbour. In the common case (no search surface, no indices) the
+  //    neighbours are the query points; otherwise the others get their own PCA normal.
+  std::vector<Eigen::Vector3f> surface_normals(surface.size(), nan3);
   if (input_normals_) {
-    surface_normals.resize(surface.size());
     for (std::size_t j = 0; j < surface.size(); ++j) {
       const auto& m = (*input_normals_)[j];
       surface_normals[j] = Eigen::Vector3f(m.normal_x, m.normal_y, m.normal_z);
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      if (neighbours[i].empty())
-        continue;
-      Eigen::Vector3f m = (*input_normals_)[indices[i]].getNormalVector3fMap();
-      const float len = m.norm();
-      if (this->fake_surface_ && std::isfinite(len) && len > 0.f) {
-        normals[i] = m / len;
-        variation[i] = (*input_normals_)[indices[i]].curvature;
-      }
-      else if (!this->fake_surface_) {
-        // The query points are not surface points: their normal is the PCA normal.
-        Eigen::Vector3f normal;
-        float sv;
-        const auto& nb = neighbours[i];
-        if (estimateNormal(
-                nb.size(),
-                [&](std::size_t j) { return surface[nb[j]].getVector3fMap(); }, normal,
-                sv)) {
-          orient(input[indices[i]].getVector3fMap(), normal);
-          normals[i] = normal;
-          variation[i] = sv;
-        }
-      }
-    }
   }
   else {
-    surface_normals.assign(surface.size(), nan3);
     std::vector<char> known(surface.size(), 0);
-    if (this->fake_surface_) {
+    if (this->fake_surface_)
       for (std::size_t i = 0; i < n; ++i) {
         surface_normals[indices[i]] = normals[i];
         known[indices[i]] = 1;
       }
-    }
-    pcl::Indices missing;
-    for (std::size_t i = 0; i < n; ++i)
-      for (const auto j : neighbours[i])
-        if (!known[j]) {
-          known[j] = 1;
-          missing.push_back(j);
-        }
-#pragma omp parallel num_threads(threads)
-    {
-      pcl::Indices nb;
-      std::vector<float> distances;
-#pragma omp for schedule(dynamic, 128)
+    std::vector<int> missing;
+    for (const int j : nb.indices)
+      if (!known[j]) {
+        known[j] = 1;
+        missing.push_back(j);
+      }
+    if (!missing.empty()) {
+      const Neighbourhoods extra = neighbourhoods(missing, false, threads);
+#pragma omp parallel for num_threads(threads) schedule(static)
       for (std::ptrdiff_t m = 0; m < static_cast<std::ptrdiff_t>(missing.size()); ++m) {
-        const auto j = missing[m];
-        if (this->searchForNeighbors(surface, j, this->search_parameter_, nb, distances) < 3)
-          continue;
-        Eigen::Vector3f normal;
+        const auto s = static_cast<std::size_t>(m);
         float sv;
-        if (estimateNormal(
-                nb.size(), [&](std::size_t t) { return surface[nb[t]].getVector3fMap(); },
-                normal, sv)) {
-          orient(surface[j].getVector3fMap(), normal);
-          surface_normals[j] = normal;
-        }
+        pcaNormal(extra, s, surface[missing[s]].getVector3fMap(), surface_normals[missing[s]],
+                  sv);
       }
     }
   }
 
   // 3. Principal curvatures from the neighbours' normals, and the output.
   bool dense = true;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 128) reduction(&& : dense)
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(&& : dense)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-    PointOutT& out = output[i];
+    const auto s = static_cast<std::size_t>(i);
+    PointOutT& out = output[s];
     PrincipalCurvatures pc;
-    const auto& nb = neighbours[i];
-    const bool ok = normals[i].allFinite() &&
+    const int* list = nb.begin(s);
+    const bool ok = normals[s].allFinite() &&
                     principalCurvaturesFromNormals(
-                        normals[i], nb.size(),
-                        [&](std::size_t j) { return surface_normals[nb[j]]; }, pc);
+                        normals[s], nb.count(s),
+                        [&](std::size_t j) { return surface_normals[list[j]]; }, pc);
     if (!ok) {
       out.normal_x = out.normal_y = out.normal_z = nan;
       out.principal_curvature_x = out.principal_curvature_y = out.principal_curvature_z = nan;
@@ -189,10 +240,10 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
       dense = false;
       continue;
     }
-    out.normal_x = normals[i].x();
-    out.normal_y = normals[i].y();
-    out.normal_z = normals[i].z();
-    out.curvature = variation[i];
+    out.normal_x = normals[s].x();
+    out.normal_y = normals[s].y();
+    out.normal_z = normals[s].z();
+    out.curvature = variation[s];
     out.principal_curvature_x = pc.direction.x();
     out.principal_curvature_y = pc.direction.y();
     out.principal_curvature_z = pc.direction.z();
@@ -200,6 +251,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
     out.pc2 = pc.k_min;
   }
   output.is_dense = dense;
+  search_.reset();
 }
 
 } // namespace facyl

@@ -1,0 +1,70 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace facyl {
+
+/** \brief Neighbour lists in compressed-row form: the neighbours of query i are
+ * indices[offsets[i]] .. indices[offsets[i + 1] - 1], nearest first. */
+struct Neighbourhoods {
+  std::vector<std::size_t> offsets{0};
+  std::vector<int> indices;
+
+  /** \brief Number of queries. */
+  std::size_t
+  size() const
+  {
+    return offsets.size() - 1;
+  }
+  /** \brief Number of neighbours of query \a i. */
+  std::size_t
+  count(std::size_t i) const
+  {
+    return offsets[i + 1] - offsets[i];
+  }
+  /** \brief Pointer to the first neighbour of query \a i. */
+  const int*
+  begin(std::size_t i) const
+  {
+    return indices.data() + offsets[i];
+  }
+};
+
+/** \brief Exact neighbour search among the finite columns of a 3 x N matrix (a nanoflann
+ * kd-tree, built once in the constructor). Queries are const, run in parallel on \a threads
+ * threads (0: OpenMP's default), and may be issued concurrently. Indices refer to columns of
+ * the surface; a query that is not finite gets no neighbour; a query that is a surface point
+ * finds itself first.
+ */
+class NeighbourSearch {
+public:
+  /** \brief Builds the tree. \a surface must outlive this object. */
+  explicit NeighbourSearch(const Eigen::Matrix3Xf& surface);
+  ~NeighbourSearch();
+  NeighbourSearch(const NeighbourSearch&) = delete;
+  NeighbourSearch&
+  operator=(const NeighbourSearch&) = delete;
+
+  /** \brief The k nearest surface points of every query column, nearest first.
+   * \throws std::invalid_argument if k < 1. */
+  Neighbourhoods
+  nearest(const Eigen::Matrix3Xf& queries, int k, int threads = 0) const;
+
+  /** \brief Every surface point within \a radius of each query column, nearest first.
+   * \throws std::invalid_argument if radius is not positive and finite. */
+  Neighbourhoods
+  within(const Eigen::Matrix3Xf& queries, float radius, int threads = 0) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace facyl

@@ -1,0 +1,157 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#include <facyl/features/neighbourhoods.h>
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace facyl {
+
+namespace {
+/** nanoflann's dataset contract over the finite columns of a 3 x N matrix. */
+struct FiniteColumns {
+  const Eigen::Matrix3Xf& points;
+  std::vector<int> columns;
+
+  explicit FiniteColumns(const Eigen::Matrix3Xf& p) : points(p)
+  {
+    columns.reserve(static_cast<std::size_t>(p.cols()));
+    for (Eigen::Index i = 0; i < p.cols(); ++i)
+      if (p.col(i).allFinite())
+        columns.push_back(static_cast<int>(i));
+  }
+  std::size_t
+  kdtree_get_point_count() const
+  {
+    return columns.size();
+  }
+  float
+  kdtree_get_pt(std::size_t idx, std::size_t dim) const
+  {
+    return points(static_cast<Eigen::Index>(dim), columns[idx]);
+  }
+  template <class BBox>
+  bool
+  kdtree_get_bbox(BBox&) const
+  {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FiniteColumns>,
+                                                 FiniteColumns, 3, std::uint32_t>;
+
+int
+threadCount(int threads)
+{
+#ifdef _OPENMP
+  return threads > 0 ? threads : omp_get_max_threads();
+#else
+  (void)threads;
+  return 1;
+#endif
+}
+} // namespace
+
+struct NeighbourSearch::Impl {
+  FiniteColumns data;
+  Tree tree;
+  explicit Impl(const Eigen::Matrix3Xf& surface)
+  : data(surface), tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(16))
+  {
+    if (!data.columns.empty())
+      tree.buildIndex();
+  }
+};
+
+NeighbourSearch::NeighbourSearch(const Eigen::Matrix3Xf& surface)
+: impl_(std::make_unique<Impl>(surface))
+{}
+
+NeighbourSearch::~NeighbourSearch() = default;
+
+Neighbourhoods
+NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) const
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::NeighbourSearch::nearest: k must be at least 1");
+  const auto& data = impl_->data;
+  const auto& tree = impl_->tree;
+  const std::size_t n = static_cast<std::size_t>(queries.cols());
+  Neighbourhoods out;
+  out.offsets.assign(n + 1, 0);
+  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), data.columns.size());
+  if (kk == 0)
+    return out;
+  std::vector<std::uint32_t> found(n * kk);
+  std::vector<std::uint32_t> counts(n, 0);
+#pragma omp parallel num_threads(threadCount(threads))
+  {
+    std::vector<float> distances(kk);
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+      const Eigen::Vector3f q = queries.col(i);
+      if (!q.allFinite())
+        continue;
+      counts[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(
+          tree.knnSearch(q.data(), kk, found.data() + static_cast<std::size_t>(i) * kk,
+                         distances.data()));
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    out.offsets[i + 1] = out.offsets[i] + counts[i];
+  out.indices.resize(out.offsets[n]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < counts[i]; ++j)
+      out.indices[out.offsets[i] + j] = data.columns[found[i * kk + j]];
+  return out;
+}
+
+Neighbourhoods
+NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threads) const
+{
+  if (!(radius > 0.f) || !std::isfinite(radius))
+    throw std::invalid_argument(
+        "facyl::NeighbourSearch::within: radius must be positive and finite");
+  const auto& data = impl_->data;
+  const auto& tree = impl_->tree;
+  const std::size_t n = static_cast<std::size_t>(queries.cols());
+  Neighbourhoods out;
+  out.offsets.assign(n + 1, 0);
+  if (data.columns.empty())
+    return out;
+  std::vector<std::vector<int>> lists(n);
+#pragma omp parallel num_threads(threadCount(threads))
+  {
+    std::vector<std::pair<std::uint32_t, float>> matches;
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+      const Eigen::Vector3f q = queries.col(i);
+      if (!q.allFinite())
+        continue;
+      tree.radiusSearch(q.data(), radius * radius, matches,
+                        nanoflann::SearchParams(32, 0.f, true));
+      auto& list = lists[static_cast<std::size_t>(i)];
+      list.reserve(matches.size());
+      for (const auto& m : matches)
+        list.push_back(data.columns[m.first]);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    out.offsets[i + 1] = out.offsets[i] + lists[i].size();
+  out.indices.reserve(out.offsets[n]);
+  for (const auto& list : lists)
+    out.indices.insert(out.indices.end(), list.begin(), list.end());
+  return out;
+}
+
+} // namespace facyl
