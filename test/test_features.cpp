@@ -1,0 +1,271 @@
+/*
+ * facyl: tests of NormalCurvatureEstimation and NeighbourSearch.
+ */
+#include "test_helpers.h"
+
+#include <facyl/features/neighbourhoods.h>
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/simulation/cylinder_simulation.h>
+
+#include <pcl/features/normal_3d.h>
+#include <pcl/features/principal_curvatures.h>
+#include <pcl/search/kdtree.h>
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+using Cues = pcl::PointCloud<facyl::NormalCurvature>;
+
+namespace {
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+cylinderXYZ(float noise, std::uint64_t seed)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.1f;
+  p.height = 0.4f;
+  p.lateral_points = 2000;
+  p.noise = noise;
+  p.seed = seed;
+  const auto sim = facyl::simulateCylinder(p);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& q : sim.cloud)
+    cloud->push_back(pcl::PointXYZ(q.x, q.y, q.z));
+  return cloud;
+}
+} // namespace
+
+TEST(NeighbourSearch, MatchesBruteForce)
+{
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  Eigen::Matrix3Xf pts(3, 500);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i)
+    pts.col(i) = Eigen::Vector3f(u(rng), u(rng), u(rng));
+  pts.col(7).setConstant(std::numeric_limits<float>::quiet_NaN());
+  const facyl::NeighbourSearch search(pts);
+  const auto knn = search.nearest(pts, 8, 2);
+  const auto ball = search.within(pts, 0.3f, 2);
+  ASSERT_EQ(knn.size(), 500u);
+  EXPECT_EQ(knn.count(7), 0u);
+  EXPECT_EQ(ball.count(7), 0u);
+  for (std::size_t i = 0; i < 500; ++i) {
+    if (i == 7)
+      continue;
+    std::vector<std::pair<float, int>> all;
+    for (Eigen::Index j = 0; j < pts.cols(); ++j)
+      if (j != 7)
+        all.emplace_back((pts.col(j) - pts.col(i)).squaredNorm(), static_cast<int>(j));
+    std::sort(all.begin(), all.end());
+    ASSERT_EQ(knn.count(i), 8u);
+    for (std::size_t j = 0; j < 8; ++j)
+      EXPECT_FLOAT_EQ((pts.col(knn.begin(i)[j]) - pts.col(i)).squaredNorm(), all[j].first);
+    const auto inside = std::count_if(all.begin(), all.end(),
+                                      [](const auto& d) { return d.first <= 0.09f; });
+    EXPECT_EQ(ball.count(i), static_cast<std::size_t>(inside));
+  }
+  EXPECT_THROW(search.nearest(pts, 0), std::invalid_argument);
+  EXPECT_THROW(search.within(pts, -1.f), std::invalid_argument);
+}
+
+TEST(NormalCurvatureEstimation, CylinderNormalsAreRadialAndCurvatureCircumferential)
+{
+  const auto cloud = cylinderXYZ(0.f, 1);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(16);
+  Cues cues;
+  ne.compute(cues);
+  ASSERT_EQ(cues.size(), cloud->size());
+  EXPECT_TRUE(cues.is_dense);
+  int good_normal = 0, good_direction = 0, anisotropic = 0, interior = 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Eigen::Vector3f p = (*cloud)[i].getVector3fMap();
+    if (p.z() < 0.05f || p.z() > 0.35f)
+      continue; // neighbourhoods cut by the open ends
+    ++interior;
+    const Eigen::Vector3f radial = Eigen::Vector3f(p.x(), p.y(), 0.f).normalized();
+    const Eigen::Vector3f n(cues[i].normal_x, cues[i].normal_y, cues[i].normal_z);
+    const Eigen::Vector3f c = cues[i].principalCurvatureVector3fMap();
+    good_normal += std::abs(n.dot(radial)) > std::cos(5.f * M_PI / 180.f); // PCA tilts on curved, uneven patches
+    good_direction += std::abs(c.z()) < 0.1f;
+    anisotropic += facyl::curvatureAnisotropy(cues[i].pc1, cues[i].pc2) > 0.8f;
+    // oriented towards the view point (the origin lies on the axis: inward)
+    EXPECT_LE(n.dot(radial), 0.f);
+  }
+  EXPECT_GT(good_normal, 0.95 * interior);
+  EXPECT_GT(good_direction, 0.9 * interior);
+  EXPECT_GT(anisotropic, 0.95 * interior);
+}
+
+TEST(NormalCurvatureEstimation, MatchesPclNormalAndPrincipalCurvatures)
+{
+  const auto cloud = cylinderXYZ(0.01f, 2);
+  Cues cues;
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(12);
+  ne.compute(cues);
+
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> pne;
+  pne.setInputCloud(cloud);
+  pne.setKSearch(12);
+  pne.compute(*normals);
+  pcl::PointCloud<pcl::PrincipalCurvatures> pcs;
+  pcl::PrincipalCurvaturesEstimation<pcl::PointXYZ, pcl::Normal> pce;
+  pce.setInputCloud(cloud);
+  pce.setInputNormals(normals);
+  pce.setKSearch(12);
+  pce.compute(pcs);
+
+  int checked = 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const Eigen::Vector3f a(cues[i].normal_x, cues[i].normal_y, cues[i].normal_z);
+    const Eigen::Vector3f b = (*normals)[i].getNormalVector3fMap();
+    ASSERT_NEAR(std::abs(a.dot(b)), 1.f, 1e-4f) << "point " << i;
+    EXPECT_NEAR(cues[i].curvature, (*normals)[i].curvature, 1e-4f);
+    // PCL flips towards the origin too; its curvatures use the same projected normals.
+    EXPECT_NEAR(cues[i].pc1, pcs[i].pc1, 1e-4f + 1e-3f * pcs[i].pc1);
+    EXPECT_NEAR(cues[i].pc2, pcs[i].pc2, 1e-4f + 1e-3f * pcs[i].pc2);
+    if (pcs[i].pc1 > 2.f * pcs[i].pc2 + 1e-4f) { // a well-defined direction
+      const Eigen::Vector3f c = cues[i].principalCurvatureVector3fMap();
+      const Eigen::Vector3f d(pcs[i].principal_curvature_x, pcs[i].principal_curvature_y,
+                              pcs[i].principal_curvature_z);
+      EXPECT_NEAR(std::abs(c.dot(d.normalized())), 1.f, 1e-2f);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(NormalCurvatureEstimation, IndicesSubsetGivesTheSameValues)
+{
+  const auto cloud = cylinderXYZ(0.01f, 3);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(10);
+  Cues full, part;
+  ne.compute(full);
+  pcl::IndicesPtr subset(new pcl::Indices);
+  for (int i = 0; i < static_cast<int>(cloud->size()); i += 7)
+    subset->push_back(i);
+  ne.setIndices(subset);
+  ne.compute(part);
+  ASSERT_EQ(part.size(), subset->size());
+  for (std::size_t k = 0; k < subset->size(); ++k) {
+    const auto& a = full[(*subset)[k]];
+    const auto& b = part[k];
+    EXPECT_NEAR(a.normal_x, b.normal_x, 1e-6f);
+    EXPECT_NEAR(a.pc1, b.pc1, 1e-6f);
+    EXPECT_NEAR(a.pc2, b.pc2, 1e-6f);
+  }
+}
+
+TEST(NormalCurvatureEstimation, ThreadsAndSearchMethodsAgree)
+{
+  const auto cloud = cylinderXYZ(0.02f, 4);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(10);
+  Cues one, two, pcl_tree;
+  ne.setNumberOfThreads(1);
+  ne.compute(one);
+  ne.setNumberOfThreads(2);
+  ne.compute(two);
+  ne.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
+  ne.compute(pcl_tree);
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    EXPECT_EQ(one[i].normal_x, two[i].normal_x);
+    EXPECT_EQ(one[i].pc1, two[i].pc1);
+    EXPECT_NEAR(one[i].normal_x, pcl_tree[i].normal_x, 1e-5f);
+    EXPECT_NEAR(one[i].pc1, pcl_tree[i].pc1, 1e-5f + 1e-4f * one[i].pc1);
+  }
+}
+
+TEST(NormalCurvatureEstimation, RadiusSearchAndGivenNormals)
+{
+  const auto cloud = cylinderXYZ(0.f, 5);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setRadiusSearch(0.03);
+  Cues by_radius;
+  ne.compute(by_radius);
+  ASSERT_EQ(by_radius.size(), cloud->size());
+  pcl::PointCloud<pcl::Normal>::Ptr given(new pcl::PointCloud<pcl::Normal>);
+  for (const auto& c : by_radius)
+    given->push_back(pcl::Normal(c.normal_x, c.normal_y, c.normal_z));
+  ne.setInputNormals(given);
+  Cues with_given;
+  ne.compute(with_given);
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    if (!std::isfinite(by_radius[i].pc1))
+      continue;
+    EXPECT_NEAR(by_radius[i].pc1, with_given[i].pc1, 1e-6f);
+  }
+}
+
+TEST(NormalCurvatureEstimation, NanPointsGiveNanOutput)
+{
+  auto cloud = cylinderXYZ(0.f, 6);
+  (*cloud)[10].x = std::numeric_limits<float>::quiet_NaN();
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(10);
+  Cues cues;
+  ne.compute(cues);
+  ASSERT_EQ(cues.size(), cloud->size());
+  EXPECT_FALSE(cues.is_dense);
+  EXPECT_TRUE(std::isnan(cues[10].normal_x));
+  EXPECT_TRUE(std::isnan(cues[10].pc1));
+  EXPECT_TRUE(std::isfinite(cues[11].normal_x));
+
+  pcl::PointCloud<pcl::PointXYZ>::Ptr all_nan(new pcl::PointCloud<pcl::PointXYZ>);
+  all_nan->resize(50, pcl::PointXYZ(NAN, NAN, NAN));
+  ne.setInputCloud(all_nan);
+  ne.compute(cues);
+  ASSERT_EQ(cues.size(), 50u);
+  EXPECT_FALSE(cues.is_dense);
+  for (const auto& c : cues)
+    EXPECT_TRUE(std::isnan(c.normal_x));
+}
+
+TEST(NormalCurvatureEstimation, BadInputsGiveEmptyOutput)
+{
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  Cues cues;
+  ne.setKSearch(10);
+  ne.compute(cues); // no input
+  EXPECT_TRUE(cues.empty());
+  ne.setInputCloud(pcl::PointCloud<pcl::PointXYZ>::Ptr(new pcl::PointCloud<pcl::PointXYZ>));
+  ne.compute(cues); // empty input
+  EXPECT_TRUE(cues.empty());
+  const auto cloud = cylinderXYZ(0.f, 7);
+  ne.setInputCloud(cloud);
+  ne.setKSearch(2); // too few neighbours for a plane
+  ne.compute(cues);
+  EXPECT_TRUE(cues.empty());
+  ne.setKSearch(0); // neither k nor radius
+  ne.compute(cues);
+  EXPECT_TRUE(cues.empty());
+  ne.setKSearch(10);
+  ne.setRadiusSearch(0.1); // both
+  ne.compute(cues);
+  EXPECT_TRUE(cues.empty());
+  ne.setRadiusSearch(0.0);
+  pcl::PointCloud<pcl::Normal>::Ptr wrong(new pcl::PointCloud<pcl::Normal>);
+  wrong->resize(3);
+  ne.setInputNormals(wrong);
+  ne.compute(cues);
+  EXPECT_TRUE(cues.empty());
+}
+
+TEST(LocalGeometry, CurvatureAnisotropyIsBounded)
+{
+  EXPECT_FLOAT_EQ(facyl::curvatureAnisotropy(1.f, 0.f), 1.f);
+  EXPECT_FLOAT_EQ(facyl::curvatureAnisotropy(1.f, 1.f), 0.f);
+  EXPECT_FLOAT_EQ(facyl::curvatureAnisotropy(0.f, 0.f), 0.f);
+  EXPECT_FLOAT_EQ(facyl::curvatureAnisotropy(NAN, 0.f), 0.f);
+  EXPECT_NEAR(facyl::curvatureAnisotropy(3.f, 1.f), 0.5f, 1e-6f);
+}

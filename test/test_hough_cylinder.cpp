@@ -1,0 +1,505 @@
+/*
+ * facyl: tests of the Hough cylinder estimator and its numerics.
+ */
+#include "test_helpers.h"
+
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
+#include <facyl/simulation/cylinder_simulation.h>
+
+#include <pcl/common/io.h>
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+using facyl::CylinderModel;
+using facyl::VotingMode;
+using facyl_test::degrees;
+using facyl_test::quantile;
+using Hough = facyl::HoughCylinderEstimation<pcl::PointNormal, facyl::NormalCurvature>;
+using Cloud = pcl::PointCloud<pcl::PointNormal>;
+
+namespace {
+
+struct Outcome {
+  bool found{false};
+  float axis_deg{90.f};
+  float radius_rel{1.f};
+  CylinderModel model;
+};
+
+Outcome
+fitOnce(const Cloud::ConstPtr& cloud, const facyl::CylinderGroundTruth& truth, Hough& hough)
+{
+  hough.setInputCloud(cloud);
+  hough.setInputNormals(facyl_test::estimateCues(cloud));
+  std::vector<CylinderModel> models;
+  Outcome o;
+  if (!hough.segment(models))
+    return o;
+  o.found = true;
+  o.model = models.front();
+  o.axis_deg = degrees(facyl::axisAngle(o.model.axis, truth.axis));
+  o.radius_rel = std::abs(o.model.radius - truth.radius) / truth.radius;
+  return o;
+}
+
+/** The robustness setting: random axis, radius 0.02-0.3 m, height 0.05-2 m. */
+facyl::CylinderSimulationParameters
+randomCylinder(int run, float lid_ratio, float noise)
+{
+  std::mt19937 rng(static_cast<unsigned>(run));
+  facyl::CylinderSimulationParameters p;
+  p.random_axis = true;
+  p.radius = std::uniform_real_distribution<float>(0.02f, 0.3f)(rng);
+  p.height = std::uniform_real_distribution<float>(0.05f, 2.0f)(rng);
+  p.lid_ratio = lid_ratio;
+  p.noise = noise;
+  p.seed = 1000 + static_cast<std::uint64_t>(run);
+  return p;
+}
+
+struct Sweep {
+  std::vector<float> axis_deg, radius_rel;
+  int failures{0};
+};
+
+Sweep
+sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = true)
+{
+  Sweep s;
+  for (int run = 0; run < runs; ++run) {
+    const auto sim = facyl::simulateCylinder(randomCylinder(run, lid_ratio, noise));
+    Hough hough;
+    hough.setVotingMode(mode);
+    hough.setRefine(refine);
+    hough.setRadiusLimits(0.01f, 0.5f);
+    const auto o = fitOnce(sim.cloud.makeShared(), sim.truth, hough);
+    s.axis_deg.push_back(o.axis_deg);
+    s.radius_rel.push_back(o.radius_rel);
+    s.failures += o.axis_deg > 10.f;
+  }
+  return s;
+}
+
+} // namespace
+
+TEST(HoughCylinderEstimation, CleanCylinderIsExact)
+{
+  for (int run = 0; run < 20; ++run) {
+    auto p = randomCylinder(run, 0.f, 0.f);
+    p.height = std::max(p.height, 2.f * p.radius);
+    const auto sim = facyl::simulateCylinder(p);
+    Hough hough;
+    const auto o = fitOnce(sim.cloud.makeShared(), sim.truth, hough);
+    ASSERT_TRUE(o.found) << "run " << run;
+    EXPECT_LT(o.axis_deg, 0.5f) << "run " << run;
+    EXPECT_LT(o.radius_rel, 0.01f) << "run " << run;
+    EXPECT_LT(facyl_test::axisOffset(o.model, sim.truth.base), 0.01f * p.radius);
+    EXPECT_NEAR(o.model.height, p.height, 0.02f * p.height);
+    EXPECT_GT(o.model.inlier_ratio, 0.95f);
+    EXPECT_GT(o.model.angular_coverage, 0.95f);
+  }
+}
+
+TEST(HoughCylinderEstimation, SoftCurvatureIsRobustToLids)
+{
+  // Random axes, radius 0.02-0.3 m, 1% noise, lids at 300% and 500% of the lateral points.
+  for (const float lids : {3.f, 5.f}) {
+    const Sweep s = sweep(VotingMode::SoftCurvature, lids, 0.01f, 100);
+    EXPECT_LT(quantile(s.axis_deg, 0.5), 1.f) << "lids " << lids;
+    EXPECT_LT(s.failures, 2) << "lids " << lids; // fewer than 2% of 100 fits off by > 10 deg
+    EXPECT_LT(quantile(s.radius_rel, 0.5), 0.01f) << "lids " << lids;
+  }
+}
+
+TEST(HoughCylinderEstimation, SoftCurvatureBeatsRabbaniWithLids)
+{
+  const Sweep rabbani = sweep(VotingMode::Rabbani, 3.f, 0.01f, 40);
+  const Sweep soft = sweep(VotingMode::SoftCurvature, 3.f, 0.01f, 40);
+  // Planar lid points vote for the great circle orthogonal to the axis: hard votes fail.
+  EXPECT_GT(rabbani.failures, 20);
+  EXPECT_LT(soft.failures, rabbani.failures);
+  EXPECT_LT(quantile(soft.axis_deg, 0.5), quantile(rabbani.axis_deg, 0.5));
+}
+
+TEST(HoughCylinderEstimation, RefinementRemovesCellQuantisation)
+{
+  // The paper's axis is a cell of the accumulator: about 3.8 deg radius for N_d = 450.
+  const Sweep cell = sweep(VotingMode::SoftCurvature, 0.f, 0.01f, 40, false);
+  const Sweep refined = sweep(VotingMode::SoftCurvature, 0.f, 0.01f, 40, true);
+  EXPECT_GT(quantile(cell.axis_deg, 0.5), 1.f);
+  EXPECT_LT(quantile(refined.axis_deg, 0.5), 0.2f);
+  EXPECT_LT(quantile(refined.axis_deg, 0.9), quantile(cell.axis_deg, 0.5));
+}
+
+TEST(HoughCylinderEstimation, FindsACylinderNextToATable)
+{
+  for (const bool upright : {true, false}) {
+    facyl::CylinderSimulationParameters p;
+    p.radius = 0.04f;
+    p.height = 0.12f;
+    p.noise = 0.01f;
+    p.lid_ratio = 0.3f;
+    p.seed = upright ? 1 : 2;
+    // Upright on the table (axis = table normal), or lying on it.
+    p.axis = upright ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
+    p.base = upright ? Eigen::Vector3f::Zero() : Eigen::Vector3f(-0.06f, 0.f, p.radius);
+    const auto sim = facyl::simulateCylinder(p);
+    // Table twice the object's size, as dense as the object.
+    const float side = 2.f * std::max(p.height, 2.f * p.radius) * 2.f;
+    auto table = facyl::simulatePlane(Eigen::Vector3f(0.1f, 0.05f, 0.f), Eigen::Vector3f::UnitZ(),
+                                      side, side, 1800, 0.01f * p.radius, 3);
+    Cloud::Ptr cloud(new Cloud(sim.cloud));
+    *cloud += table;
+    Hough hough;
+    const auto o = fitOnce(cloud, sim.truth, hough);
+    ASSERT_TRUE(o.found) << (upright ? "upright" : "lying");
+    EXPECT_LT(o.axis_deg, 2.f) << (upright ? "upright" : "lying");
+    EXPECT_LT(o.radius_rel, 0.03f) << (upright ? "upright" : "lying");
+    EXPECT_LT(facyl_test::axisOffset(o.model, sim.truth.base), 0.1f * p.radius);
+  }
+}
+
+TEST(HoughCylinderEstimation, ExtractsTwoCylinders)
+{
+  facyl::CylinderSimulationParameters a, b;
+  a.radius = 0.05f;
+  a.height = 0.3f;
+  a.noise = 0.01f;
+  a.axis = Eigen::Vector3f(0.2f, 0.f, 1.f);
+  a.seed = 1;
+  b.radius = 0.12f;
+  b.height = 0.5f;
+  b.noise = 0.01f;
+  b.axis = Eigen::Vector3f(1.f, 0.3f, 0.1f);
+  b.base = Eigen::Vector3f(0.4f, 0.3f, 0.1f);
+  b.seed = 2;
+  const auto sa = facyl::simulateCylinder(a);
+  const auto sb = facyl::simulateCylinder(b);
+  Cloud::Ptr cloud(new Cloud(sa.cloud));
+  *cloud += sb.cloud;
+  Hough hough;
+  hough.setInputCloud(cloud);
+  hough.setInputNormals(facyl_test::estimateCues(cloud));
+  hough.setMaxCylinders(2);
+  std::vector<CylinderModel> models;
+  ASSERT_TRUE(hough.segment(models));
+  ASSERT_EQ(models.size(), 2u);
+  for (const auto* truth : {&sa.truth, &sb.truth}) {
+    const auto match = std::find_if(models.begin(), models.end(), [&](const CylinderModel& m) {
+      return std::abs(m.radius - truth->radius) < 0.05f * truth->radius;
+    });
+    ASSERT_NE(match, models.end()) << "radius " << truth->radius;
+    EXPECT_LT(degrees(facyl::axisAngle(match->axis, truth->axis)), 1.f);
+    EXPECT_LT(facyl_test::axisOffset(*match, truth->base), 0.05f * truth->radius);
+  }
+  // The first cylinder's points are not the second's.
+  std::vector<int> both;
+  std::set_intersection(models[0].inliers.begin(), models[0].inliers.end(),
+                        models[1].inliers.begin(), models[1].inliers.end(),
+                        std::back_inserter(both));
+  EXPECT_TRUE(both.empty());
+  // And with one cylinder asked for, there is one.
+  hough.setMaxCylinders(1);
+  ASSERT_TRUE(hough.segment(models));
+  EXPECT_EQ(models.size(), 1u);
+}
+
+TEST(HoughCylinderEstimation, PclStyleOutputAndIndices)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.07f;
+  p.height = 0.25f;
+  p.axis = Eigen::Vector3f(0.f, 1.f, 1.f);
+  p.base = Eigen::Vector3f(0.1f, 0.2f, 0.8f);
+  p.noise = 0.005f;
+  const auto sim = facyl::simulateCylinder(p);
+  // A second object the indices leave out.
+  facyl::CylinderSimulationParameters q = p;
+  q.base = Eigen::Vector3f(0.5f, 0.f, 0.8f);
+  q.radius = 0.03f;
+  Cloud::Ptr cloud(new Cloud(sim.cloud));
+  *cloud += facyl::simulateCylinder(q).cloud;
+  pcl::IndicesPtr first(new pcl::Indices);
+  for (int i = 0; i < static_cast<int>(sim.cloud.size()); ++i)
+    first->push_back(i);
+
+  Hough hough;
+  hough.setInputCloud(cloud);
+  hough.setInputNormals(facyl_test::estimateCues(cloud));
+  hough.setIndices(first);
+  pcl::PointIndices inliers;
+  pcl::ModelCoefficients coefficients;
+  ASSERT_TRUE(hough.segment(inliers, coefficients));
+  ASSERT_EQ(coefficients.values.size(), 7u);
+  const Eigen::Vector3f point(coefficients.values[0], coefficients.values[1],
+                             coefficients.values[2]);
+  const Eigen::Vector3f axis(coefficients.values[3], coefficients.values[4],
+                             coefficients.values[5]);
+  EXPECT_NEAR(axis.norm(), 1.f, 1e-5f);
+  EXPECT_LT(degrees(facyl::axisAngle(axis, sim.truth.axis)), 1.f);
+  EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
+  EXPECT_LT(facyl::distanceToLine(p.base, point, axis), 0.02f * p.radius);
+  ASSERT_FALSE(inliers.indices.empty());
+  EXPECT_TRUE(std::is_sorted(inliers.indices.begin(), inliers.indices.end()));
+  EXPECT_LT(inliers.indices.back(), static_cast<int>(sim.cloud.size()));
+  EXPECT_GT(inliers.indices.size(), 0.9 * sim.cloud.size());
+}
+
+TEST(HoughCylinderEstimation, SameSeedSameResult)
+{
+  const auto sim = facyl::simulateCylinder(randomCylinder(5, 2.f, 0.02f));
+  const auto cloud = sim.cloud.makeShared();
+  const auto cues = facyl_test::estimateCues(cloud);
+  std::vector<CylinderModel> a, b;
+  for (auto* out : {&a, &b}) {
+    Hough hough;
+    hough.setSeed(99);
+    hough.setInputCloud(cloud);
+    hough.setInputNormals(cues);
+    ASSERT_TRUE(hough.segment(*out));
+  }
+  EXPECT_EQ(a[0].axis, b[0].axis);
+  EXPECT_EQ(a[0].radius, b[0].radius);
+  EXPECT_EQ(a[0].inliers, b[0].inliers);
+}
+
+TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.05f;
+  p.height = 0.3f;
+  p.noise = 0.005f;
+  const auto sim = facyl::simulateCylinder(p);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
+  pcl::copyPointCloud(sim.cloud, *xyz);
+  const auto cues = facyl_test::estimateCues(sim.cloud.makeShared());
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  pcl::PointCloud<pcl::PrincipalCurvatures>::Ptr curvatures(
+      new pcl::PointCloud<pcl::PrincipalCurvatures>);
+  pcl::copyPointCloud(*cues, *normals);
+  pcl::copyPointCloud(*cues, *curvatures);
+
+  facyl::HoughCylinderEstimation<pcl::PointXYZ, pcl::Normal> hough;
+  hough.setInputCloud(xyz);
+  hough.setInputNormals(normals);
+  pcl::PointIndices inliers;
+  pcl::ModelCoefficients coefficients;
+  // SoftCurvature (the default) needs curvatures, which pcl::Normal does not carry.
+  EXPECT_FALSE(hough.segment(inliers, coefficients));
+  EXPECT_TRUE(coefficients.values.empty());
+  hough.setInputCurvatures(curvatures);
+  ASSERT_TRUE(hough.segment(inliers, coefficients));
+  EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
+  hough.setInputCurvatures(nullptr);
+  for (const auto mode : {VotingMode::SoftNormal, VotingMode::Rabbani}) {
+    hough.setVotingMode(mode);
+    ASSERT_TRUE(hough.segment(inliers, coefficients)) << facyl::toString(mode);
+    EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
+  }
+}
+
+TEST(HoughCylinderEstimation, PriorsInTheReferenceFrame)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.05f;
+  p.height = 0.3f;
+  p.noise = 0.01f;
+  p.lid_ratio = 1.f;
+  p.axis = Eigen::Vector3f(0.1f, 1.f, 0.05f); // "up" is y here
+  const auto sim = facyl::simulateCylinder(p);
+  Hough hough;
+  hough.setOrientationPrior(facyl::OrientationPrior::VerticalStrong);
+  hough.setUpDirection(Eigen::Vector3f::UnitY());
+  hough.setNumberOfOrientations(100);
+  const auto o = fitOnce(sim.cloud.makeShared(), sim.truth, hough);
+  ASSERT_TRUE(o.found);
+  EXPECT_LT(o.axis_deg, 1.f);
+  const auto& cells = hough.getAccumulators().front().directions();
+  EXPECT_GT(cells.row(1).array().abs().mean(), 0.8f);
+}
+
+TEST(HoughCylinderEstimation, InvalidInputsAreReported)
+{
+  const auto sim = facyl::simulateCylinder({});
+  const auto cloud = sim.cloud.makeShared();
+  const auto cues = facyl_test::estimateCues(cloud);
+  pcl::PointIndices inliers;
+  pcl::ModelCoefficients coefficients;
+  const auto fails = [&](Hough& h) {
+    inliers.indices = {1, 2, 3};
+    coefficients.values = {1.f};
+    const bool ok = h.segment(inliers, coefficients);
+    return !ok && inliers.indices.empty() && coefficients.values.empty();
+  };
+  {
+    Hough h; // no input at all
+    EXPECT_TRUE(fails(h));
+  }
+  {
+    Hough h;
+    h.setInputCloud(Cloud::Ptr(new Cloud));
+    h.setInputNormals(cues);
+    EXPECT_TRUE(fails(h)); // empty cloud
+  }
+  {
+    Hough h;
+    h.setInputCloud(cloud);
+    EXPECT_TRUE(fails(h)); // no normals
+    pcl::PointCloud<facyl::NormalCurvature>::Ptr fewer(new pcl::PointCloud<facyl::NormalCurvature>(*cues));
+    fewer->resize(10);
+    h.setInputNormals(fewer);
+    EXPECT_TRUE(fails(h)); // sizes differ
+  }
+  {
+    Cloud::Ptr nan(new Cloud(*cloud));
+    for (auto& q : *nan)
+      q.x = std::numeric_limits<float>::quiet_NaN();
+    Hough h;
+    h.setInputCloud(nan);
+    h.setInputNormals(cues);
+    EXPECT_TRUE(fails(h)); // no finite point
+  }
+  {
+    Hough h;
+    h.setInputCloud(cloud);
+    h.setInputNormals(cues);
+    h.setRadiusLimits(0.5f, 0.1f);
+    EXPECT_TRUE(fails(h)); // inverted radius limits
+    h.setRadiusLimits(0.f, std::numeric_limits<float>::infinity());
+    h.setNumberOfOrientations(0);
+    EXPECT_TRUE(fails(h)); // empty accumulator
+    h.setNumberOfOrientations(450);
+    h.setDistanceThreshold(-1.f);
+    EXPECT_TRUE(fails(h));
+    h.setDistanceThreshold(0.f);
+    h.setMaxCylinders(0);
+    EXPECT_TRUE(fails(h));
+    h.setMaxCylinders(1);
+    h.setOrientationMixture({});
+    EXPECT_TRUE(fails(h)); // no mixture component
+    h.setOrientationPrior(facyl::OrientationPrior::Uniform);
+    h.setIndices(pcl::IndicesPtr(new pcl::Indices{0, 1, static_cast<int>(cloud->size()) + 5}));
+    EXPECT_TRUE(fails(h)); // index outside the cloud
+  }
+  {
+    // No cylinder in a plane: false, not a made-up cylinder.
+    const auto plane = facyl::simulatePlane(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(),
+                                            1.f, 1.f, 2000, 0.001f, 1);
+    Hough h;
+    h.setInputCloud(plane.makeShared());
+    h.setInputNormals(facyl_test::estimateCues(plane.makeShared()));
+    h.setRadiusLimits(0.01f, 0.3f);
+    EXPECT_TRUE(fails(h));
+  }
+}
+
+// ---- numerics -------------------------------------------------------------------------
+
+TEST(CylinderFitting, CircleFitIsExactOnACircle)
+{
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> angle(0.f, 2.f * static_cast<float>(M_PI));
+  Eigen::Matrix2Xf pts(2, 100);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i) {
+    const float t = angle(rng);
+    pts.col(i) = Eigen::Vector2f(1.f, -2.f) + 0.3f * Eigen::Vector2f(std::cos(t), std::sin(t));
+  }
+  facyl::Circle c{Eigen::Vector2f(1.05f, -1.97f), 0.25f};
+  ASSERT_TRUE(facyl::fitCircle(pts, 0.2f, c));
+  EXPECT_NEAR(c.center.x(), 1.f, 1e-4f);
+  EXPECT_NEAR(c.center.y(), -2.f, 1e-4f);
+  EXPECT_NEAR(c.radius, 0.3f, 1e-4f);
+}
+
+TEST(CylinderFitting, HoughCircleFindsTheCentreWithinACell)
+{
+  Eigen::Matrix2Xf pts(2, 60), normals(2, 60);
+  for (Eigen::Index i = 0; i < 60; ++i) {
+    const float t = 0.05f * static_cast<float>(i); // a 170 degree arc
+    normals.col(i) = Eigen::Vector2f(std::cos(t), std::sin(t));
+    pts.col(i) = Eigen::Vector2f(0.5f, 0.5f) + 0.2f * normals.col(i);
+  }
+  facyl::Circle c;
+  ASSERT_TRUE(facyl::houghCircle(pts, normals, 0.05f, 1.f, 64, c));
+  const float cell = (0.4f + 2.f) / 64.f;
+  EXPECT_LT((c.center - Eigen::Vector2f(0.5f, 0.5f)).norm(), 1.5f * cell);
+  EXPECT_NEAR(c.radius, 0.2f, 1.5f * cell);
+}
+
+TEST(CylinderFitting, RefineCylinderConvergesFromAnOffStart)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.1f;
+  p.height = 0.5f;
+  p.axis = Eigen::Vector3f(0.3f, -0.2f, 1.f);
+  p.base = Eigen::Vector3f(1.f, 1.f, 1.f);
+  const auto sim = facyl::simulateCylinder(p);
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(sim.cloud.size()));
+  for (std::size_t i = 0; i < sim.cloud.size(); ++i)
+    pts.col(static_cast<Eigen::Index>(i)) = sim.cloud[i].getVector3fMap();
+  Eigen::Vector3f point = p.base + Eigen::Vector3f(0.01f, -0.01f, 0.f);
+  Eigen::Vector3f axis = (sim.truth.axis + Eigen::Vector3f(0.05f, 0.02f, 0.f)).normalized();
+  float radius = 0.09f;
+  ASSERT_TRUE(facyl::refineCylinder(pts, point, axis, radius, 10));
+  EXPECT_LT(degrees(facyl::axisAngle(axis, sim.truth.axis)), 0.01f);
+  EXPECT_NEAR(radius, 0.1f, 1e-4f);
+  EXPECT_LT(facyl::distanceToLine(p.base, point, axis), 1e-4f);
+}
+
+TEST(CylinderFitting, NormalRotationSlopeTellsCylindersFromPlanes)
+{
+  // A 40-degree arc of a cylinder of radius 1 about z, and a flat strip of the same width.
+  Eigen::Matrix3Xf arc(3, 200), arc_n(3, 200), strip(3, 200), strip_n(3, 200);
+  for (Eigen::Index i = 0; i < 200; ++i) {
+    const float t = -0.35f + 0.7f * static_cast<float>(i) / 199.f;
+    const float z = 0.01f * static_cast<float>(i % 10);
+    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), z);
+    arc_n.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.f);
+    strip.col(i) = Eigen::Vector3f(1.f, std::sin(t), z);
+    strip_n.col(i) = Eigen::Vector3f::UnitX();
+  }
+  const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
+  EXPECT_NEAR(facyl::normalRotationSlope(arc, arc_n, origin, z), 1.f, 1e-3f);
+  EXPECT_LT(facyl::normalRotationSlope(strip, strip_n, origin, z), 0.05f);
+}
+
+TEST(CylinderFitting, VotesPeakAtTheAxis)
+{
+  // Normals and c_max of an ideal cylinder about z: every mode peaks at z.
+  facyl::VotingCues cues;
+  cues.resize(72);
+  for (Eigen::Index i = 0; i < 72; ++i) {
+    const float t = 0.0872665f * static_cast<float>(i);
+    cues.nx(i) = std::cos(t);
+    cues.ny(i) = std::sin(t);
+    cues.nz(i) = 0.f;
+    cues.cx(i) = -std::sin(t);
+    cues.cy(i) = std::cos(t);
+    cues.cz(i) = 0.f;
+    cues.weight(i) = 1.f;
+  }
+  Eigen::Matrix3Xf cells(3, 4);
+  cells << 0, 1, 0, 0.6f, //
+      0, 0, 1, 0,         //
+      1, 0, 0, 0.8f;
+  for (const auto mode : {VotingMode::Rabbani, VotingMode::SoftNormal, VotingMode::SoftCurvature})
+    for (const int p : {1, 2, 3}) {
+      Eigen::VectorXf votes;
+      facyl::castVotes(cells, cues, mode, p, 0.06f, votes);
+      Eigen::Index best;
+      votes.maxCoeff(&best);
+      EXPECT_EQ(best, 0) << facyl::toString(mode) << " p " << p;
+    }
+  Eigen::VectorXf votes(4);
+  votes << 5.f, 4.f, 3.f, 4.5f;
+  const auto peaks = facyl::findPeaks(cells, votes, 3, 0.8f);
+  // cell 3 is 37 degrees from cell 0: suppressed at 0.8 rad separation
+  ASSERT_EQ(peaks.size(), 3u);
+  EXPECT_EQ(peaks[0], 0);
+  EXPECT_EQ(peaks[1], 1);
+  EXPECT_EQ(peaks[2], 2);
+}

@@ -8,6 +8,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <numeric>
 #include <optional>
@@ -610,8 +612,47 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
   Circle circle;
   if (!houghCircle(vq, vm, params.radius_min, r_max, params.circle_grid, circle))
     return std::nullopt;
-  const float cell = (extent + 2.f * r_max) / static_cast<float>(params.circle_grid);
-  if (!fitCircle(q, std::max(0.3f * circle.radius, 3.f * cell), circle))
+  float cell = (extent + 2.f * r_max) / static_cast<float>(params.circle_grid);
+
+  // The points that agree with a circle: near it, with a normal along its radius. Other
+  // structure that shares the axis direction (a table under a lying can) drops out here.
+  const float cos_n = std::cos(params.normal_angle_threshold);
+  const auto agreeing = [&](const Eigen::Matrix2Xf& pts, const Eigen::Matrix2Xf& nrm,
+                            const Circle& c, float band) {
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = 0; i < pts.cols(); ++i) {
+      const Eigen::Vector2f w = pts.col(i) - c.center;
+      const float d = w.norm();
+      if (std::abs(d - c.radius) < band && std::abs(nrm.col(i).dot(w)) >= cos_n * d)
+        keep.push_back(i);
+    }
+    return keep;
+  };
+  // Coarse to fine: with a wide radius range the first grid's cells can exceed the radius;
+  // vote again on the agreeing points over a range around the first estimate.
+  if (cell > 0.1f * circle.radius) {
+    const auto keep = agreeing(vq, vm, circle, std::max(0.5f * circle.radius, 2.f * cell));
+    if (keep.size() >= 5) {
+      const float lo = std::max(params.radius_min, 0.5f * circle.radius - cell);
+      const float hi = std::min(r_max, 1.5f * circle.radius + cell);
+      Circle fine;
+      if (hi > lo && houghCircle(vq(Eigen::all, keep), vm(Eigen::all, keep), lo, hi,
+                                 params.circle_grid, fine)) {
+        Eigen::Matrix2Xf kept = vq(Eigen::all, keep);
+        const float fine_extent = (kept.rowwise().maxCoeff() - kept.rowwise().minCoeff()).norm();
+        circle = fine;
+        cell = (fine_extent + 2.f * hi) / static_cast<float>(params.circle_grid);
+      }
+    }
+  }
+  Eigen::Matrix2Xf qm(2, q.cols());
+  for (std::size_t k = 0; k < support.size(); ++k) {
+    const auto m = cues.normals.col(support[k]);
+    qm.col(static_cast<Eigen::Index>(k)) = Eigen::Vector2f(u.dot(m), v.dot(m)).normalized();
+  }
+  const auto keep = agreeing(q, qm, circle, std::max(0.3f * circle.radius, 3.f * cell));
+  if (keep.size() < 5 ||
+      !fitCircle(q(Eigen::all, keep), std::max(0.3f * circle.radius, 3.f * cell), circle))
     return std::nullopt;
   if (circle.radius < params.radius_min || circle.radius > params.radius_max)
     return std::nullopt;
@@ -782,6 +823,9 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
       continue;
     CylinderModel model = describe(cues, active, *candidate, params);
     const double s = score(model);
+    if (std::getenv("FACYL_DEBUG"))
+      std::fprintf(stderr, "seed (%.3f %.3f %.3f) -> axis (%.3f %.3f %.3f) r %.4f inliers %zu score %.2f\n",
+                   seed.axis.x(), seed.axis.y(), seed.axis.z(), model.axis.x(), model.axis.y(), model.axis.z(), model.radius, model.inliers.size(), s);
     if (!best || s > best_score || (s == best_score && model.rms_error < best->rms_error)) {
       best = std::move(model);
       best_score = s;
