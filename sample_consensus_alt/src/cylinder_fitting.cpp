@@ -695,38 +695,52 @@ describe(const CylinderCues& cues, const std::vector<int>& active, const Candida
          const HoughCylinderParameters& params)
 {
   CylinderModel m;
-  m.axis = foldToHemisphere(c.axis.normalized());
+  m.axis = c.axis;
+  m.point_on_axis = c.point_on_axis;
   m.radius = c.radius;
   m.distance_threshold = c.threshold;
   const std::vector<int> inliers =
       selectInliers(cues, active, c, std::cos(params.normal_angle_threshold));
   m.inliers.assign(inliers.begin(), inliers.end());
+  describeInliers(cues.points(Eigen::all, inliers), m);
+  return m;
+}
+
+} // namespace
+
+void
+describeInliers(const Eigen::Matrix3Xf& points, CylinderModel& m)
+{
+  m.axis = foldToHemisphere(m.axis.normalized());
   Eigen::Vector3f u, v;
   basisFor(m.axis, u, v);
+  const Eigen::Vector3f origin = m.point_on_axis;
   float t_min = std::numeric_limits<float>::max(), t_max = -t_min;
   double sq = 0.0;
   std::vector<char> sectors(36, 0);
-  for (const int s : inliers) {
-    const Eigen::Vector3f w = cues.points.col(s) - c.point_on_axis;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - origin;
     const float t = w.dot(m.axis);
     const Eigen::Vector3f d = w - t * m.axis;
     t_min = std::min(t_min, t);
     t_max = std::max(t_max, t);
-    const double e = d.norm() - c.radius;
+    const double e = d.norm() - m.radius;
     sq += e * e;
     const float angle = std::atan2(d.dot(v), d.dot(u)) + static_cast<float>(M_PI);
     sectors[std::min<std::size_t>(35, static_cast<std::size_t>(angle / (2 * M_PI) * 36))] = 1;
   }
-  if (inliers.empty())
+  if (points.cols() == 0)
     t_min = t_max = 0.f;
-  m.base = c.point_on_axis + t_min * m.axis;
-  m.top = c.point_on_axis + t_max * m.axis;
+  m.base = origin + t_min * m.axis;
+  m.top = origin + t_max * m.axis;
   m.point_on_axis = m.base;
   m.height = t_max - t_min;
-  m.rms_error = inliers.empty() ? 0.f : static_cast<float>(std::sqrt(sq / inliers.size()));
-  m.angular_coverage = static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
-  return m;
+  m.rms_error = points.cols() == 0 ? 0.f : static_cast<float>(std::sqrt(sq / points.cols()));
+  m.angular_coverage =
+      static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
 }
+
+namespace {
 
 std::optional<CylinderModel>
 fitOne(const CylinderCues& cues, const std::vector<int>& active,

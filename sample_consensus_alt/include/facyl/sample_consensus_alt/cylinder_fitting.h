@@ -124,6 +124,12 @@ float
 normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
                     const Eigen::Vector3f& point_on_axis, const Eigen::Vector3f& axis);
 
+/** \brief Completes \a model from its inlier points (3 x N): base and top (the extreme
+ * sections along the axis, with point_on_axis set to the base), height, rms_error and
+ * angular_coverage. Axis, a point on it and radius must be set; the axis is folded. */
+void
+describeInliers(const Eigen::Matrix3Xf& inlier_points, CylinderModel& model);
+
 /** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). */
 struct HoughCylinderParameters {
   VotingMode voting_mode{VotingMode::SoftCurvature};

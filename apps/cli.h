@@ -1,0 +1,157 @@
+/*
+ * facyl: small helpers shared by the command-line tools (strict option parsing, JSON).
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace facyl_cli {
+
+/** Options "--name value" and switches "--name"; everything else is a positional argument.
+ * Unknown options and malformed values are errors (std::invalid_argument), never ignored. */
+class Arguments {
+public:
+  Arguments(int argc, char** argv, const std::set<std::string>& with_value,
+            const std::set<std::string>& switches)
+  {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.size() > 1 && a[0] == '-' && !(a.size() > 1 && (std::isdigit(a[1]) || a[1] == '.'))) {
+        if (switches.count(a)) {
+          switches_.insert(a);
+          continue;
+        }
+        if (!with_value.count(a))
+          throw std::invalid_argument("unknown option " + a + " (see -h)");
+        if (i + 1 >= argc)
+          throw std::invalid_argument("option " + a + " needs a value");
+        values_[a] = argv[++i];
+        continue;
+      }
+      positional_.push_back(a);
+    }
+  }
+  bool
+  has(const std::string& s) const
+  {
+    return switches_.count(s) > 0 || values_.count(s) > 0;
+  }
+  const std::vector<std::string>&
+  positional() const
+  {
+    return positional_;
+  }
+  std::string
+  text(const std::string& name, const std::string& fallback) const
+  {
+    const auto it = values_.find(name);
+    return it == values_.end() ? fallback : it->second;
+  }
+  double
+  number(const std::string& name, double fallback) const
+  {
+    const auto it = values_.find(name);
+    if (it == values_.end())
+      return fallback;
+    char* end = nullptr;
+    const double v = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
+      throw std::invalid_argument("option " + name + ": '" + it->second + "' is not a number");
+    return v;
+  }
+  long long
+  integer(const std::string& name, long long fallback, long long min_value) const
+  {
+    const auto it = values_.find(name);
+    if (it == values_.end())
+      return fallback;
+    char* end = nullptr;
+    const long long v = std::strtoll(it->second.c_str(), &end, 10);
+    if (end == it->second.c_str() || *end != '\0')
+      throw std::invalid_argument("option " + name + ": '" + it->second + "' is not an integer");
+    if (v < min_value)
+      throw std::invalid_argument("option " + name + " must be at least " +
+                                  std::to_string(min_value));
+    return v;
+  }
+  Eigen::Vector3f
+  vector3(const std::string& name, const Eigen::Vector3f& fallback) const
+  {
+    const auto it = values_.find(name);
+    if (it == values_.end())
+      return fallback;
+    Eigen::Vector3f v;
+    char comma1, comma2;
+    std::istringstream in(it->second);
+    if (!(in >> v.x() >> comma1 >> v.y() >> comma2 >> v.z()) || comma1 != ',' || comma2 != ',' ||
+        !v.allFinite())
+      throw std::invalid_argument("option " + name + ": expected x,y,z, got '" + it->second + "'");
+    return v;
+  }
+
+private:
+  std::map<std::string, std::string> values_;
+  std::set<std::string> switches_;
+  std::vector<std::string> positional_;
+};
+
+/** JSON string literal. */
+inline std::string
+quote(const std::string& s)
+{
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+    case '"':
+      out += "\\\"";
+      break;
+    case '\\':
+      out += "\\\\";
+      break;
+    case '\n':
+      out += "\\n";
+      break;
+    case '\t':
+      out += "\\t";
+      break;
+    default:
+      if (static_cast<unsigned char>(c) < 0x20) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        out += buf;
+      }
+      else
+        out += c;
+    }
+  }
+  return out + "\"";
+}
+
+/** JSON number (null when not finite). */
+inline std::string
+number(double v)
+{
+  if (!std::isfinite(v))
+    return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+inline std::string
+vector(const Eigen::Vector3f& v)
+{
+  return "[" + number(v.x()) + "," + number(v.y()) + "," + number(v.z()) + "]";
+}
+
+} // namespace facyl_cli

@@ -1,0 +1,290 @@
+/*
+ * facyl_fit: fit cylinders to PCD files; one JSON object per file on stdout.
+ */
+#include "cli.h"
+#include "pcd_input.h"
+
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
+
+#include <pcl/common/common.h>
+#include <pcl/common/io.h>
+#include <pcl/common/point_tests.h>
+#include <pcl/common/time.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <fstream>
+#include <iostream>
+#include <limits>
+
+namespace {
+
+// Defaults, PCL-tool style.
+const char* default_method = "soft-curvature";
+const char* default_prior = "uniform";
+constexpr long long default_orientations = 450;
+constexpr long long default_accumulators = 1;
+constexpr long long default_k = 16;
+constexpr long long default_max_cylinders = 1;
+
+void
+printHelp(const char* self)
+{
+  std::printf(
+      "Usage: %s [options] FILE.pcd...\n"
+      "Fits cylinders to each point cloud and prints one JSON object per file.\n\n"
+      "  --method M           soft-curvature (default) | soft-normal | rabbani | pcl-ransac\n"
+      "                       (pcl-ransac: pcl::SACSegmentationFromNormals, SACMODEL_CYLINDER)\n"
+      "  --prior P            uniform (default) | vertical | vertical-strong | horizontal\n"
+      "  --up x,y,z           the prior's \"up\" direction (default 0,0,1)\n"
+      "  --orientations N     cells per orientation accumulator, N_d (default %lld)\n"
+      "  --accumulators K     independent accumulators per fit (default %lld)\n"
+      "  --radius-min R       smallest radius (default 0)\n"
+      "  --radius-max R       largest radius (default: twice the extent of the data)\n"
+      "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
+      "                       pcl-ransac: 1%% of the bounding-box diagonal)\n"
+      "  --max-cylinders N    cylinders to extract, one after another (default %lld)\n"
+      "  --k K                neighbours for normals and curvatures (default %lld)\n"
+      "  --seed S             seed of the accumulator draws and of RANSAC (default 0)\n"
+      "  --threads T          threads for normals (default: all)\n"
+      "  -h, --help           this help\n\n"
+      "Normals are estimated unless the file has normal_x/y/z. Exit status: 0 if every file\n"
+      "was processed, 1 if some file failed (its object holds \"error\"), 2 on bad options.\n",
+      self, default_orientations, default_accumulators, default_max_cylinders, default_k);
+}
+
+struct Settings {
+  std::string method{default_method};
+  facyl::HoughCylinderParameters params;
+  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
+  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
+  std::size_t orientations{default_orientations};
+  std::size_t accumulators{default_accumulators};
+  int k{default_k};
+  std::uint64_t seed{0};
+  unsigned threads{0};
+};
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Cues = pcl::PointCloud<facyl::NormalCurvature>;
+
+/** PCL RANSAC on the same cloud and normals, with the same radius limits. */
+std::vector<facyl::CylinderModel>
+fitPclRansac(const Cloud::ConstPtr& cloud, const Cues& cues, const Settings& s)
+{
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  pcl::copyPointCloud(cues, *normals);
+  Eigen::Vector4f lo, hi;
+  pcl::getMinMax3D(*cloud, lo, hi);
+  const float diagonal = (hi - lo).head<3>().norm();
+  pcl::SACSegmentationFromNormals<pcl::PointXYZ, pcl::Normal> seg;
+  seg.setOptimizeCoefficients(true);
+  seg.setModelType(pcl::SACMODEL_CYLINDER);
+  seg.setMethodType(pcl::SAC_RANSAC);
+  seg.setNormalDistanceWeight(0.1);
+  seg.setMaxIterations(10000);
+  seg.setDistanceThreshold(s.params.distance_threshold > 0.f ? s.params.distance_threshold
+                                                             : 0.01f * diagonal);
+  seg.setRadiusLimits(s.params.radius_min,
+                      std::isfinite(s.params.radius_max) ? s.params.radius_max : diagonal);
+  seg.setInputCloud(cloud);
+  seg.setInputNormals(normals);
+  pcl::IndicesPtr remaining(new pcl::Indices);
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    if (pcl::isFinite((*cloud)[i]) && std::isfinite(cues[i].normal_x))
+      remaining->push_back(static_cast<int>(i));
+  const std::size_t total = cloud->size();
+  std::vector<facyl::CylinderModel> models;
+  for (std::size_t round = 0; round < s.params.max_cylinders && remaining->size() > 10; ++round) {
+    seg.setIndices(remaining);
+    pcl::PointIndices inliers;
+    pcl::ModelCoefficients c;
+    seg.segment(inliers, c);
+    if (inliers.indices.size() < 10 || c.values.size() != 7)
+      break;
+    facyl::CylinderModel m;
+    m.point_on_axis = Eigen::Vector3f(c.values[0], c.values[1], c.values[2]);
+    m.axis = Eigen::Vector3f(c.values[3], c.values[4], c.values[5]).normalized();
+    m.radius = c.values[6];
+    m.inliers = inliers.indices;
+    m.inlier_ratio = static_cast<float>(inliers.indices.size()) / static_cast<float>(total);
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(inliers.indices.size()));
+    for (std::size_t k = 0; k < inliers.indices.size(); ++k)
+      pts.col(static_cast<Eigen::Index>(k)) = (*cloud)[inliers.indices[k]].getVector3fMap();
+    facyl::describeInliers(pts, m);
+    models.push_back(m);
+    pcl::Indices rest;
+    std::set_difference(remaining->begin(), remaining->end(), inliers.indices.begin(),
+                        inliers.indices.end(), std::back_inserter(rest));
+    remaining->swap(rest);
+  }
+  return models;
+}
+
+std::string
+errorObject(const std::string& file, const std::string& message)
+{
+  return "{\"file\":" + facyl_cli::quote(file) + ",\"error\":" + facyl_cli::quote(message) + "}";
+}
+
+using facyl_cli::hasField;
+
+/** One file: the JSON line, and whether it worked. */
+std::string
+processFile(const std::string& file, const Settings& s, bool& ok)
+{
+  ok = false;
+  pcl::StopWatch total_watch;
+  pcl::PCLPointCloud2 blob;
+  const std::string unreadable = facyl_cli::readPcd(file, blob);
+  if (!unreadable.empty())
+    return errorObject(file, unreadable);
+  Cloud::Ptr cloud(new Cloud);
+  pcl::fromPCLPointCloud2(blob, *cloud);
+  if (cloud->empty())
+    return errorObject(file, "the cloud is empty");
+  const auto finite = std::count_if(cloud->begin(), cloud->end(),
+                                    [](const pcl::PointXYZ& p) { return pcl::isFinite(p); });
+  if (finite == 0)
+    return errorObject(file, "the cloud has no finite point");
+  const double load_ms = total_watch.getTime();
+
+  // Normals and curvatures (the file's normals when it has them).
+  pcl::StopWatch normals_watch;
+  Cues::Ptr cues(new Cues);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(s.k);
+  ne.setNumberOfThreads(s.threads);
+  if (hasField(blob, "normal_x") && hasField(blob, "normal_y") && hasField(blob, "normal_z")) {
+    pcl::PointCloud<pcl::Normal>::Ptr given(new pcl::PointCloud<pcl::Normal>);
+    pcl::fromPCLPointCloud2(blob, *given);
+    ne.setInputNormals(given);
+  }
+  ne.compute(*cues);
+  if (cues->size() != cloud->size())
+    return errorObject(file, "normal estimation failed (too few points for k = " +
+                                 std::to_string(s.k) + "?)");
+  const double normals_ms = normals_watch.getTime();
+  if (std::none_of(cues->begin(), cues->end(),
+                   [](const facyl::NormalCurvature& c) { return std::isfinite(c.normal_x); }))
+    return errorObject(file, "no point has a normal: " + std::to_string(finite) +
+                                 " finite points are too few or degenerate for k = " +
+                                 std::to_string(s.k));
+
+  pcl::StopWatch fit_watch;
+  std::vector<facyl::CylinderModel> models;
+  if (s.method == "pcl-ransac") {
+    models = fitPclRansac(cloud, *cues, s);
+  }
+  else {
+    facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
+    hough.setParameters(s.params);
+    hough.setOrientationPrior(s.prior);
+    hough.setUpDirection(s.up);
+    hough.setNumberOfOrientations(s.orientations);
+    hough.setNumberOfAccumulators(s.accumulators);
+    hough.setSeed(s.seed);
+    hough.setInputCloud(cloud);
+    hough.setInputNormals(cues);
+    hough.segment(models); // false with no cylinder: an empty list, not an error
+  }
+  const double fit_ms = fit_watch.getTime();
+
+  using facyl_cli::number;
+  using facyl_cli::vector;
+  std::string out = "{\"file\":" + facyl_cli::quote(file) + ",\"method\":" +
+                    facyl_cli::quote(s.method) + ",\"points\":" + std::to_string(cloud->size()) +
+                    ",\"cylinders\":[";
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const auto& m = models[i];
+    out += (i ? "," : "");
+    out += "{\"point_on_axis\":" + vector(m.point_on_axis) + ",\"axis\":" + vector(m.axis) +
+           ",\"radius\":" + number(m.radius) + ",\"height\":" + number(m.height) +
+           ",\"base\":" + vector(m.base) + ",\"top\":" + vector(m.top) +
+           ",\"inlier_ratio\":" + number(m.inlier_ratio) +
+           ",\"inliers\":" + std::to_string(m.inliers.size()) +
+           ",\"rms_error\":" + number(m.rms_error) +
+           ",\"angular_coverage\":" + number(m.angular_coverage) + "}";
+  }
+  out += "],\"timing_ms\":{\"load\":" + number(load_ms) + ",\"normals\":" + number(normals_ms) +
+         ",\"fit\":" + number(fit_ms) + ",\"total\":" + number(total_watch.getTime()) + "}}";
+  ok = true;
+  return out;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help") {
+      printHelp(argv[0]);
+      return 0;
+    }
+  Settings s;
+  std::vector<std::string> files;
+  try {
+    const facyl_cli::Arguments args(
+        argc, argv,
+        {"--method", "--prior", "--up", "--orientations", "--accumulators", "--radius-min",
+         "--radius-max", "--distance-threshold", "--max-cylinders", "--k", "--seed",
+         "--threads"},
+        {});
+    files = args.positional();
+    s.method = args.text("--method", default_method);
+    facyl::VotingMode mode;
+    if (s.method != "pcl-ransac") {
+      if (!facyl::parseVotingMode(s.method, mode))
+        throw std::invalid_argument("unknown --method '" + s.method + "'");
+      s.params.voting_mode = mode;
+    }
+    if (!facyl::parseOrientationPrior(args.text("--prior", default_prior), s.prior))
+      throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
+    s.up = args.vector3("--up", s.up);
+    if (!(s.up.norm() > 0.f))
+      throw std::invalid_argument("--up must not be zero");
+    s.orientations = static_cast<std::size_t>(args.integer("--orientations", default_orientations, 1));
+    s.accumulators = static_cast<std::size_t>(args.integer("--accumulators", default_accumulators, 1));
+    s.params.radius_min = static_cast<float>(args.number("--radius-min", 0.0));
+    s.params.radius_max = static_cast<float>(
+        args.number("--radius-max", std::numeric_limits<double>::infinity()));
+    s.params.distance_threshold = static_cast<float>(args.number("--distance-threshold", 0.0));
+    s.params.max_cylinders =
+        static_cast<std::size_t>(args.integer("--max-cylinders", default_max_cylinders, 1));
+    s.k = static_cast<int>(args.integer("--k", default_k, 3));
+    s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
+    s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0));
+    const std::string why = facyl::validate(s.params);
+    if (!why.empty())
+      throw std::invalid_argument(why);
+    if (files.empty())
+      throw std::invalid_argument("no input file (see -h)");
+  }
+  catch (const std::exception& e) {
+    std::fprintf(stderr, "facyl_fit: %s\n", e.what());
+    return 2;
+  }
+  // PCL's own console messages (warnings about a file) go to stderr; the JSON stays clean.
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  int failed = 0;
+  for (const auto& file : files) {
+    bool ok = false;
+    std::string line;
+    try {
+      line = processFile(file, s, ok);
+    }
+    catch (const std::exception& e) {
+      line = errorObject(file, e.what());
+    }
+    std::cout << line << std::endl;
+    failed += !ok;
+  }
+  return failed ? 1 : 0;
+}
