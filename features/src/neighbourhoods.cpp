@@ -6,6 +6,8 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -17,17 +19,21 @@
 namespace facyl {
 
 namespace {
-/** nanoflann's dataset contract over the finite columns of a 3 x N matrix. */
+/** nanoflann's dataset contract over the finite columns of a 3 x N matrix, copied into one
+ * contiguous block (the tree reads coordinates in its inner loop). */
 struct FiniteColumns {
-  const Eigen::Matrix3Xf& points;
-  std::vector<int> columns;
+  std::vector<float> xyz;   // finite points, packed
+  std::vector<int> columns; // their column in the surface
 
-  explicit FiniteColumns(const Eigen::Matrix3Xf& p) : points(p)
+  explicit FiniteColumns(const Eigen::Matrix3Xf& p)
   {
     columns.reserve(static_cast<std::size_t>(p.cols()));
+    xyz.reserve(3 * static_cast<std::size_t>(p.cols()));
     for (Eigen::Index i = 0; i < p.cols(); ++i)
-      if (p.col(i).allFinite())
+      if (p.col(i).allFinite()) {
         columns.push_back(static_cast<int>(i));
+        xyz.insert(xyz.end(), {p(0, i), p(1, i), p(2, i)});
+      }
   }
   std::size_t
   kdtree_get_point_count() const
@@ -37,7 +43,7 @@ struct FiniteColumns {
   float
   kdtree_get_pt(std::size_t idx, std::size_t dim) const
   {
-    return points(static_cast<Eigen::Index>(dim), columns[idx]);
+    return xyz[3 * idx + dim];
   }
   template <class BBox>
   bool
@@ -66,7 +72,7 @@ struct NeighbourSearch::Impl {
   FiniteColumns data;
   Tree tree;
   explicit Impl(const Eigen::Matrix3Xf& surface)
-  : data(surface), tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(16))
+  : data(surface), tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(10))
   {
     if (!data.columns.empty())
       tree.buildIndex();
@@ -102,9 +108,9 @@ NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) co
       const Eigen::Vector3f q = queries.col(i);
       if (!q.allFinite())
         continue;
-      counts[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(
-          tree.knnSearch(q.data(), kk, found.data() + static_cast<std::size_t>(i) * kk,
-                         distances.data()));
+      std::uint32_t* out = found.data() + static_cast<std::size_t>(i) * kk;
+      counts[static_cast<std::size_t>(i)] =
+          static_cast<std::uint32_t>(tree.knnSearch(q.data(), kk, out, distances.data()));
     }
   }
   for (std::size_t i = 0; i < n; ++i)

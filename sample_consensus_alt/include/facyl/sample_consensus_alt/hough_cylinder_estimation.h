@@ -180,7 +180,7 @@ public:
   {
     return params_.min_inliers;
   }
-  /** \brief Accumulator peaks per accumulator that are refined and fitted (default 3). */
+  /** \brief Accumulator peaks per accumulator that are refined and fitted (default 2). */
   void
   setOrientationCandidates(std::size_t n)
   {
