@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -24,46 +25,62 @@ struct PrincipalCurvatures {
  * \param[out] normal unit normal (sign arbitrary)
  * \param[out] surface_variation lambda0 / (lambda0 + lambda1 + lambda2), PCL's "curvature"
  * \return false when fewer than 3 finite points were given or they are degenerate.
- * Accumulates in double around the first point, so clouds far from the origin keep precision.
+ * Accumulates around the first point, so clouds far from the origin keep precision.
  */
 template <typename PointAt>
 bool
 estimateNormal(std::size_t count, PointAt point_at, Eigen::Vector3f& normal,
                float& surface_variation)
 {
-  Eigen::Vector3d origin{Eigen::Vector3d::Zero()}, sum{Eigen::Vector3d::Zero()};
-  Eigen::Matrix3d sq{Eigen::Matrix3d::Zero()};
+  // Float sums around the first point (neighbourhoods are small, so this keeps precision far
+  // from the origin), then one 3x3 direct eigen-solve on the scaled covariance.
+  Eigen::Vector3f origin{Eigen::Vector3f::Zero()}, sum{Eigen::Vector3f::Zero()};
+  float xx = 0.f, xy = 0.f, xz = 0.f, yy = 0.f, yz = 0.f, zz = 0.f;
   std::size_t used = 0;
   for (std::size_t j = 0; j < count; ++j) {
     const Eigen::Vector3f p = point_at(j);
     if (!p.allFinite())
       continue;
     if (used == 0)
-      origin = p.cast<double>();
-    const Eigen::Vector3d q = p.cast<double>() - origin;
+      origin = p;
+    const Eigen::Vector3f q = p - origin;
     sum += q;
-    sq.noalias() += q * q.transpose();
+    xx += q.x() * q.x();
+    xy += q.x() * q.y();
+    xz += q.x() * q.z();
+    yy += q.y() * q.y();
+    yz += q.y() * q.z();
+    zz += q.z() * q.z();
     ++used;
   }
   if (used < 3)
     return false;
-  const Eigen::Vector3d mean = sum / static_cast<double>(used);
-  const Eigen::Matrix3d cov = sq / static_cast<double>(used) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(cov);
-  const Eigen::Vector3d evals = solver.eigenvalues().cwiseMax(0.0);
-  const double total = evals.sum();
-  if (!(total > 0.0) || !(evals(1) > 1e-12 * total))
+  const float inv = 1.f / static_cast<float>(used);
+  const Eigen::Vector3f mean = sum * inv;
+  Eigen::Matrix3f cov;
+  cov << xx * inv, xy * inv, xz * inv, //
+      xy * inv, yy * inv, yz * inv,    //
+      xz * inv, yz * inv, zz * inv;
+  cov -= mean * mean.transpose();
+  const float scale = cov.cwiseAbs().maxCoeff();
+  if (!(scale > 0.f) || !std::isfinite(scale))
+    return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
+  solver.computeDirect(cov / scale);
+  const Eigen::Vector3f evals = solver.eigenvalues().cwiseMax(0.f);
+  const float total = evals.sum();
+  if (!(total > 0.f) || !(evals(1) > 1e-6f * total))
     return false; // all points on a line (or one point): no plane
-  normal = solver.eigenvectors().col(0).cast<float>().normalized();
-  surface_variation = static_cast<float>(evals(0) / total);
-  return true;
+  normal = solver.eigenvectors().col(0).normalized();
+  surface_variation = evals(0) / total;
+  return normal.allFinite();
 }
 
 /** \brief Principal curvature direction and magnitudes from the neighbours' normals
  * (paper III-C2, as pcl::PrincipalCurvaturesEstimation): project the normals returned by
  * \a normal_at(0..count-1) on the tangent plane of \a normal, then eigen-decompose the
- * covariance of the projections.
+ * covariance of the projections. The projections have no component along the normal, so the
+ * decomposition is that of a 2x2 matrix in a tangent basis, in closed form.
  *
  * Neighbour normals that point away from \a normal are flipped first, so unoriented input
  * normals give the same result as oriented ones.
@@ -74,35 +91,36 @@ bool
 principalCurvaturesFromNormals(const Eigen::Vector3f& normal, std::size_t count,
                                NormalAt normal_at, PrincipalCurvatures& out)
 {
-  const Eigen::Vector3d n = normal.cast<double>();
-  const Eigen::Matrix3d projection = Eigen::Matrix3d::Identity() - n * n.transpose();
-  Eigen::Vector3d sum{Eigen::Vector3d::Zero()};
-  Eigen::Matrix3d sq{Eigen::Matrix3d::Zero()};
+  const Eigen::Vector3f t1 = normal.unitOrthogonal();
+  const Eigen::Vector3f t2 = normal.cross(t1);
+  float su = 0.f, sv = 0.f, suu = 0.f, suv = 0.f, svv = 0.f;
   std::size_t used = 0;
   for (std::size_t j = 0; j < count; ++j) {
-    Eigen::Vector3d m = normal_at(j).template cast<double>();
+    const Eigen::Vector3f m = normal_at(j);
     if (!m.allFinite())
       continue;
-    if (m.dot(n) < 0.0)
-      m = -m;
-    const Eigen::Vector3d p = projection * m;
-    sum += p;
-    sq.noalias() += p * p.transpose();
+    const float sign = m.dot(normal) < 0.f ? -1.f : 1.f;
+    const float u = sign * m.dot(t1), v = sign * m.dot(t2);
+    su += u;
+    sv += v;
+    suu += u * u;
+    suv += u * v;
+    svv += v * v;
     ++used;
   }
   if (used < 3)
     return false;
-  const Eigen::Vector3d mean = sum / static_cast<double>(used);
-  const Eigen::Matrix3d cov = sq / static_cast<double>(used) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(cov);
-  const Eigen::Vector3d evals = solver.eigenvalues().cwiseMax(0.0);
-  Eigen::Vector3d dir = solver.eigenvectors().col(2);
-  dir -= n * n.dot(dir); // exactly tangent, despite rounding
-  const double len = dir.norm();
-  out.direction = len > 0.0 ? Eigen::Vector3f((dir / len).cast<float>()) : Eigen::Vector3f::Zero();
-  out.k_max = static_cast<float>(evals(2));
-  out.k_min = static_cast<float>(evals(1));
+  const float inv = 1.f / static_cast<float>(used);
+  const float mu = su * inv, mv = sv * inv;
+  const float a = suu * inv - mu * mu, b = suv * inv - mu * mv, c = svv * inv - mv * mv;
+  // Eigen-decomposition of [[a b] [b c]].
+  const float half_trace = 0.5f * (a + c);
+  const float radius = std::sqrt(0.25f * (a - c) * (a - c) + b * b);
+  out.k_max = std::max(0.f, half_trace + radius);
+  out.k_min = std::max(0.f, half_trace - radius);
+  // Eigenvector of k_max: angle of the major axis.
+  const float angle = 0.5f * std::atan2(2.f * b, a - c);
+  out.direction = (std::cos(angle) * t1 + std::sin(angle) * t2).normalized();
   return true;
 }
 
