@@ -35,8 +35,9 @@ CylinderModel::signedDistance(const Eigen::Vector3f& p) const
 float
 axisAngle(const Eigen::Vector3f& a, const Eigen::Vector3f& b)
 {
-  const float c = std::abs(a.normalized().dot(b.normalized()));
-  return std::acos(std::min(1.f, c));
+  // atan2 of |cross| and |dot| keeps precision at small angles, where acos(dot) rounds to 0.
+  const Eigen::Vector3f u = a.normalized(), v = b.normalized();
+  return std::atan2(u.cross(v).norm(), std::abs(u.dot(v)));
 }
 
 float
