@@ -274,6 +274,34 @@ TEST(HoughCylinderEstimation, SameSeedSameResult)
   EXPECT_EQ(a[0].inliers, b[0].inliers);
 }
 
+TEST(HoughCylinderEstimation, ResultDoesNotDependOnTheDraw)
+{
+  // The paper draws a fresh accumulator per fit; with refinement the answer must not depend on
+  // which cells were drawn.
+  auto p = randomCylinder(8, 1.f, 0.02f);
+  p.height = std::max(p.height, 2.f * p.radius); // not a coin: the axis is well defined
+  const auto sim = facyl::simulateCylinder(p);
+  const auto cloud = sim.cloud.makeShared();
+  const auto cues = facyl_test::estimateCues(cloud);
+  std::vector<Eigen::Vector3f> axes;
+  std::vector<float> radii;
+  for (std::uint64_t seed = 0; seed < 10; ++seed) {
+    Hough hough;
+    hough.setSeed(seed);
+    hough.setInputCloud(cloud);
+    hough.setInputNormals(cues);
+    std::vector<CylinderModel> m;
+    ASSERT_TRUE(hough.segment(m));
+    axes.push_back(m[0].axis);
+    radii.push_back(m[0].radius);
+  }
+  for (std::size_t i = 1; i < axes.size(); ++i) {
+    EXPECT_LT(degrees(facyl::axisAngle(axes[i], axes[0])), 0.05f);
+    EXPECT_NEAR(radii[i], radii[0], 1e-3f * radii[0]);
+  }
+  EXPECT_LT(degrees(facyl::axisAngle(axes[0], sim.truth.axis)), 0.5f);
+}
+
 TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
 {
   facyl::CylinderSimulationParameters p;

@@ -488,25 +488,35 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
   if (phi.size() < 3)
     return 1.f;
   const double mean_phi = 0.5 * std::atan2(sum_sin, sum_cos);
-  double var = 0.0, cov = 0.0, mean_eps = 0.0, mean_c = 0.0;
+  double var = 0.0, cov = 0.0, var_eps = 0.0, mean_eps = 0.0, mean_c = 0.0;
   for (std::size_t k = 0; k < phi.size(); ++k) {
     phi[k] = std::remainder(phi[k] - mean_phi, M_PI);
     mean_c += phi[k];
     mean_eps += eps[k];
   }
-  mean_c /= static_cast<double>(phi.size());
-  mean_eps /= static_cast<double>(phi.size());
+  const double count = static_cast<double>(phi.size());
+  mean_c /= count;
+  mean_eps /= count;
   for (std::size_t k = 0; k < phi.size(); ++k) {
     var += (phi[k] - mean_c) * (phi[k] - mean_c);
     cov += (phi[k] - mean_c) * (eps[k] - mean_eps);
+    var_eps += (eps[k] - mean_eps) * (eps[k] - mean_eps);
   }
-  var /= static_cast<double>(phi.size());
-  cov /= static_cast<double>(phi.size());
+  var /= count;
+  cov /= count;
+  var_eps /= count;
   // A uniform arc of width W has variance W^2 / 12: past a quarter turn (modulo pi), no plane
   // strip fits.
-  if (var > M_PI * M_PI / 48.0 || !(var > 0.0))
+  if (var > M_PI * M_PI / 48.0)
     return 1.f;
-  return static_cast<float>(std::clamp(1.0 + cov / var, 0.0, 1.0));
+  if (!(var > 0.0))
+    return 0.f;
+  // The slope must be measured, not guessed: take its lower 2-sigma bound, so that an arc too
+  // narrow for the normals' noise (a huge radius through a flat patch) scores 0.
+  const double slope = 1.0 + cov / var;
+  const double residual = std::max(0.0, var_eps - cov * cov / var);
+  const double standard_error = std::sqrt(residual / (count * var));
+  return static_cast<float>(std::clamp(slope - 2.0 * standard_error, 0.0, 1.0));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -582,6 +592,7 @@ struct Candidate {
   Eigen::Vector3f axis;
   float radius{0.f};
   float threshold{0.f};
+  float radius_limit{std::numeric_limits<float>::infinity()}; ///< given or from the data
 };
 
 /** Robust noise estimate: 1.4826 MAD of the surface distances of the points near it. */
@@ -706,13 +717,14 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
   if (keep.size() < 5 ||
       !fitCircle(q(Eigen::all, keep), std::max(0.3f * circle.radius, 3.f * cell), circle))
     return std::nullopt;
-  if (circle.radius < params.radius_min || circle.radius > params.radius_max)
+  if (circle.radius < params.radius_min || circle.radius > r_max)
     return std::nullopt;
 
   Candidate c;
   c.axis = axis;
   c.point_on_axis = circle.center.x() * u + circle.center.y() * v;
   c.radius = circle.radius;
+  c.radius_limit = r_max;
   const bool auto_threshold = params.distance_threshold <= 0.f;
   c.threshold = auto_threshold ? estimateThreshold(cues, support, c) : params.distance_threshold;
   return c;
@@ -739,7 +751,7 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
       pts.col(static_cast<Eigen::Index>(k)) = cues.points.col(inliers[k]);
     Candidate next = c;
     if (!refineCylinder(pts, next.point_on_axis, next.axis, next.radius) ||
-        next.radius < params.radius_min || next.radius > params.radius_max)
+        next.radius < params.radius_min || next.radius > c.radius_limit)
       break;
     if (auto_threshold)
       next.threshold = estimateThreshold(cues, support, next);
