@@ -3,6 +3,7 @@
  */
 #include "cli.h"
 #include "pcd_input.h"
+#include "pcl_baseline.h"
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
@@ -14,9 +15,6 @@
 #include <pcl/common/time.h>
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
-#include <pcl/sample_consensus/method_types.h>
-#include <pcl/sample_consensus/model_types.h>
-#include <pcl/segmentation/sac_segmentation.h>
 
 #include <fstream>
 #include <iostream>
@@ -82,48 +80,13 @@ fitPclRansac(const Cloud::ConstPtr& cloud, const Cues& cues, const Settings& s)
   Eigen::Vector4f lo, hi;
   pcl::getMinMax3D(*cloud, lo, hi);
   const float diagonal = (hi - lo).head<3>().norm();
-  pcl::SACSegmentationFromNormals<pcl::PointXYZ, pcl::Normal> seg;
-  seg.setOptimizeCoefficients(true);
-  seg.setModelType(pcl::SACMODEL_CYLINDER);
-  seg.setMethodType(pcl::SAC_RANSAC);
-  seg.setNormalDistanceWeight(0.1);
-  seg.setMaxIterations(10000);
-  seg.setDistanceThreshold(s.params.distance_threshold > 0.f ? s.params.distance_threshold
-                                                             : 0.01f * diagonal);
-  seg.setRadiusLimits(s.params.radius_min,
-                      std::isfinite(s.params.radius_max) ? s.params.radius_max : diagonal);
-  seg.setInputCloud(cloud);
-  seg.setInputNormals(normals);
-  pcl::IndicesPtr remaining(new pcl::Indices);
-  for (std::size_t i = 0; i < cloud->size(); ++i)
-    if (pcl::isFinite((*cloud)[i]) && std::isfinite(cues[i].normal_x))
-      remaining->push_back(static_cast<int>(i));
-  const std::size_t total = cloud->size();
-  std::vector<facyl::CylinderModel> models;
-  for (std::size_t round = 0; round < s.params.max_cylinders && remaining->size() > 10; ++round) {
-    seg.setIndices(remaining);
-    pcl::PointIndices inliers;
-    pcl::ModelCoefficients c;
-    seg.segment(inliers, c);
-    if (inliers.indices.size() < 10 || c.values.size() != 7)
-      break;
-    facyl::CylinderModel m;
-    m.point_on_axis = Eigen::Vector3f(c.values[0], c.values[1], c.values[2]);
-    m.axis = Eigen::Vector3f(c.values[3], c.values[4], c.values[5]).normalized();
-    m.radius = c.values[6];
-    m.inliers = inliers.indices;
-    m.inlier_ratio = static_cast<float>(inliers.indices.size()) / static_cast<float>(total);
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(inliers.indices.size()));
-    for (std::size_t k = 0; k < inliers.indices.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = (*cloud)[inliers.indices[k]].getVector3fMap();
-    facyl::describeInliers(pts, m);
-    models.push_back(m);
-    pcl::Indices rest;
-    std::set_difference(remaining->begin(), remaining->end(), inliers.indices.begin(),
-                        inliers.indices.end(), std::back_inserter(rest));
-    remaining->swap(rest);
-  }
-  return models;
+  facyl_cli::PclCylinderOptions o;
+  o.distance_threshold =
+      s.params.distance_threshold > 0.f ? s.params.distance_threshold : 0.01f * diagonal;
+  o.radius_min = s.params.radius_min;
+  o.radius_max = std::isfinite(s.params.radius_max) ? s.params.radius_max : diagonal;
+  o.max_cylinders = s.params.max_cylinders;
+  return facyl_cli::fitPclCylinders<pcl::PointXYZ>(cloud, normals, o);
 }
 
 std::string

@@ -127,6 +127,18 @@ softVotes(float dx, float dy, float dz, const float* nx, const float* ny, const 
       acc += w[s] * v;
     }
   }
+  else if (p == 1) {
+#pragma omp simd reduction(+ : acc)
+    for (Eigen::Index s = 0; s < n; ++s)
+      acc += w[s] * (1.f - std::abs(dx * nx[s] + dy * ny[s] + dz * nz[s]));
+  }
+  else if (p == 2) {
+#pragma omp simd reduction(+ : acc)
+    for (Eigen::Index s = 0; s < n; ++s) {
+      const float b = 1.f - std::abs(dx * nx[s] + dy * ny[s] + dz * nz[s]);
+      acc += w[s] * b * b;
+    }
+  }
   else {
 #pragma omp simd reduction(+ : acc)
     for (Eigen::Index s = 0; s < n; ++s) {
@@ -284,9 +296,9 @@ houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, flo
   if (!(cell > 0.f))
     return false;
   std::vector<float> acc(static_cast<std::size_t>(grid * grid), 0.f);
-  // Rays in grid units: from p +- r_min m to p +- r_max m, 0.7 cells a step.
+  // Rays in grid units: from p +- r_min m to p +- r_max m, about a cell a step.
   const float inv_cell = 1.f / cell;
-  const int steps = static_cast<int>(std::ceil((r_max - r_min) * inv_cell / 0.7f)) + 1;
+  const int steps = static_cast<int>(std::ceil((r_max - r_min) * inv_cell)) + 1;
   const float step = (r_max - r_min) * inv_cell / static_cast<float>(std::max(1, steps - 1));
   for (Eigen::Index i = 0; i < n; ++i) {
     const float px = (points(0, i) - lo.x()) * inv_cell, py = (points(1, i) - lo.y()) * inv_cell;
@@ -304,15 +316,21 @@ houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, flo
       }
     }
   }
-  // Peak of the 3x3 box-filtered accumulator, then the vote-weighted centre of its 3x3 cells.
+  // Peak of the 3x3 box-filtered accumulator (separable: rows, then columns), then the
+  // vote-weighted centre of its 3x3 cells.
+  std::vector<float> rows(acc.size(), 0.f);
+  for (int y = 0; y < grid; ++y)
+    for (int x = 1; x + 1 < grid; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * grid + x);
+      rows[i] = acc[i - 1] + acc[i] + acc[i + 1];
+    }
   float best = 0.f;
   int bx = -1, by = -1;
   for (int y = 1; y + 1 < grid; ++y)
     for (int x = 1; x + 1 < grid; ++x) {
-      float s = 0.f;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          s += acc[static_cast<std::size_t>((y + dy) * grid + x + dx)];
+      const std::size_t i = static_cast<std::size_t>(y * grid + x);
+      const float s = rows[i - static_cast<std::size_t>(grid)] + rows[i] +
+                      rows[i + static_cast<std::size_t>(grid)];
       if (s > best) {
         best = s;
         bx = x;
@@ -837,20 +855,28 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   };
   std::vector<Seed> seeds;
   Eigen::VectorXf votes;
-  for (const auto& acc : accumulators) {
+  // A seed within the refinement's reach of a known one adds nothing but time.
+  const auto addPeaks = [&](const OrientationAccumulator& acc, VotingMode mode,
+                            std::size_t count) {
     const float cell = acc.cellRadius();
-    castVotes(acc.directions(), voting, params.voting_mode, params.kernel_exponent,
-              std::sin(cell), votes);
-    for (const auto i : findPeaks(acc.directions(), votes, params.orientation_candidates,
-                                  std::max(4.f * cell, 10.f * kOneDegree))) {
+    const float separation = std::max(4.f * cell, 10.f * kOneDegree);
+    castVotes(acc.directions(), voting, mode, params.kernel_exponent, std::sin(cell), votes);
+    for (const auto i : findPeaks(acc.directions(), votes, count, separation)) {
       const Eigen::Vector3f d = acc.directions().col(i);
       const bool known = std::any_of(seeds.begin(), seeds.end(), [&](const Seed& s) {
-        return axisAngle(s.axis, d) < std::max(s.cell_radius, cell);
+        return axisAngle(s.axis, d) < (mode == params.voting_mode ? std::max(s.cell_radius, cell)
+                                                                  : separation);
       });
       if (!known)
         seeds.push_back({d, cell});
     }
-  }
+  };
+  for (const auto& acc : accumulators)
+    addPeaks(acc, params.voting_mode, params.orientation_candidates);
+  // Curvature directions fade into noise before normals do (a short or noisy cylinder): the
+  // best normals-only peak joins the curvature-weighted ones. The fit decides.
+  if (curvature)
+    addPeaks(accumulators.front(), VotingMode::SoftNormal, 1);
 
   // Candidates compete on their inliers. With curvature cues each inlier counts by its vote
   // for the candidate's axis (eq. 3): a plane strip that happens to fit a wide cylinder (a lid
@@ -893,8 +919,9 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
       solver.computeDirect(m);
       const Eigen::Vector3f d = foldToHemisphere(solver.eigenvectors().col(2));
       const float cell = accumulators.front().cellRadius();
+      const float separation = std::max(4.f * cell, 10.f * kOneDegree);
       if (d.allFinite() && std::none_of(seeds.begin(), seeds.end(), [&](const Seed& s) {
-            return axisAngle(s.axis, d) < cell;
+            return axisAngle(s.axis, d) < separation;
           }))
         seeds.push_back({d, cell});
     }

@@ -139,11 +139,11 @@ struct HoughCylinderParameters {
   float radius_max{std::numeric_limits<float>::infinity()}; ///< > radius_min; inf: data extent
   float distance_threshold{0.f};        ///< > 0, or 0: estimated from the residuals
   float normal_angle_threshold{0.6f};   ///< rad, in (0, pi/2]: normal vs surface normal
-  std::size_t orientation_candidates{2}; ///< peaks per accumulator that are fitted
+  std::size_t orientation_candidates{1}; ///< peaks per accumulator that are fitted
   bool refine{true};                    ///< sub-cell axis + 5-dof least squares
   std::size_t max_cylinders{1};         ///< >= 1
   std::size_t min_inliers{0};           ///< 0: max(10, 5% of the points)
-  std::size_t max_voting_points{800};   ///< voters are subsampled above this; 0: all
+  std::size_t max_voting_points{500};   ///< voters are subsampled above this; 0: all
   int circle_grid{48};                  ///< CHT accumulator size per side, >= 8
 };
 

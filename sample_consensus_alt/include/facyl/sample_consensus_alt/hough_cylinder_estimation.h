@@ -180,7 +180,8 @@ public:
   {
     return params_.min_inliers;
   }
-  /** \brief Accumulator peaks per accumulator that are refined and fitted (default 2). */
+  /** \brief Accumulator peaks per accumulator that are refined and fitted (default 1;
+   * with SoftCurvature, the dominant planar normal and the best normals-only peak are fitted too). */
   void
   setOrientationCandidates(std::size_t n)
   {
