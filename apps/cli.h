@@ -105,6 +105,16 @@ private:
   std::vector<std::string> positional_;
 };
 
+/** True if -h or --help is among the arguments. */
+inline bool
+wantsHelp(int argc, char** argv)
+{
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help")
+      return true;
+  return false;
+}
+
 /** JSON string literal. */
 inline std::string
 quote(const std::string& s)

@@ -263,11 +263,10 @@ printHelp(const char* self)
 int
 main(int argc, char** argv)
 {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help") {
-      printHelp(argv[0]);
-      return 0;
-    }
+  if (facyl_cli::wantsHelp(argc, argv)) {
+    printHelp(argv[0]);
+    return 0;
+  }
   int scenes = 1000, threads = 0;
   std::uint64_t seed = 1;
   std::string out = "bench_out", dump;

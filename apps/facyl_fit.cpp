@@ -186,11 +186,10 @@ processFile(const std::string& file, const Settings& s, bool& ok)
 int
 main(int argc, char** argv)
 {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help") {
-      printHelp(argv[0]);
-      return 0;
-    }
+  if (facyl_cli::wantsHelp(argc, argv)) {
+    printHelp(argv[0]);
+    return 0;
+  }
   Settings s;
   std::vector<std::string> files;
   try {

@@ -33,11 +33,10 @@ printHelp(const char* self)
 int
 main(int argc, char** argv)
 {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help") {
-      printHelp(argv[0]);
-      return 0;
-    }
+  if (facyl_cli::wantsHelp(argc, argv)) {
+    printHelp(argv[0]);
+    return 0;
+  }
   facyl::CylinderSimulationParameters p;
   std::string out;
   bool normals = false;

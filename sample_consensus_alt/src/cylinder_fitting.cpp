@@ -230,6 +230,20 @@ basisFor(const Eigen::Vector3f& a, Eigen::Vector3f& u, Eigen::Vector3f& v)
 }
 
 constexpr float kOneDegree = static_cast<float>(M_PI / 180.0);
+
+/** sum_s w_s n_s n_s^T over the cues' normals. */
+Eigen::Matrix3d
+normalScatter(const VotingCues& cues, const Eigen::ArrayXf& w)
+{
+  Eigen::Matrix3d m;
+  m(0, 0) = (w * cues.nx * cues.nx).sum();
+  m(1, 1) = (w * cues.ny * cues.ny).sum();
+  m(2, 2) = (w * cues.nz * cues.nz).sum();
+  m(0, 1) = m(1, 0) = (w * cues.nx * cues.ny).sum();
+  m(0, 2) = m(2, 0) = (w * cues.nx * cues.nz).sum();
+  m(1, 2) = m(2, 1) = (w * cues.ny * cues.nz).sum();
+  return m;
+}
 } // namespace
 
 Eigen::Vector3f
@@ -249,15 +263,8 @@ refineAxis(const VotingCues& cues, const Eigen::Vector3f& initial, float initial
     const float total = omega.sum();
     if (!(total > 0.f))
       break;
-    Eigen::Matrix3d m;
-    m(0, 0) = (omega * cues.nx * cues.nx).sum();
-    m(1, 1) = (omega * cues.ny * cues.ny).sum();
-    m(2, 2) = (omega * cues.nz * cues.nz).sum();
-    m(0, 1) = m(1, 0) = (omega * cues.nx * cues.ny).sum();
-    m(0, 2) = m(2, 0) = (omega * cues.nx * cues.nz).sum();
-    m(1, 2) = m(2, 1) = (omega * cues.ny * cues.nz).sum();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(m);
+    solver.computeDirect(normalScatter(cues, omega));
     Eigen::Vector3f next = solver.eigenvectors().col(0).cast<float>().normalized();
     if (!next.allFinite())
       break;
@@ -906,18 +913,11 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   // the points that spoil the votes (eq. 3 spreads theirs over a great circle) point at the
   // axis themselves. The seed only competes; the fit decides.
   if (curvature) {
-    const Eigen::ArrayXf planar = 1.f - voting.weight;
-    Eigen::Matrix3f m;
-    m(0, 0) = (planar * voting.nx * voting.nx).sum();
-    m(1, 1) = (planar * voting.ny * voting.ny).sum();
-    m(2, 2) = (planar * voting.nz * voting.nz).sum();
-    m(0, 1) = m(1, 0) = (planar * voting.nx * voting.ny).sum();
-    m(0, 2) = m(2, 0) = (planar * voting.nx * voting.nz).sum();
-    m(1, 2) = m(2, 1) = (planar * voting.ny * voting.nz).sum();
-    if (m.trace() > 0.f) {
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
+    const Eigen::Matrix3d m = normalScatter(voting, 1.f - voting.weight);
+    if (m.trace() > 0.0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
       solver.computeDirect(m);
-      const Eigen::Vector3f d = foldToHemisphere(solver.eigenvectors().col(2));
+      const Eigen::Vector3f d = foldToHemisphere(solver.eigenvectors().col(2).cast<float>());
       const float cell = accumulators.front().cellRadius();
       const float separation = std::max(4.f * cell, 10.f * kOneDegree);
       if (d.allFinite() && std::none_of(seeds.begin(), seeds.end(), [&](const Seed& s) {
