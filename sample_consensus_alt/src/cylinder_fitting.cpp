@@ -862,6 +862,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   };
   std::vector<Seed> seeds;
   Eigen::VectorXf votes;
+  bool normals_seed_tried = false;
   // A seed within the refinement's reach of a known one adds nothing but time.
   const auto addPeaks = [&](const OrientationAccumulator& acc, VotingMode mode,
                             std::size_t count) {
@@ -880,10 +881,6 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   };
   for (const auto& acc : accumulators)
     addPeaks(acc, params.voting_mode, params.orientation_candidates);
-  // Curvature directions fade into noise before normals do (a short or noisy cylinder): the
-  // best normals-only peak joins the curvature-weighted ones. The fit decides.
-  if (curvature)
-    addPeaks(accumulators.front(), VotingMode::SoftNormal, 1);
 
   // Candidates compete on their inliers. With curvature cues each inlier counts by its vote
   // for the candidate's axis (eq. 3): a plane strip that happens to fit a wide cylinder (a lid
@@ -931,7 +928,22 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   Candidate best_candidate;
   double best_score = -1.0;
   std::vector<Eigen::Vector3f> tried;
-  for (const auto& seed : seeds) {
+  for (std::size_t k = 0;; ++k) {
+    if (k == seeds.size()) {
+      // Curvature directions fade into noise before normals do (a short or noisy cylinder).
+      // Unless a convincing cylinder was found already (a quarter of the points, half the
+      // circumference), the best normals-only peak joins the candidates; the fit decides.
+      const bool convincing = best && best->angular_coverage >= 0.5f &&
+                              4 * best->inliers.size() >= active.size();
+      const std::size_t before = seeds.size();
+      if (curvature && !convincing && !normals_seed_tried) {
+        normals_seed_tried = true;
+        addPeaks(accumulators.front(), VotingMode::SoftNormal, 1);
+      }
+      if (seeds.size() == before)
+        break;
+    }
+    const Seed seed = seeds[k];
     Eigen::Vector3f axis = seed.axis;
     if (params.refine) {
       axis = refineAxis(refining, seed.axis, std::max(3.f * seed.cell_radius, 10.f * kOneDegree));
