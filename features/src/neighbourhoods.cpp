@@ -131,11 +131,9 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
   const auto& data = impl_->data;
   const auto& tree = impl_->tree;
   const std::size_t n = static_cast<std::size_t>(queries.cols());
-  Neighbourhoods out;
-  out.offsets.assign(n + 1, 0);
-  if (data.columns.empty())
-    return out;
   std::vector<std::vector<int>> lists(n);
+  if (data.columns.empty())
+    return Neighbourhoods::fromLists(lists);
 #pragma omp parallel num_threads(threadCount(threads))
   {
     std::vector<std::pair<std::uint32_t, float>> matches;
@@ -152,12 +150,7 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
         list.push_back(data.columns[m.first]);
     }
   }
-  for (std::size_t i = 0; i < n; ++i)
-    out.offsets[i + 1] = out.offsets[i] + lists[i].size();
-  out.indices.reserve(out.offsets[n]);
-  for (const auto& list : lists)
-    out.indices.insert(out.indices.end(), list.begin(), list.end());
-  return out;
+  return Neighbourhoods::fromLists(lists);
 }
 
 } // namespace facyl

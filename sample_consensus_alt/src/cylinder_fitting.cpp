@@ -655,6 +655,20 @@ selectInliers(const CylinderCues& cues, const std::vector<int>& columns, const C
   return inliers;
 }
 
+/** The points whose normal is within the normal angle threshold of orthogonal to \a axis:
+ * those a cylinder about it can explain. */
+std::vector<int>
+supporters(const CylinderCues& cues, const std::vector<int>& active, const Eigen::Vector3f& axis,
+           const HoughCylinderParameters& params)
+{
+  const float sin_n = std::sin(params.normal_angle_threshold);
+  std::vector<int> support;
+  for (const int s : active)
+    if (std::abs(axis.dot(cues.normals.col(s))) < sin_n)
+      support.push_back(s);
+  return support;
+}
+
 /** Step 2 for one axis: circle Hough on the supporters, circle and cylinder least squares. */
 std::optional<Candidate>
 fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eigen::Vector3f& axis,
@@ -662,41 +676,33 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
 {
   Eigen::Vector3f u, v;
   basisFor(axis, u, v);
-  const float sin_n = std::sin(params.normal_angle_threshold);
-  std::vector<int> support;
-  for (const int s : active)
-    if (std::abs(axis.dot(cues.normals.col(s))) < sin_n)
-      support.push_back(s);
+  const std::vector<int> support = supporters(cues, active, axis, params);
   if (support.size() < 5)
     return std::nullopt;
 
-  Eigen::Matrix2Xf q(2, static_cast<Eigen::Index>(support.size()));
-  for (std::size_t k = 0; k < support.size(); ++k) {
-    const auto p = cues.points.col(support[k]);
-    q.col(static_cast<Eigen::Index>(k)) << u.dot(p), v.dot(p);
-  }
+  // The supporters projected on the plane orthogonal to the axis, with their normals.
+  Eigen::Matrix<float, 2, 3> project;
+  project << u.transpose(), v.transpose();
+  const Eigen::Matrix2Xf q = project * cues.points(Eigen::all, support);
+  const Eigen::Matrix2Xf m = project * cues.normals(Eigen::all, support);
+  const Eigen::RowVectorXf m_len = m.colwise().norm();
+  const Eigen::Matrix2Xf qm = m.array().rowwise() / m_len.array();
   const float extent = (q.rowwise().maxCoeff() - q.rowwise().minCoeff()).norm();
   const float r_max = std::min(params.radius_max, 2.f * extent);
   if (!(r_max > params.radius_min))
     return std::nullopt;
 
-  const std::vector<int> voters = subsample(support, 300);
-  Eigen::Matrix2Xf vq(2, static_cast<Eigen::Index>(voters.size()));
-  Eigen::Matrix2Xf vm(2, static_cast<Eigen::Index>(voters.size()));
-  Eigen::Index used = 0;
-  for (const int s : voters) {
-    const auto p = cues.points.col(s);
-    const auto m = cues.normals.col(s);
-    Eigen::Vector2f m2(u.dot(m), v.dot(m));
-    const float len = m2.norm();
-    if (!(len > 0.3f))
-      continue;
-    vq.col(used) << u.dot(p), v.dot(p);
-    vm.col(used) = m2 / len;
-    ++used;
+  // Circle Hough voters: an even subset of the supporters whose normal is not along the axis.
+  std::vector<Eigen::Index> voters;
+  const auto n_support = static_cast<Eigen::Index>(support.size());
+  const Eigen::Index n_voters = std::min<Eigen::Index>(n_support, 300);
+  for (Eigen::Index k = 0; k < n_voters; ++k) {
+    const Eigen::Index i = k * n_support / n_voters;
+    if (m_len(i) > 0.3f)
+      voters.push_back(i);
   }
-  vq.conservativeResize(2, used);
-  vm.conservativeResize(2, used);
+  const Eigen::Matrix2Xf vq = q(Eigen::all, voters);
+  const Eigen::Matrix2Xf vm = qm(Eigen::all, voters);
   Circle circle;
   if (!houghCircle(vq, vm, params.radius_min, r_max, params.circle_grid, circle))
     return std::nullopt;
@@ -733,11 +739,6 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
       }
     }
   }
-  Eigen::Matrix2Xf qm(2, q.cols());
-  for (std::size_t k = 0; k < support.size(); ++k) {
-    const auto m = cues.normals.col(support[k]);
-    qm.col(static_cast<Eigen::Index>(k)) = Eigen::Vector2f(u.dot(m), v.dot(m)).normalized();
-  }
   const auto keep = agreeing(q, qm, circle, std::max(0.3f * circle.radius, 3.f * cell));
   if (keep.size() < 5 ||
       !fitCircle(q(Eigen::all, keep), std::max(0.3f * circle.radius, 3.f * cell), circle))
@@ -761,19 +762,13 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
                 const HoughCylinderParameters& params)
 {
   const bool auto_threshold = params.distance_threshold <= 0.f;
-  const float sin_n = std::sin(params.normal_angle_threshold);
-  std::vector<int> support;
-  for (const int s : active)
-    if (std::abs(c.axis.dot(cues.normals.col(s))) < sin_n)
-      support.push_back(s);
+  const std::vector<int> support = supporters(cues, active, c.axis, params);
   const float cos_normal = std::cos(params.normal_angle_threshold);
   for (int round = 0; round < 3; ++round) {
     const std::vector<int> inliers = selectInliers(cues, active, c, cos_normal);
     if (inliers.size() < 6)
       break;
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(inliers.size()));
-    for (std::size_t k = 0; k < inliers.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = cues.points.col(inliers[k]);
+    const Eigen::Matrix3Xf pts = cues.points(Eigen::all, inliers);
     Candidate next = c;
     if (!refineCylinder(pts, next.point_on_axis, next.axis, next.radius) ||
         next.radius < params.radius_min || next.radius > c.radius_limit)
@@ -888,13 +883,9 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   // has c_max orthogonal to the axis and weights near 1.
   // Either way the score is scaled by normalRotationSlope: plane strips score ~0.
   const auto score = [&](const CylinderModel& m) {
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(m.inliers.size()));
-    Eigen::Matrix3Xf nrm(3, pts.cols());
-    for (std::size_t k = 0; k < m.inliers.size(); ++k) {
-      pts.col(static_cast<Eigen::Index>(k)) = cues.points.col(m.inliers[k]);
-      nrm.col(static_cast<Eigen::Index>(k)) = cues.normals.col(m.inliers[k]);
-    }
-    const double slope = normalRotationSlope(pts, nrm, m.point_on_axis, m.axis);
+    const double slope = normalRotationSlope(cues.points(Eigen::all, m.inliers),
+                                             cues.normals(Eigen::all, m.inliers),
+                                             m.point_on_axis, m.axis);
     if (!curvature)
       return slope * static_cast<double>(m.inliers.size());
     double sum = 0.0;

@@ -29,6 +29,20 @@ struct Neighbourhoods {
   {
     return offsets[i + 1] - offsets[i];
   }
+  /** \brief Compressed rows from one list of neighbour indices per query. */
+  template <typename List>
+  static Neighbourhoods
+  fromLists(const std::vector<List>& lists)
+  {
+    Neighbourhoods out;
+    out.offsets.assign(lists.size() + 1, 0);
+    for (std::size_t i = 0; i < lists.size(); ++i)
+      out.offsets[i + 1] = out.offsets[i] + lists[i].size();
+    out.indices.reserve(out.offsets.back());
+    for (const auto& list : lists)
+      out.indices.insert(out.indices.end(), list.begin(), list.end());
+    return out;
+  }
   /** \brief Pointer to the first neighbour of query \a i. */
   const int*
   begin(std::size_t i) const

@@ -87,8 +87,6 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
   const auto query_point = [&](std::size_t i) -> const PointInT& {
     return queries_are_input ? input[surface_queries[i]] : surface[surface_queries[i]];
   };
-  Neighbourhoods out;
-  out.offsets.assign(n + 1, 0);
   if (use_pcl_search_) {
     std::vector<pcl::Indices> lists(n);
 #pragma omp parallel num_threads(threads)
@@ -107,12 +105,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
                                    lists[s], distances);
       }
     }
-    for (std::size_t i = 0; i < n; ++i)
-      out.offsets[i + 1] = out.offsets[i] + lists[i].size();
-    out.indices.reserve(out.offsets[n]);
-    for (const auto& l : lists)
-      out.indices.insert(out.indices.end(), l.begin(), l.end());
-    return out;
+    return Neighbourhoods::fromLists(lists);
   }
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
   for (std::size_t i = 0; i < n; ++i)
