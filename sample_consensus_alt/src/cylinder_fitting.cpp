@@ -683,8 +683,10 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
   // The supporters projected on the plane orthogonal to the axis, with their normals.
   Eigen::Matrix<float, 2, 3> project;
   project << u.transpose(), v.transpose();
-  const Eigen::Matrix2Xf q = project * cues.points(Eigen::all, support);
-  const Eigen::Matrix2Xf m = project * cues.normals(Eigen::all, support);
+  const Eigen::Matrix3Xf support_points = cues.points(Eigen::all, support);
+  const Eigen::Matrix3Xf support_normals = cues.normals(Eigen::all, support);
+  const Eigen::Matrix2Xf q = project * support_points;
+  const Eigen::Matrix2Xf m = project * support_normals;
   const Eigen::RowVectorXf m_len = m.colwise().norm();
   const Eigen::Matrix2Xf qm = m.array().rowwise() / m_len.array();
   const float extent = (q.rowwise().maxCoeff() - q.rowwise().minCoeff()).norm();
