@@ -1,0 +1,79 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Explicit instantiations for the common point types.
+ */
+#include <facyl/recognition/impl/tabletop_cylinder_recognizer.hpp>
+
+#include <cmath>
+#include <sstream>
+
+namespace facyl {
+
+std::string
+validate(const TabletopRecognizerParameters& p)
+{
+  std::string why = validate(p.segmentation);
+  if (!why.empty())
+    return "segmentation: " + why;
+  why = validate(p.hough);
+  if (!why.empty())
+    return "fit: " + why;
+  std::ostringstream s;
+  if (p.orientations < 10)
+    s << "orientations " << p.orientations << " must be >= 10";
+  else if (p.max_fit_points < 50)
+    s << "max_fit_points " << p.max_fit_points << " must be >= 50";
+  else if (p.neighbours < 5)
+    s << "neighbours " << p.neighbours << " must be >= 5";
+  else if (!(p.min_inlier_ratio >= 0.f && p.min_inlier_ratio <= 1.f))
+    s << "min_inlier_ratio " << p.min_inlier_ratio << " must be in [0, 1]";
+  else if (!(p.max_curvature_ratio > 0.f && p.max_curvature_ratio <= 1.f))
+    s << "max_curvature_ratio " << p.max_curvature_ratio << " must be in (0, 1]";
+  else if (!(p.min_probability >= 0.f && p.min_probability <= 1.f))
+    s << "min_probability " << p.min_probability << " must be in [0, 1]";
+  return s.str();
+}
+
+std::size_t
+countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, float distance, float max_angle)
+{
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float h = (model.top - model.base).dot(a);
+  const float cos_max = std::cos(max_angle);
+  std::size_t count = 0, next = 0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    while (next < model.inliers.size() && model.inliers[next] < i)
+      ++next;
+    if (next < model.inliers.size() && model.inliers[next] == i)
+      continue;
+    const Eigen::Vector3f d = points.col(i) - model.base;
+    const float t = d.dot(a);
+    const float radial = (d - t * a).norm();
+    const bool on_plane = std::abs(t) <= distance || std::abs(t - h) <= distance;
+    if (on_plane && radial <= model.radius + distance && std::abs(normals.col(i).dot(a)) >= cos_max)
+      ++count;
+  }
+  return count;
+}
+
+pcl::Indices
+evenSubsample(const pcl::Indices& indices, std::size_t max_count)
+{
+  if (indices.size() <= max_count)
+    return indices;
+  pcl::Indices out;
+  if (max_count == 0)
+    return out;
+  out.reserve(max_count);
+  const double step = static_cast<double>(indices.size()) / static_cast<double>(max_count);
+  for (std::size_t k = 0; k < max_count; ++k)
+    out.push_back(indices[static_cast<std::size_t>(static_cast<double>(k) * step)]);
+  return out;
+}
+
+} // namespace facyl
+
+FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZ)
+FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGBA)

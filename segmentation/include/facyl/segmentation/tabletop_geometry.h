@@ -1,0 +1,73 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Small numerics of the tabletop pipeline, free functions so that tests reach them.
+ */
+#pragma once
+
+#include <pcl/types.h>
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace facyl {
+
+/** \brief A pinhole camera: pixel (u, v) = (fx x / z + cx, fy y / z + cy). */
+struct PinholeCamera {
+  float fx{0.f}, fy{0.f}, cx{0.f}, cy{0.f};
+  int width{0}, height{0};
+  /** \brief True when fx, fy > 0 and the image is not empty. */
+  bool
+  valid() const
+  {
+    return fx > 0.f && fy > 0.f && width > 0 && height > 0;
+  }
+  /** \brief The pixel of camera-frame point \a p (z > 0). */
+  Eigen::Vector2f
+  project(const Eigen::Vector3f& p) const
+  {
+    return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+  }
+};
+
+/** \brief Pixel box, inclusive: {u0, v0, u1, v1}; all -1 when unknown. */
+using PixelBox = std::array<int, 4>;
+
+/** \brief Least-squares plane through \a points (3 x n, n >= 3): unit normal, d; its normal
+ * points to the side of \a viewpoint. \return false when the points do not span a plane. */
+bool
+fitPlane(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane);
+
+/** \brief \a plane (a, b, c, d) scaled to a unit normal that points to \a viewpoint's side. */
+Eigen::Vector4f
+orientPlane(const Eigen::Vector4f& plane, const Eigen::Vector3f& viewpoint);
+
+/** \brief Frame of a plane: z is its unit normal, origin the projection of \a origin_hint on it,
+ * x the projection of the sensor's x axis (or y when x is nearly normal to the plane). Maps
+ * table coordinates to sensor coordinates. */
+Eigen::Affine3f
+planeFrame(const Eigen::Vector4f& plane, const Eigen::Vector3f& origin_hint);
+
+/** \brief Even-odd test of \a p against a simple polygon (vertices in order). */
+bool
+pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon);
+
+/** \brief Bounding box of organized-cloud indices in an image \a width pixels wide. */
+PixelBox
+pixelBox(const pcl::Indices& indices, std::uint32_t width);
+
+/** \brief Bounding box of the projections of \a points (camera frame; points with z <= 0 are
+ * skipped), clipped to the image. All -1 when nothing projects inside. */
+PixelBox
+projectedBox(const Eigen::Matrix3Xf& points, const PinholeCamera& camera);
+
+/** \brief Pinhole intrinsics from points and the pixels they were measured at (least squares
+ * on u = fx x/z + cx and v = fy y/z + cy). \return false with fewer than 10 usable points or a
+ * degenerate fit. */
+bool
+estimatePinhole(const Eigen::Matrix3Xf& points, const Eigen::Matrix2Xf& pixels, int width,
+                int height, PinholeCamera& camera);
+
+} // namespace facyl

@@ -1,0 +1,41 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Explicit instantiations for the common point types.
+ */
+#include <facyl/segmentation/impl/tabletop_segmentation.hpp>
+
+#include <sstream>
+
+namespace facyl {
+
+std::string
+validate(const TabletopSegmentationParameters& p)
+{
+  std::ostringstream why;
+  if (!(p.plane_distance > 0.f))
+    why << "plane distance " << p.plane_distance << " must be > 0";
+  else if (!(p.plane_angle > 0.f && p.plane_angle < 1.58f))
+    why << "plane angle " << p.plane_angle << " must be in (0, pi/2]";
+  else if (p.min_plane_points < 3)
+    why << "min_plane_points must be >= 3";
+  else if (!(p.min_height < p.max_height) || !std::isfinite(p.min_height) ||
+           !std::isfinite(p.max_height))
+    why << "height limits [" << p.min_height << ", " << p.max_height << "] must be finite, min < max";
+  else if (!(p.cluster_tolerance > 0.f))
+    why << "cluster tolerance " << p.cluster_tolerance << " must be > 0";
+  else if (p.min_cluster_size < 1 || p.min_cluster_size > p.max_cluster_size)
+    why << "cluster sizes must satisfy 1 <= min <= max";
+  else if (!(p.min_hull_share > 0.f && p.min_hull_share <= 1.f))
+    why << "min_hull_share " << p.min_hull_share << " must be in (0, 1]";
+  else if (p.plane_step < 1 || p.plane_step > 16)
+    why << "plane step " << p.plane_step << " must be in [1, 16]";
+  else if (!(p.voxel_size > 0.f))
+    why << "voxel size " << p.voxel_size << " must be > 0";
+  return why.str();
+}
+
+} // namespace facyl
+
+FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZ)
+FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGBA)
