@@ -30,8 +30,12 @@ printHelp(const char* self)
     "Usage: %s [options] SCENE.pcd...\n"
     "Finds the table, the objects on it and the cylinders among them; prints one JSON object\n"
     "per scene. Organized clouds (RGB-D frames) and unorganized clouds are accepted.\n"
-    "Decision:\n"
-    "  --min-inlier-ratio R   a fitted object is a cylinder if inlier ratio (eq. 4) >= R (0.5)\n"
+    "Decision (a fitted object is a cylinder if score >= R and curvature ratio <= C):\n"
+    "  --score S              surface (default: lateral inliers + points on the end caps, over\n"
+    "                         all points) | inlier (the paper's eq. 4 inlier ratio)\n"
+    "  --min-inlier-ratio R   score threshold (default 0.5)\n"
+    "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
+    "                         (default 0.35; 1 turns the check off)\n"
     "Fit:\n"
     "  --prior P              orientation prior in the table frame: uniform | vertical (default)\n"
     "                         | vertical-strong | horizontal\n"
@@ -154,6 +158,8 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
   const bool has_colour = facyl_cli::hasField(blob, "rgb") || facyl_cli::hasField(blob, "rgba");
   if (cloud->empty())
     return fail("the cloud is empty");
+  if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))
+    return fail("the cloud has no finite point");
 
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
   rec.setParameters(s.params);
@@ -163,7 +169,7 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
   std::vector<facyl::RecognitionTiming> timings;
   for (int r = 0; r < s.repeat; ++r) {
     if (!rec.recognize(objects))
-      return fail("no table found (see the message above), or invalid input");
+      return fail("no table found: no plane with enough points (see the message above)");
     timings.push_back(rec.getTiming());
   }
   // Median over the repetitions, by total.
@@ -211,6 +217,9 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
     out << ",\"p_cylinder\":"
         << (std::isfinite(o.p_cylinder) ? facyl_cli::number(o.p_cylinder) : std::string("null"))
         << ",\"inlier_ratio\":" << facyl_cli::number(o.inlier_ratio)
+        << ",\"surface_ratio\":" << facyl_cli::number(o.surface_ratio) << ",\"curvature_ratio\":"
+        << (std::isfinite(o.curvature_ratio) ? facyl_cli::number(o.curvature_ratio)
+                                             : std::string("null"))
         << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
     if (o.fitted)
       out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)
@@ -321,7 +330,7 @@ main(int argc, char** argv)
   try {
     const facyl_cli::Arguments args(
       argc, argv,
-      {"--min-inlier-ratio", "--prior", "--radius-limits", "--orientations", "--max-fit-points",
+      {"--min-inlier-ratio", "--score", "--max-curvature-ratio", "--prior", "--radius-limits", "--orientations", "--max-fit-points",
        "--neighbours", "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
        "--cluster-size", "--camera", "--overlay", "--save-clusters", "--repeat"},
       {});
@@ -330,6 +339,13 @@ main(int argc, char** argv)
       throw std::invalid_argument("give at least one scene (see -h)");
     auto& p = s.params;
     p.min_inlier_ratio = static_cast<float>(args.number("--min-inlier-ratio", p.min_inlier_ratio));
+    const std::string score = args.text("--score", "surface");
+    if (score != "surface" && score != "inlier")
+      throw std::invalid_argument("--score must be surface or inlier");
+    p.score = score == "surface" ? facyl::TabletopRecognizerParameters::Score::SurfaceRatio
+                                 : facyl::TabletopRecognizerParameters::Score::InlierRatio;
+    p.max_curvature_ratio =
+      static_cast<float>(args.number("--max-curvature-ratio", p.max_curvature_ratio));
     if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
       throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
     const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
@@ -368,6 +384,11 @@ main(int argc, char** argv)
     const std::string why = facyl::validate(p);
     if (!why.empty())
       throw std::invalid_argument(why);
+    if (!s.many && !s.overlay.empty()) {
+      const auto parent = std::filesystem::path(s.overlay).parent_path();
+      if (!parent.empty() && !std::filesystem::is_directory(parent))
+        throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
+    }
     for (const std::string& dir : {s.clusters_dir, s.many ? s.overlay : std::string()})
       if (!dir.empty() && !std::filesystem::is_directory(dir))
         throw std::invalid_argument("folder '" + dir + "' does not exist");

@@ -153,7 +153,7 @@ printHelp(const char* self)
     "          [--csv FILE]\n"
     "Runs TabletopCylinderRecognizer (default settings) on N simulated scenes and/or the\n"
     "labelled mOSD scenes and prints detection precision/recall for several thresholds, radius\n"
-    "and axis errors of the detected cylinders (with --score/--threshold, default inlier 0.5),\n"
+    "and axis errors of the detected cylinders (with --score/--threshold, default surface 0.5),\n"
     "and the stage timing.\n",
     self);
 }
@@ -170,7 +170,7 @@ main(int argc, char** argv)
   std::size_t sim = 0;
   std::uint64_t seed = 1000;
   std::string mosd, csv;
-  Decision decision{false, 0.5f};
+  Decision decision{true, 0.5f};
   facyl::TabletopRecognizerParameters params;
   try {
     const facyl_cli::Arguments args(argc, argv,
@@ -182,7 +182,7 @@ main(int argc, char** argv)
     seed = static_cast<std::uint64_t>(args.integer("--seed", 1000, 0));
     mosd = args.text("--mosd", "");
     csv = args.text("--csv", "");
-    const std::string score = args.text("--score", "inlier");
+    const std::string score = args.text("--score", "surface");
     if (score != "inlier" && score != "surface")
       throw std::invalid_argument("--score must be inlier or surface");
     decision.use_surface = score == "surface";

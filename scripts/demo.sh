@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# New user, step 1: install what is needed, build (Release), and fit the cylinder of the
-# bundled scene. Any arguments are passed to facyl_fit instead of the default scene.
+# New user, step 1: install what is needed, build (Release), and find every cylinder on the
+# table of the bundled RGB-D frame (data/default_scene.pcd, rendered by facyl_synth --seed 1).
+# Writes build/default_scene_overlay.png. Any arguments are passed to facyl_detect instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=OFF -DFACYL_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build build -j"$(nproc)" --target facyl_fit
+cmake --build build -j"$(nproc)" --target facyl_detect facyl_fit facyl_synth
 if [ $# -eq 0 ]; then
-  set -- data/default_cylinder.pcd
+  set -- --overlay build/default_scene_overlay.png data/default_scene.pcd
 fi
-echo "facyl_fit $*"
-./build/apps/facyl_fit "$@"
+echo "facyl_detect $*"
+./build/apps/facyl_detect "$@"
