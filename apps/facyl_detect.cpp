@@ -30,12 +30,15 @@ printHelp(const char* self)
     "Usage: %s [options] SCENE.pcd...\n"
     "Finds the table, the objects on it and the cylinders among them; prints one JSON object\n"
     "per scene. Organized clouds (RGB-D frames) and unorganized clouds are accepted.\n"
-    "Decision (a fitted object is a cylinder if score >= R and curvature ratio <= C):\n"
+    "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C and\n"
+    "angular coverage >= V):\n"
     "  --score S              surface (default: lateral inliers + points on the end caps, over\n"
     "                         all points) | inlier (the paper's eq. 4 inlier ratio)\n"
     "  --min-inlier-ratio R   score threshold (default 0.5)\n"
     "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
     "                         (default 0.35; 1 turns the check off)\n"
+    "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
+    "  --no-retry             no second fit with upright/lying priors when the first fails\n"
     "Fit:\n"
     "  --prior P              orientation prior in the table frame: uniform | vertical (default)\n"
     "                         | vertical-strong | horizontal\n"
@@ -225,7 +228,8 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
       out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)
           << ",\"axis\":" << facyl_cli::vector(o.cylinder.axis)
           << ",\"radius\":" << facyl_cli::number(o.cylinder.radius)
-          << ",\"height\":" << facyl_cli::number(o.cylinder.height) << "}";
+          << ",\"height\":" << facyl_cli::number(o.cylinder.height)
+          << ",\"angular_coverage\":" << facyl_cli::number(o.cylinder.angular_coverage) << "}";
     else
       out << "null";
     out << "}";
@@ -332,8 +336,9 @@ main(int argc, char** argv)
       argc, argv,
       {"--min-inlier-ratio", "--score", "--max-curvature-ratio", "--prior", "--radius-limits", "--orientations", "--max-fit-points",
        "--neighbours", "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
-       "--cluster-size", "--camera", "--overlay", "--save-clusters", "--repeat"},
-      {});
+       "--cluster-size", "--camera", "--overlay", "--save-clusters", "--repeat",
+       "--min-coverage"},
+      {"--no-retry"});
     files = args.positional();
     if (files.empty())
       throw std::invalid_argument("give at least one scene (see -h)");
@@ -346,6 +351,9 @@ main(int argc, char** argv)
                                  : facyl::TabletopRecognizerParameters::Score::InlierRatio;
     p.max_curvature_ratio =
       static_cast<float>(args.number("--max-curvature-ratio", p.max_curvature_ratio));
+    p.retry_upright_lying = !args.has("--no-retry");
+    p.min_angular_coverage =
+      static_cast<float>(args.number("--min-coverage", p.min_angular_coverage));
     if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
       throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
     const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);

@@ -33,7 +33,7 @@ struct Row {
   bool found{false};        ///< a cluster maps to it
   std::size_t clusters{0};  ///< clusters mapping to it
   bool merged{false};       ///< its best cluster holds >= 20% of another object's points too
-  float inlier_ratio{0.f}, surface_ratio{0.f}, curvature_ratio{NAN}; ///< of its best cluster
+  float inlier_ratio{0.f}, surface_ratio{0.f}, curvature_ratio{NAN}, coverage{0.f}; ///< best cluster
   bool fitted{false};
   float radius{NAN}, true_radius{NAN}, axis_error_deg{NAN};
 };
@@ -85,6 +85,7 @@ matchClusters(const std::vector<facyl::RecognizedObject>& objects, LabelOf label
     r.inlier_ratio = o.inlier_ratio;
     r.surface_ratio = o.surface_ratio;
     r.curvature_ratio = o.curvature_ratio;
+    r.coverage = o.fitted ? o.cylinder.angular_coverage : 0.f;
     r.fitted = o.fitted;
     r.radius = o.fitted ? o.cylinder.radius : NAN;
     r.merged = false;
@@ -98,34 +99,35 @@ struct Decision {
   bool use_surface;
   float threshold;
   float max_curvature_ratio{1.f};
+  float min_coverage{0.f};
   bool
-  operator()(float inlier, float surface, bool fitted, float curvature_ratio) const
+  operator()(float inlier, float surface, bool fitted, float curvature_ratio, float coverage) const
   {
     return fitted && (use_surface ? surface : inlier) >= threshold &&
-           !(curvature_ratio > max_curvature_ratio);
+           !(curvature_ratio > max_curvature_ratio) && coverage >= min_coverage;
   }
 };
 
 /** Precision and recall over rows (ground-truth objects) and false clusters. */
 void
-report(const std::vector<Row>& rows, const std::vector<std::tuple<float, float, float>>& stray,
-       const std::string& title, float max_kr)
+report(const std::vector<Row>& rows, const std::vector<std::tuple<float, float, float, float>>& stray,
+       const std::string& title, float max_kr, float min_coverage)
 {
   std::printf("\n%s\n\n| score | threshold | TP | FP | FN | precision | recall |\n"
               "|---|---|---|---|---|---|---|\n",
               title.c_str());
   for (bool surface : {false, true})
     for (float t : {0.3f, 0.4f, 0.5f, 0.6f, 0.7f}) {
-      const Decision d{surface, t, max_kr};
+      const Decision d{surface, t, max_kr, min_coverage};
       std::size_t tp = 0, fp = 0, fn = 0;
       for (const Row& r : rows) {
-        const bool yes = r.found && d(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio);
+        const bool yes = r.found && d(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage);
         tp += r.positive && yes;
         fn += r.positive && !yes;
         fp += !r.positive && yes;
       }
-      for (const auto& [inlier, surface_ratio, kr] : stray)
-        fp += d(inlier, surface_ratio, true, kr);
+      for (const auto& [inlier, surface_ratio, kr, coverage] : stray)
+        fp += d(inlier, surface_ratio, true, kr, coverage);
       std::printf("| %s | %.1f | %zu | %zu | %zu | %.3f | %.3f |\n",
                   surface ? "surface ratio" : "inlier ratio (eq. 4)", t, tp, fp, fn,
                   tp + fp ? static_cast<double>(tp) / static_cast<double>(tp + fp) : NAN,
@@ -150,6 +152,8 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [--sim N] [--seed S] [--mosd DIR] [--score inlier|surface] [--threshold R]\n"
+    "          [--max-curvature-ratio C] [--min-coverage V] [--no-retry] [--normal-angle A]\n"
+    "          [--distance D]\n"
     "          [--csv FILE]\n"
     "Runs TabletopCylinderRecognizer (default settings) on N simulated scenes and/or the\n"
     "labelled mOSD scenes and prints detection precision/recall for several thresholds, radius\n"
@@ -175,7 +179,9 @@ main(int argc, char** argv)
   try {
     const facyl_cli::Arguments args(argc, argv,
                                     {"--sim", "--seed", "--mosd", "--score", "--threshold", "--csv",
-                                     "--normal-angle", "--distance", "--max-curvature-ratio"}, {});
+                                     "--normal-angle", "--distance", "--max-curvature-ratio",
+                                     "--min-coverage"},
+                                    {"--no-retry"});
     if (!args.positional().empty())
       throw std::invalid_argument("unexpected argument " + args.positional()[0]);
     sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
@@ -194,6 +200,10 @@ main(int argc, char** argv)
     params.max_curvature_ratio =
       static_cast<float>(args.number("--max-curvature-ratio", params.max_curvature_ratio));
     decision.max_curvature_ratio = params.max_curvature_ratio;
+    params.retry_upright_lying = !args.has("--no-retry");
+    params.min_angular_coverage =
+      static_cast<float>(args.number("--min-coverage", params.min_angular_coverage));
+    decision.min_coverage = params.min_angular_coverage;
     const std::string why = facyl::validate(params);
     if (!why.empty())
       throw std::invalid_argument(why);
@@ -226,7 +236,7 @@ main(int argc, char** argv)
 
   if (sim > 0) {
     std::vector<Row> all;
-    std::vector<std::tuple<float, float, float>> stray;
+    std::vector<std::tuple<float, float, float, float>> stray;
     std::vector<facyl::RecognitionTiming> timing;
     std::size_t failures = 0;
     for (std::size_t k = 0; k < sim; ++k) {
@@ -264,7 +274,7 @@ main(int argc, char** argv)
         if (!rows.count(labels[c]))
           if (objects[c].fitted)
             stray.emplace_back(objects[c].inlier_ratio, objects[c].surface_ratio,
-                               objects[c].curvature_ratio);
+                               objects[c].curvature_ratio, objects[c].cylinder.angular_coverage);
       // Axis errors of the best cluster of each cylinder.
       for (auto& [id, r] : rows) {
         if (!r.positive || !r.fitted)
@@ -298,13 +308,13 @@ main(int argc, char** argv)
                 found, all.size(), merged, split);
     report(all, stray, "Detection (object level; a cluster matching no object and called a "
                        "cylinder is a false positive):",
-           params.max_curvature_ratio);
+           params.max_curvature_ratio, params.min_angular_coverage);
     std::map<std::string, std::pair<std::size_t, std::size_t>> fp_by; // kind: (called, total)
     for (const Row& r : all)
       if (!r.positive) {
         auto& c = fp_by[r.kind];
         ++c.second;
-        c.first += r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio);
+        c.first += r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage);
       }
     std::printf("\nDistractors called cylinders (%s >= %.2f):",
                 decision.use_surface ? "surface ratio" : "inlier ratio", decision.threshold);
@@ -314,7 +324,7 @@ main(int argc, char** argv)
     std::vector<double> radius_rel, axis;
     std::map<std::string, std::vector<double>> axis_by, radius_by;
     for (const Row& r : all)
-      if (r.positive && r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio)) {
+      if (r.positive && r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage)) {
         const double rel = std::abs(r.radius - r.true_radius) / r.true_radius * 100.0;
         radius_rel.push_back(rel);
         axis.push_back(r.axis_error_deg);
@@ -359,7 +369,7 @@ main(int argc, char** argv)
         truth[f[1]][std::stoi(f[2])] = {f[3], f[4], f[8]};
     }
     std::vector<Row> all;
-    std::vector<std::tuple<float, float, float>> stray;
+    std::vector<std::tuple<float, float, float, float>> stray;
     std::vector<facyl::RecognitionTiming> timing;
     std::map<std::string, std::vector<std::pair<std::string, float>>> radii; // by note
     for (const auto& [scene_name, objects_truth] : truth) {
@@ -403,11 +413,11 @@ main(int argc, char** argv)
         if (!rows.count(labels[c]))
           if (objects[c].fitted)
             stray.emplace_back(objects[c].inlier_ratio, objects[c].surface_ratio,
-                               objects[c].curvature_ratio);
+                               objects[c].curvature_ratio, objects[c].cylinder.angular_coverage);
       for (auto& [id, r] : rows) {
         all.push_back(r);
         const std::string& note = objects_truth.at(id)[2];
-        if (r.fitted && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio))
+        if (r.fitted && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage))
           for (const char* key : {"sticker", "plain white mug", "flower canister", "small white canister", "Pringles"})
             if (note.find(key) != std::string::npos)
               radii[key].emplace_back(scene_name, r.radius);
@@ -427,8 +437,8 @@ main(int argc, char** argv)
       r.positive = r.kind == "cylinder";
     report(strict, stray, "Positives = class `cylinder` only (mugs and handled containers count "
                           "as the rest):",
-           params.max_curvature_ratio);
-    report(all, stray, "Positives = `cylinder` and `cylinder_handle`:", params.max_curvature_ratio);
+           params.max_curvature_ratio, params.min_angular_coverage);
+    report(all, stray, "Positives = `cylinder` and `cylinder_handle`:", params.max_curvature_ratio, params.min_angular_coverage);
     std::printf("\nRadius of recurring objects (decided cylinders):\n");
     for (const auto& [key, v] : radii) {
       std::vector<double> r;

@@ -29,6 +29,8 @@ validate(const TabletopRecognizerParameters& p)
     s << "min_inlier_ratio " << p.min_inlier_ratio << " must be in [0, 1]";
   else if (!(p.max_curvature_ratio > 0.f && p.max_curvature_ratio <= 1.f))
     s << "max_curvature_ratio " << p.max_curvature_ratio << " must be in (0, 1]";
+  else if (!(p.min_angular_coverage >= 0.f && p.min_angular_coverage <= 1.f))
+    s << "min_angular_coverage " << p.min_angular_coverage << " must be in [0, 1]";
   else if (!(p.min_probability >= 0.f && p.min_probability <= 1.f))
     s << "min_probability " << p.min_probability << " must be in [0, 1]";
   return s.str();

@@ -29,8 +29,8 @@ validate(const TabletopSegmentationParameters& p)
     why << "min_hull_share " << p.min_hull_share << " must be in (0, 1]";
   else if (p.plane_step < 1 || p.plane_step > 16)
     why << "plane step " << p.plane_step << " must be in [1, 16]";
-  else if (!(p.voxel_size > 0.f))
-    why << "voxel size " << p.voxel_size << " must be > 0";
+  else if (p.plane_samples < 100)
+    why << "plane_samples " << p.plane_samples << " must be >= 100";
   return why.str();
 }
 

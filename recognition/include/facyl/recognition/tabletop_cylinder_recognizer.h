@@ -38,6 +38,9 @@ struct TabletopRecognizerParameters {
   /** Orientation prior, expressed in the table frame (up = table normal). */
   OrientationPrior prior{OrientationPrior::Vertical};
   std::size_t orientations{450};  ///< accumulator cells N_d, >= 10
+  /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
+   * a lying (Horizontal) prior in the table frame and keep the best. */
+  bool retry_upright_lying{true};
   std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, >= 50
   int neighbours{16};             ///< k of the normal/curvature estimation, >= 5
   /** Decision score: the inlier ratio of eq. 4 (the paper), or the surface ratio, which also
@@ -48,6 +51,9 @@ struct TabletopRecognizerParameters {
   /** Decision: the inliers' curvature ratio (RecognizedObject::curvature_ratio) at most this,
    * in (0, 1]; 1 turns the check off. Rejects most spheres and bowls. */
   float max_curvature_ratio{0.35f};
+  /** Decision: the inliers cover at least this share of the circumference (a camera sees about
+   * half of a cylinder), in [0, 1]; a large cylinder fitted to a shallow arc covers less. */
+  float min_angular_coverage{0.2f};
   std::uint64_t seed{0};
 };
 
@@ -84,7 +90,8 @@ struct RecognitionTiming {
  * optional shape classifier, then a Hough cylinder fit per cluster (normals and curvatures by
  * NormalCurvatureEstimation, prior in the table frame) and the decision
  * `p_cylinder >= min_probability` (when classified), `score >= min_inlier_ratio` (score: eq. 4
- * inlier ratio, or the surface ratio) and `curvature_ratio <= max_curvature_ratio`.
+ * inlier ratio, or the surface ratio), `curvature_ratio <= max_curvature_ratio` and
+ * `cylinder.angular_coverage >= min_angular_coverage`.
  *
  * \code
  * facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
@@ -185,3 +192,7 @@ evenSubsample(const pcl::Indices& indices, std::size_t max_count);
 
 #define FACYL_INSTANTIATE_TabletopCylinderRecognizer(T)                                     \
   template class facyl::TabletopCylinderRecognizer<T>;
+
+#ifdef PCL_NO_PRECOMPILE
+#include <facyl/recognition/impl/tabletop_cylinder_recognizer.hpp>
+#endif

@@ -31,7 +31,7 @@ struct TabletopSegmentationParameters {
    * table's convex hull, in (0, 1] (1: every point, as pcl::ExtractPolygonalPrismData). */
   float min_hull_share{0.25f};
   int plane_step{4};              ///< organized: the plane search sees every step-th pixel, >= 1
-  float voxel_size{0.01f};        ///< unorganized: voxel grid for the plane search, > 0
+  std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
@@ -51,7 +51,7 @@ struct TabletopCluster {
  * planes by pcl::OrganizedMultiPlaneSegmentation on every plane_step-th pixel; the largest plane
  * is the table, refitted on its full-resolution inliers; clusters are connected components
  * (pcl::OrganizedConnectedComponentSegmentation with pcl::EuclideanClusterComparator) of the
- * points above it. Unorganized clouds: a voxel grid, pcl::NormalEstimation and
+ * points above it. Unorganized clouds: pcl::RandomSample, pcl::NormalEstimation and
  * pcl::SACSegmentationFromNormals (SACMODEL_NORMAL_PLANE) find the plane;
  * pcl::EuclideanClusterExtraction the clusters. In both cases the clusters are made of the points
  * within [min_height, max_height] above the plane (on the side of the sensor, whose position is
@@ -182,3 +182,7 @@ private:
 } // namespace facyl
 
 #define FACYL_INSTANTIATE_TabletopSegmentation(T) template class facyl::TabletopSegmentation<T>;
+
+#ifdef PCL_NO_PRECOMPILE
+#include <facyl/segmentation/impl/tabletop_segmentation.hpp>
+#endif

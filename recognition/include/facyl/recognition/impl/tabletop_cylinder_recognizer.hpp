@@ -55,12 +55,21 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation;
   cues_estimation.setKSearch(params_.neighbours);
   cues_estimation.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
-  HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature> hough;
-  hough.setParameters(params_.hough);
-  hough.setOrientationMixture(GaussianMixture::fromPrior(params_.prior));
-  hough.setReferenceFrame(segmentation_.getTableFrame().linear());
-  hough.setNumberOfOrientations(params_.orientations);
-  hough.setSeed(params_.seed);
+  // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
+  // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
+  // face from pulling the axis.
+  std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators(
+    params_.retry_upright_lying ? 3 : 1);
+  const OrientationPrior priors[3] = {params_.prior, OrientationPrior::VerticalStrong,
+                                      OrientationPrior::Horizontal};
+  for (std::size_t e = 0; e < estimators.size(); ++e) {
+    auto& hough = estimators[e];
+    hough.setParameters(params_.hough);
+    hough.setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
+    hough.setReferenceFrame(segmentation_.getTableFrame().linear());
+    hough.setNumberOfOrientations(params_.orientations);
+    hough.setSeed(params_.seed);
+  }
 
   for (auto& cluster : clusters) {
     RecognizedObject object;
@@ -86,55 +95,80 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
     pcl::PointCloud<NormalCurvature>::Ptr cues(new pcl::PointCloud<NormalCurvature>);
     cues_estimation.setInputCloud(points);
     cues_estimation.compute(*cues);
-    hough.setInputCloud(points);
-    hough.setInputNormals(cues);
-    std::vector<CylinderModel> models;
-    if (hough.segment(models) && !models.empty()) {
-      object.fitted = true;
-      object.cylinder = std::move(models.front());
-      object.inlier_ratio = object.cylinder.inlier_ratio;
-      // Cap points, on the points that have a normal (the estimator's columns skip the rest).
-      Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(points->size()));
-      Eigen::Matrix3Xf nrm(3, static_cast<Eigen::Index>(points->size()));
-      pcl::Indices column_of(points->size(), -1);
-      Eigen::Index n = 0;
-      for (std::size_t k = 0; k < points->size(); ++k) {
-        const auto& c = (*cues)[k];
-        if (!pcl::isFinite((*points)[k]) || !std::isfinite(c.normal_x))
-          continue;
-        pts.col(n) = (*points)[k].getVector3fMap();
-        nrm.col(n) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
-        column_of[k] = static_cast<pcl::index_t>(n++);
-      }
-      CylinderModel in_columns = object.cylinder;
+    // Points with a normal, as columns (the estimator's inliers skip the rest).
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(points->size()));
+    Eigen::Matrix3Xf nrm(3, static_cast<Eigen::Index>(points->size()));
+    pcl::Indices column_of(points->size(), -1);
+    Eigen::Index n = 0;
+    for (std::size_t k = 0; k < points->size(); ++k) {
+      const auto& c = (*cues)[k];
+      if (!pcl::isFinite((*points)[k]) || !std::isfinite(c.normal_x))
+        continue;
+      pts.col(n) = (*points)[k].getVector3fMap();
+      nrm.col(n) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
+      column_of[k] = static_cast<pcl::index_t>(n++);
+    }
+    struct Fit {
+      bool fitted{false};
+      CylinderModel model; // inliers index `points`
+      float inlier_ratio{0.f}, surface_ratio{0.f};
+      float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
+      float score{-1.f};
+      bool accepted{false};
+    };
+    const auto fit_with = [&](HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>& hough) {
+      Fit f;
+      hough.setInputCloud(points);
+      hough.setInputNormals(cues);
+      std::vector<CylinderModel> models;
+      if (!hough.segment(models) || models.empty())
+        return f;
+      f.fitted = true;
+      f.model = std::move(models.front());
+      f.inlier_ratio = f.model.inlier_ratio;
+      CylinderModel in_columns = f.model;
       for (auto& i : in_columns.inliers)
         i = column_of[static_cast<std::size_t>(i)];
       const std::size_t caps =
         countCapPoints(in_columns, pts.leftCols(n), nrm.leftCols(n),
-                       2.f * object.cylinder.distance_threshold, params_.hough.normal_angle_threshold);
-      object.surface_ratio = std::min(
-        1.f, object.inlier_ratio + static_cast<float>(caps) / static_cast<float>(points->size()));
-      {
-        std::vector<float> k_max, k_min;
-        for (const auto i : object.cylinder.inliers) {
-          const auto& c = (*cues)[static_cast<std::size_t>(i)];
-          if (std::isfinite(c.pc1) && std::isfinite(c.pc2))
-            k_max.push_back(std::abs(c.pc1)), k_min.push_back(std::abs(c.pc2));
-        }
-        if (!k_max.empty()) {
-          const auto mid = k_max.size() / 2;
-          std::nth_element(k_max.begin(), k_max.begin() + mid, k_max.end());
-          std::nth_element(k_min.begin(), k_min.begin() + mid, k_min.end());
-          object.curvature_ratio = k_max[mid] > 0.f ? k_min[mid] / k_max[mid] : 1.f;
-        }
+                       2.f * f.model.distance_threshold, params_.hough.normal_angle_threshold);
+      f.surface_ratio = std::min(
+        1.f, f.inlier_ratio + static_cast<float>(caps) / static_cast<float>(points->size()));
+      std::vector<float> k_max, k_min;
+      for (const auto i : f.model.inliers) {
+        const auto& c = (*cues)[static_cast<std::size_t>(i)];
+        if (std::isfinite(c.pc1) && std::isfinite(c.pc2))
+          k_max.push_back(std::abs(c.pc1)), k_min.push_back(std::abs(c.pc2));
       }
+      if (!k_max.empty()) {
+        const auto mid = k_max.size() / 2;
+        std::nth_element(k_max.begin(), k_max.begin() + mid, k_max.end());
+        std::nth_element(k_min.begin(), k_min.begin() + mid, k_min.end());
+        f.curvature_ratio = k_max[mid] > 0.f ? k_min[mid] / k_max[mid] : 1.f;
+      }
+      f.score = params_.score == TabletopRecognizerParameters::Score::SurfaceRatio
+                  ? f.surface_ratio
+                  : f.inlier_ratio;
+      f.accepted = f.score >= params_.min_inlier_ratio &&
+                   !(f.curvature_ratio > params_.max_curvature_ratio) &&
+                   f.model.angular_coverage >= params_.min_angular_coverage;
+      return f;
+    };
+    Fit best = fit_with(estimators[0]);
+    for (std::size_t e = 1; e < estimators.size() && !best.accepted; ++e) {
+      Fit f = fit_with(estimators[e]);
+      if (f.fitted && (f.accepted || f.score > best.score))
+        best = std::move(f);
+    }
+    if (best.fitted) {
+      object.fitted = true;
+      object.cylinder = std::move(best.model);
       for (auto& i : object.cylinder.inliers)
         i = subset[static_cast<std::size_t>(i)];
-      const float score = params_.score == TabletopRecognizerParameters::Score::SurfaceRatio
-                            ? object.surface_ratio
-                            : object.inlier_ratio;
-      object.is_cylinder = score >= params_.min_inlier_ratio &&
-                           !(object.curvature_ratio > params_.max_curvature_ratio);
+      object.inlier_ratio = best.inlier_ratio;
+      object.surface_ratio = best.surface_ratio;
+      object.curvature_ratio = best.curvature_ratio;
+      object.is_cylinder = best.accepted;
     }
     timing_.fitting += ms(tc, Clock::now());
     objects.push_back(std::move(object));

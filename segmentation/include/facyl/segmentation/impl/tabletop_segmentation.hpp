@@ -9,7 +9,7 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/features/integral_image_normal.h>
 #include <pcl/features/normal_3d.h>
-#include <pcl/filters/voxel_grid.h>
+#include <pcl/filters/random_sample.h>
 #include <pcl/sample_consensus/method_types.h>
 #include <pcl/sample_consensus/model_types.h>
 #include <pcl/search/kdtree.h>
@@ -21,7 +21,9 @@
 #include <pcl/surface/convex_hull.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 
 namespace facyl {
 
@@ -106,9 +108,13 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
   region->reserve(table_indices_.indices.size());
   const auto w = static_cast<pcl::index_t>(input_->width);
   const pcl::index_t step = organized ? params_.plane_step : 1;
-  for (const auto i : table_indices_.indices)
+  const std::size_t stride =
+    organized ? 1 : std::max<std::size_t>(1, table_indices_.indices.size() / params_.plane_samples);
+  for (std::size_t k = 0; k < table_indices_.indices.size(); k += stride) {
+    const auto i = table_indices_.indices[k];
     if (!organized || ((i % w) % step == 0 && (i / w) % step == 0))
       region->push_back((*input_)[i]);
+  }
   pcl::ConvexHull<PointT> convex_hull;
   convex_hull.setInputCloud(region);
   convex_hull.setDimension(2);
@@ -255,14 +261,20 @@ template <typename PointT>
 bool
 TabletopSegmentation<PointT>::findTableUnorganized(pcl::Indices& plane_points)
 {
-  // Plane search on a voxel grid, with normals.
+  // Plane search on a uniform random sample of the points, with normals: like the pixels of an
+  // organized frame, the sample follows the sensor's density, so the table outweighs a larger
+  // but farther floor (a voxel grid would weigh surfaces by their area).
+  pcl::IndicesPtr finite(new pcl::Indices);
+  for (const auto i : *indices_)
+    if (pcl::isFinite((*input_)[i]))
+      finite->push_back(i);
   typename PointCloud::Ptr coarse(new PointCloud);
-  pcl::VoxelGrid<PointT> grid;
-  grid.setInputCloud(input_);
-  if (!fake_indices_)
-    grid.setIndices(indices_);
-  grid.setLeafSize(params_.voxel_size, params_.voxel_size, params_.voxel_size);
-  grid.filter(*coarse);
+  pcl::RandomSample<PointT> sample;
+  sample.setInputCloud(input_);
+  sample.setIndices(finite);
+  sample.setSample(static_cast<unsigned>(std::min<std::size_t>(params_.plane_samples, finite->size())));
+  sample.setSeed(1);
+  sample.filter(*coarse);
   if (coarse->size() < 10)
     return false;
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
@@ -278,7 +290,7 @@ TabletopSegmentation<PointT>::findTableUnorganized(pcl::Indices& plane_points)
   sac.setMethodType(pcl::SAC_RANSAC);
   sac.setNormalDistanceWeight(0.1);
   sac.setDistanceThreshold(params_.plane_distance);
-  sac.setMaxIterations(500);
+  sac.setMaxIterations(300);
   sac.setInputCloud(coarse);
   sac.setInputNormals(normals);
   pcl::PointIndices inliers;
@@ -332,17 +344,43 @@ TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
 {
   if (objects.empty())
     return;
+  // Euclidean clusters of one representative per voxel of a quarter of the tolerance (any two
+  // points of neighbouring voxels are closer than the tolerance), then every point joins its
+  // voxel's cluster: on dense sensor clouds the radius searches then return few neighbours.
+  const float leaf = 0.25f * params_.cluster_tolerance;
+  std::unordered_map<std::uint64_t, std::size_t> voxel_of_key;
+  pcl::IndicesPtr representatives(new pcl::Indices);
+  std::vector<std::size_t> voxel(objects.size());
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const Eigen::Vector3f p = (*input_)[objects[k]].getVector3fMap() / leaf;
+    const auto cell = [](float v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v)) + (1 << 20)) &
+             0x1fffffULL;
+    };
+    const std::uint64_t key = cell(p.x()) | (cell(p.y()) << 21) | (cell(p.z()) << 42);
+    const auto it = voxel_of_key.emplace(key, representatives->size());
+    if (it.second)
+      representatives->push_back(objects[k]);
+    voxel[k] = it.first->second;
+  }
   typename pcl::search::KdTree<PointT>::Ptr tree(new pcl::search::KdTree<PointT>);
-  pcl::IndicesPtr subset(new pcl::Indices(objects));
-  tree->setInputCloud(input_, subset);
+  tree->setInputCloud(input_, representatives);
   pcl::EuclideanClusterExtraction<PointT> ec;
   ec.setClusterTolerance(params_.cluster_tolerance);
-  ec.setMinClusterSize(params_.min_cluster_size);
-  ec.setMaxClusterSize(params_.max_cluster_size);
+  ec.setMinClusterSize(1);
+  ec.setMaxClusterSize(std::numeric_limits<pcl::uindex_t>::max());
   ec.setSearchMethod(tree);
   ec.setInputCloud(input_);
-  ec.setIndices(subset);
-  ec.extract(out);
+  ec.setIndices(representatives);
+  std::vector<pcl::PointIndices> groups;
+  ec.extract(groups);
+  std::unordered_map<pcl::index_t, std::size_t> group_of;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const auto i : groups[g].indices)
+      group_of[i] = g;
+  out.assign(groups.size(), pcl::PointIndices{});
+  for (std::size_t k = 0; k < objects.size(); ++k)
+    out[group_of.at((*representatives)[voxel[k]])].indices.push_back(objects[k]);
 }
 
 } // namespace facyl
