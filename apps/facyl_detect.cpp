@@ -39,6 +39,9 @@ printHelp(const char* self)
     "                         (default 0.35; 1 turns the check off)\n"
     "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
     "  --no-retry             no second fit with upright/lying priors when the first fails\n"
+    "  --retry-inside         a last retry also fits concave clusters (the inside of an open\n"
+    "                         container; bowls too)\n"
+    "  --any-normal-sign      inliers' normals may point at the axis (default: away from it)\n"
     "Fit:\n"
     "  --prior P              orientation prior in the table frame: uniform | vertical (default)\n"
     "                         | vertical-strong | horizontal\n"
@@ -338,7 +341,7 @@ main(int argc, char** argv)
        "--neighbours", "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
        "--cluster-size", "--camera", "--overlay", "--save-clusters", "--repeat",
        "--min-coverage"},
-      {"--no-retry"});
+      {"--no-retry", "--retry-inside", "--any-normal-sign"});
     files = args.positional();
     if (files.empty())
       throw std::invalid_argument("give at least one scene (see -h)");
@@ -352,6 +355,8 @@ main(int argc, char** argv)
     p.max_curvature_ratio =
       static_cast<float>(args.number("--max-curvature-ratio", p.max_curvature_ratio));
     p.retry_upright_lying = !args.has("--no-retry");
+    p.retry_any_normal_sign = args.has("--retry-inside");
+    p.hough.outward_normals = !args.has("--any-normal-sign");
     p.min_angular_coverage =
       static_cast<float>(args.number("--min-coverage", p.min_angular_coverage));
     if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))

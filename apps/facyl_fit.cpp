@@ -50,6 +50,8 @@ printHelp(const char* self)
       "  --k K                neighbours for normals and curvatures (default %lld)\n"
       "  --seed S             seed of the accumulator draws and of RANSAC (default 0)\n"
       "  --threads T          threads for normals (default: all)\n"
+      "  --outward-normals    inliers' normals must point away from the axis (normals towards\n"
+      "                       a sensor outside the cylinder: excludes a cup's inner wall)\n"
       "  -h, --help           this help\n\n"
       "Normals are estimated unless the file has normal_x/y/z. Exit status: 0 if every file\n"
       "was processed, 1 if some file failed (its object holds \"error\"), 2 on bad options.\n",
@@ -198,7 +200,7 @@ main(int argc, char** argv)
         {"--method", "--prior", "--up", "--orientations", "--accumulators", "--radius-min",
          "--radius-max", "--distance-threshold", "--max-cylinders", "--k", "--seed",
          "--threads"},
-        {});
+        {"--outward-normals"});
     files = args.positional();
     s.method = args.text("--method", default_method);
     facyl::VotingMode mode;
@@ -223,6 +225,7 @@ main(int argc, char** argv)
     s.k = static_cast<int>(args.integer("--k", default_k, 3));
     s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
     s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0));
+    s.params.outward_normals = args.has("--outward-normals");
     const std::string why = facyl::validate(s.params);
     if (!why.empty())
       throw std::invalid_argument(why);

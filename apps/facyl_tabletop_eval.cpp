@@ -152,8 +152,8 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [--sim N] [--seed S] [--mosd DIR] [--score inlier|surface] [--threshold R]\n"
-    "          [--max-curvature-ratio C] [--min-coverage V] [--no-retry] [--normal-angle A]\n"
-    "          [--distance D]\n"
+    "          [--max-curvature-ratio C] [--min-coverage V] [--no-retry] [--retry-inside]\n"
+    "          [--any-normal-sign] [--normal-angle A] [--distance D]\n"
     "          [--csv FILE]\n"
     "Runs TabletopCylinderRecognizer (default settings) on N simulated scenes and/or the\n"
     "labelled mOSD scenes and prints detection precision/recall for several thresholds, radius\n"
@@ -181,7 +181,7 @@ main(int argc, char** argv)
                                     {"--sim", "--seed", "--mosd", "--score", "--threshold", "--csv",
                                      "--normal-angle", "--distance", "--max-curvature-ratio",
                                      "--min-coverage"},
-                                    {"--no-retry"});
+                                    {"--no-retry", "--retry-inside", "--any-normal-sign"});
     if (!args.positional().empty())
       throw std::invalid_argument("unexpected argument " + args.positional()[0]);
     sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
@@ -201,6 +201,8 @@ main(int argc, char** argv)
       static_cast<float>(args.number("--max-curvature-ratio", params.max_curvature_ratio));
     decision.max_curvature_ratio = params.max_curvature_ratio;
     params.retry_upright_lying = !args.has("--no-retry");
+    params.retry_any_normal_sign = args.has("--retry-inside");
+    params.hough.outward_normals = !args.has("--any-normal-sign");
     params.min_angular_coverage =
       static_cast<float>(args.number("--min-coverage", params.min_angular_coverage));
     decision.min_coverage = params.min_angular_coverage;

@@ -614,3 +614,36 @@ TEST(RealData, LidDominatedAndLyingTins)
     }
   }
 }
+
+TEST(RealData, FloorScenesOfPcl)
+{
+  const std::string bottles = realFile("pcl/milk_cartoon_all_small_clorox.pcd");
+  const std::string negative = realFile("pcl/grabber_frame_laptop_box.pcd");
+  if (bottles.empty() || negative.empty())
+    GTEST_SKIP() << "no " << FACYL_REAL_DATA_DIR << "/pcl scenes";
+  const auto cylinders = [](const std::string& file) {
+    Cloud::Ptr cloud(new Cloud);
+    EXPECT_EQ(pcl::io::loadPCDFile(file, *cloud), 0);
+    facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    EXPECT_TRUE(rec.recognize(objects));
+    std::vector<float> radii;
+    for (const auto& o : objects)
+      if (o.is_cylinder)
+        radii.push_back(o.cylinder.radius);
+    return radii;
+  };
+  // The detergent bottle (r ~8 cm) and the Clorox bottle (~6 cm) stand on a carpet; a laptop
+  // and a box are no cylinders: at most a small cluster may pass, never a large shallow arc.
+  const std::vector<float> found = cylinders(bottles);
+  const auto count = [](const std::vector<float>& r, float lo, float hi) {
+    return std::count_if(r.begin(), r.end(), [&](float x) { return x >= lo && x <= hi; });
+  };
+  EXPECT_EQ(count(found, 0.055f, 0.07f), 1);
+  EXPECT_EQ(count(found, 0.075f, 0.09f), 1);
+  EXPECT_EQ(count(found, 0.1f, 1.f), 0);
+  const std::vector<float> none = cylinders(negative);
+  EXPECT_LE(none.size(), 1u);
+  EXPECT_EQ(count(none, 0.05f, 1.f), 0);
+}

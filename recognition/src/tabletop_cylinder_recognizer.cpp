@@ -59,6 +59,31 @@ countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   return count;
 }
 
+std::size_t
+countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                     const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio)
+{
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float h = (model.top - model.base).dot(a);
+  const float cos_max = std::cos(max_angle);
+  std::size_t count = 0, next = 0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    while (next < model.inliers.size() && model.inliers[next] < i)
+      ++next;
+    if (next < model.inliers.size() && model.inliers[next] == i)
+      continue;
+    const Eigen::Vector3f d = points.col(i) - model.base;
+    const float t = d.dot(a);
+    const Eigen::Vector3f radial = d - t * a;
+    const float rho = radial.norm();
+    if (t < 0.f || t > h || rho > model.radius || rho < inner_ratio * model.radius || !(rho > 0.f))
+      continue;
+    if (-normals.col(i).dot(radial) >= cos_max * rho) // points at the axis
+      ++count;
+  }
+  return count;
+}
+
 pcl::Indices
 evenSubsample(const pcl::Indices& indices, std::size_t max_count)
 {

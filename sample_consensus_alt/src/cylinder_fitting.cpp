@@ -639,7 +639,7 @@ estimateThreshold(const CylinderCues& cues, const std::vector<int>& columns,
 /** Inliers: near the surface, and with a normal close to the surface normal. */
 std::vector<int>
 selectInliers(const CylinderCues& cues, const std::vector<int>& columns, const Candidate& c,
-              float cos_normal)
+              float cos_normal, bool outward)
 {
   std::vector<int> inliers;
   for (const int s : columns) {
@@ -648,7 +648,8 @@ selectInliers(const CylinderCues& cues, const std::vector<int>& columns, const C
     const float rho = d.norm();
     if (std::abs(rho - c.radius) >= c.threshold || !(rho > 0.f))
       continue;
-    if (std::abs(cues.normals.col(s).dot(d)) < cos_normal * rho)
+    const float along = cues.normals.col(s).dot(d);
+    if ((outward ? along : std::abs(along)) < cos_normal * rho)
       continue;
     inliers.push_back(s);
   }
@@ -719,7 +720,9 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
     for (Eigen::Index i = 0; i < pts.cols(); ++i) {
       const Eigen::Vector2f w = pts.col(i) - c.center;
       const float d = w.norm();
-      if (std::abs(d - c.radius) < band && std::abs(nrm.col(i).dot(w)) >= cos_n * d)
+      const float along = nrm.col(i).dot(w);
+      if (std::abs(d - c.radius) < band &&
+          (params.outward_normals ? along : std::abs(along)) >= cos_n * d)
         keep.push_back(i);
     }
     return keep;
@@ -767,7 +770,8 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
   const std::vector<int> support = supporters(cues, active, c.axis, params);
   const float cos_normal = std::cos(params.normal_angle_threshold);
   for (int round = 0; round < 3; ++round) {
-    const std::vector<int> inliers = selectInliers(cues, active, c, cos_normal);
+    const std::vector<int> inliers =
+      selectInliers(cues, active, c, cos_normal, params.outward_normals);
     if (inliers.size() < 6)
       break;
     const Eigen::Matrix3Xf pts = cues.points(Eigen::all, inliers);
@@ -797,7 +801,8 @@ describe(const CylinderCues& cues, const std::vector<int>& active, const Candida
   m.radius = c.radius;
   m.distance_threshold = c.threshold;
   const std::vector<int> inliers =
-      selectInliers(cues, active, c, std::cos(params.normal_angle_threshold));
+      selectInliers(cues, active, c, std::cos(params.normal_angle_threshold),
+                    params.outward_normals);
   m.inliers.assign(inliers.begin(), inliers.end());
   describeInliers(cues.points(Eigen::all, inliers), m);
   return m;

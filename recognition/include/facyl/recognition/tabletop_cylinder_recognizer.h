@@ -21,13 +21,15 @@
 
 namespace facyl {
 
-/** \brief The Hough settings of the recognizer: defaults, with radii in [0.01, 0.25] m. */
+/** \brief The Hough settings of the recognizer: defaults, with radii in [0.01, 0.25] m and
+ * outward normals only. */
 inline HoughCylinderParameters
 tabletopHoughDefaults()
 {
   HoughCylinderParameters p;
   p.radius_min = 0.01f;
   p.radius_max = 0.25f;
+  p.outward_normals = true; // objects on a table are seen from outside
   return p;
 }
 
@@ -41,6 +43,10 @@ struct TabletopRecognizerParameters {
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
    * a lying (Horizontal) prior in the table frame and keep the best. */
   bool retry_upright_lying{true};
+  /** With hough.outward_normals (the default), a last retry accepts inliers whose normals point
+   * at the axis: clusters made of the inside of an open container are then fitted, and so are
+   * the insides of bowls (see docs/tabletop.md for the trade-off). */
+  bool retry_any_normal_sign{false};
   std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, >= 50
   int neighbours{16};             ///< k of the normal/curvature estimation, >= 5
   /** Decision score: the inlier ratio of eq. 4 (the paper), or the surface ratio, which also
@@ -68,7 +74,9 @@ struct RecognizedObject {
   float p_cylinder{std::numeric_limits<float>::quiet_NaN()};
   bool fitted{false};       ///< a cylinder was fitted (not rejected by the classifier, fit found)
   float inlier_ratio{0.f};  ///< paper eq. 4 on the points fitted; 0 when not fitted
-  float surface_ratio{0.f}; ///< (lateral inliers + points on the end caps) / points fitted
+  /** (lateral inliers + points on the end caps + points on the inner wall of an open
+   * container) / points fitted */
+  float surface_ratio{0.f};
   /** Median |k_min| / median |k_max| over the lateral inliers: near 0 on a cylinder, near 1 on
    * a sphere or bowl; NaN when not fitted. */
   float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
@@ -182,6 +190,14 @@ private:
 std::size_t
 countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
                const Eigen::Matrix3Xf& normals, float distance, float max_angle);
+
+/** \brief Number of \a points (with unit \a normals) on the inner wall of \a model seen as an
+ * open container (a cup's inside, seen through its opening): between inner_ratio x radius and
+ * the radius from the axis, within the axial extent of the model, with a normal within
+ * \a max_angle (rad) of pointing at the axis. Points in model.inliers are not counted. */
+std::size_t
+countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                     const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio);
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */

@@ -145,6 +145,10 @@ struct HoughCylinderParameters {
   std::size_t min_inliers{0};           ///< 0: max(10, 5% of the points)
   std::size_t max_voting_points{500};   ///< voters are subsampled above this; 0: all
   int circle_grid{48};                  ///< CHT accumulator size per side, >= 8
+  /** Inliers' normals must point away from the axis, as normals oriented towards a sensor
+   * outside the cylinder do: a cup's inner wall, seen through its opening, is then no inlier.
+   * Off by default (pipes seen from inside). */
+  bool outward_normals{false};
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */

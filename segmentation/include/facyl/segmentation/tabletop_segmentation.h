@@ -177,6 +177,8 @@ private:
   Eigen::Affine3f table_frame_{Eigen::Affine3f::Identity()};
   pcl::PointIndices table_indices_;
   typename PointCloud::Ptr hull_{new PointCloud};
+  mutable pcl::PointCloud<pcl::PointXYZ>::Ptr masked_; ///< buffers of clusterOrganized
+  mutable pcl::PointCloud<pcl::Label> labels_;
 };
 
 } // namespace facyl

@@ -58,13 +58,20 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
   // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
   // face from pulling the axis.
+  // Optionally a last try allows any normal sign: the inside of an open container can make a
+  // cluster of its own (so can the inside of a bowl).
+  const bool any_sign = params_.retry_upright_lying && params_.hough.outward_normals &&
+                        params_.retry_any_normal_sign;
   std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators(
-    params_.retry_upright_lying ? 3 : 1);
-  const OrientationPrior priors[3] = {params_.prior, OrientationPrior::VerticalStrong,
-                                      OrientationPrior::Horizontal};
+    params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1);
+  const OrientationPrior priors[4] = {params_.prior, OrientationPrior::VerticalStrong,
+                                      OrientationPrior::Horizontal, params_.prior};
   for (std::size_t e = 0; e < estimators.size(); ++e) {
     auto& hough = estimators[e];
-    hough.setParameters(params_.hough);
+    HoughCylinderParameters hp = params_.hough;
+    if (e == 3)
+      hp.outward_normals = false;
+    hough.setParameters(hp);
     hough.setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
     hough.setReferenceFrame(segmentation_.getTableFrame().linear());
     hough.setNumberOfOrientations(params_.orientations);
@@ -132,8 +139,14 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
       const std::size_t caps =
         countCapPoints(in_columns, pts.leftCols(n), nrm.leftCols(n),
                        2.f * f.model.distance_threshold, params_.hough.normal_angle_threshold);
-      f.surface_ratio = std::min(
-        1.f, f.inlier_ratio + static_cast<float>(caps) / static_cast<float>(points->size()));
+      const std::size_t inner =
+        params_.hough.outward_normals
+          ? countInnerWallPoints(in_columns, pts.leftCols(n), nrm.leftCols(n),
+                                 params_.hough.normal_angle_threshold, 0.8f)
+          : 0;
+      f.surface_ratio =
+        std::min(1.f, f.inlier_ratio + static_cast<float>(caps + inner) /
+                                         static_cast<float>(points->size()));
       std::vector<float> k_max, k_min;
       for (const auto i : f.model.inliers) {
         const auto& c = (*cues)[static_cast<std::size_t>(i)];

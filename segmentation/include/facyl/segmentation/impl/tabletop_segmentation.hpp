@@ -319,12 +319,16 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
 {
   // A sparse copy with only the object points finite: the connected components then never
   // visit the rest of the image.
-  pcl::PointCloud<pcl::PointXYZ>::Ptr masked(new pcl::PointCloud<pcl::PointXYZ>);
+  // (Buffers kept between calls: fresh VGA-sized allocations cost more in page faults than the
+  // work done on them.)
+  if (!masked_)
+    masked_.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  const auto& masked = masked_;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  masked->points.assign(input_->size(), pcl::PointXYZ(nan, nan, nan));
   masked->width = input_->width;
   masked->height = input_->height;
   masked->is_dense = false;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  masked->points.assign(input_->size(), pcl::PointXYZ(nan, nan, nan));
   for (const auto i : objects)
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
   pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
@@ -333,8 +337,8 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   comparator->setDistanceThreshold(params_.cluster_tolerance, false);
   pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
   components.setInputCloud(masked);
-  pcl::PointCloud<pcl::Label> labels;
-  components.segment(labels, out);
+  labels_.clear(); // PCL's segment() resizes without resetting: start empty (capacity stays)
+  components.segment(labels_, out);
 }
 
 template <typename PointT>
