@@ -183,25 +183,20 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
             [](const auto& a, const auto& b) { return a.total < b.total; });
   const facyl::RecognitionTiming t = timings[timings.size() / 2];
 
-  // Camera for drawing: given, or estimated from an organized cloud.
+  // Camera for drawing: given, or estimated from an organized cloud (every 17th pixel).
   facyl::PinholeCamera camera = s.camera;
-  if (!camera.valid() && cloud->isOrganized()) {
-    Eigen::Matrix3Xf pts(3, 0);
-    Eigen::Matrix2Xf px(2, 0);
-    std::vector<Eigen::Vector3f> p3;
-    std::vector<Eigen::Vector2f> p2;
+  if (!s.overlay.empty() && !camera.valid() && cloud->isOrganized()) {
+    const auto samples = static_cast<Eigen::Index>(cloud->size() / 17 + 1);
+    Eigen::Matrix3Xf pts(3, samples);
+    Eigen::Matrix2Xf px(2, samples);
+    Eigen::Index n = 0;
     for (std::size_t i = 0; i < cloud->size(); i += 17)
       if (pcl::isFinite((*cloud)[i])) {
-        p3.push_back((*cloud)[i].getVector3fMap());
-        p2.emplace_back(static_cast<float>(i % cloud->width), static_cast<float>(i / cloud->width));
+        pts.col(n) = (*cloud)[i].getVector3fMap();
+        px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud->width),
+                                      static_cast<float>(i / cloud->width));
       }
-    pts.resize(3, static_cast<Eigen::Index>(p3.size()));
-    px.resize(2, static_cast<Eigen::Index>(p2.size()));
-    for (std::size_t k = 0; k < p3.size(); ++k) {
-      pts.col(static_cast<Eigen::Index>(k)) = p3[k];
-      px.col(static_cast<Eigen::Index>(k)) = p2[k];
-    }
-    facyl::estimatePinhole(pts, px, static_cast<int>(cloud->width),
+    facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), static_cast<int>(cloud->width),
                            static_cast<int>(cloud->height), camera);
   }
 

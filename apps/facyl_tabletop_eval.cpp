@@ -29,6 +29,7 @@ using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
 struct Row {
   std::string scene, kind, pose;
   int object{-1};
+  std::size_t cluster{0};   ///< its best (largest) cluster, when found
   bool positive{false};     ///< ground truth: a cylinder
   bool found{false};        ///< a cluster maps to it
   std::size_t clusters{0};  ///< clusters mapping to it
@@ -55,15 +56,20 @@ percentile(std::vector<double> v, double q)
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
 }
 
-/** Maps each cluster to the label most of its points carry; fills the rows' cluster fields. */
+/** (inlier ratio, surface ratio, curvature ratio, angular coverage) of a fitted cluster that
+ * matches no object. */
+using Stray = std::tuple<float, float, float, float>;
+
+/** Maps each cluster to the label most of its points carry; fills the rows' cluster fields and
+ * adds the fitted clusters that match no row to \a stray. */
 template <typename LabelOf>
 void
 matchClusters(const std::vector<facyl::RecognizedObject>& objects, LabelOf label_of,
-              std::map<int, Row>& rows, std::vector<int>& cluster_label)
+              std::map<int, Row>& rows, std::vector<Stray>& stray)
 {
-  cluster_label.clear();
   std::map<int, std::size_t> best_size;
-  for (const auto& o : objects) {
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const auto& o = objects[k];
     std::map<int, std::size_t> votes;
     for (const auto i : o.cluster.indices.indices)
       ++votes[label_of(i)];
@@ -72,16 +78,20 @@ matchClusters(const std::vector<facyl::RecognizedObject>& objects, LabelOf label
     for (const auto& [l, c] : votes)
       if (c > most)
         label = l, most = c;
-    cluster_label.push_back(label);
     auto it = rows.find(label);
-    if (it == rows.end())
+    if (it == rows.end()) {
+      if (o.fitted)
+        stray.emplace_back(o.inlier_ratio, o.surface_ratio, o.curvature_ratio,
+                           o.cylinder.angular_coverage);
       continue;
+    }
     Row& r = it->second;
     r.found = true;
     ++r.clusters;
     if (o.cluster.indices.indices.size() < best_size[label])
       continue;
     best_size[label] = o.cluster.indices.indices.size();
+    r.cluster = k;
     r.inlier_ratio = o.inlier_ratio;
     r.surface_ratio = o.surface_ratio;
     r.curvature_ratio = o.curvature_ratio;
@@ -110,7 +120,7 @@ struct Decision {
 
 /** Precision and recall over rows (ground-truth objects) and false clusters. */
 void
-report(const std::vector<Row>& rows, const std::vector<std::tuple<float, float, float, float>>& stray,
+report(const std::vector<Row>& rows, const std::vector<Stray>& stray,
        const std::string& title, float max_kr, float min_coverage)
 {
   std::printf("\n%s\n\n| score | threshold | TP | FP | FN | precision | recall |\n"
@@ -238,7 +248,7 @@ main(int argc, char** argv)
 
   if (sim > 0) {
     std::vector<Row> all;
-    std::vector<std::tuple<float, float, float, float>> stray;
+    std::vector<Stray> stray;
     std::vector<facyl::RecognitionTiming> timing;
     std::size_t failures = 0;
     for (std::size_t k = 0; k < sim; ++k) {
@@ -269,26 +279,16 @@ main(int argc, char** argv)
           r.true_radius = o.radius;
         rows[r.object] = r;
       }
-      std::vector<int> labels;
       matchClusters(objects, [&](pcl::index_t i) { return static_cast<int>(scene.object_id[i]); },
-                    rows, labels);
-      for (std::size_t c = 0; c < objects.size(); ++c)
-        if (!rows.count(labels[c]))
-          if (objects[c].fitted)
-            stray.emplace_back(objects[c].inlier_ratio, objects[c].surface_ratio,
-                               objects[c].curvature_ratio, objects[c].cylinder.angular_coverage);
+                    rows, stray);
       // Axis errors of the best cluster of each cylinder.
       for (auto& [id, r] : rows) {
         if (!r.positive || !r.fitted)
           continue;
         const facyl::CylinderTruth truth =
           facyl::cylinderTruth(scene.scene, scene.scene.objects[static_cast<std::size_t>(id - 2)]);
-        std::size_t best = 0, size = 0;
-        for (std::size_t c = 0; c < objects.size(); ++c)
-          if (labels[c] == id && objects[c].cluster.indices.indices.size() >= size)
-            best = c, size = objects[c].cluster.indices.indices.size();
-        r.axis_error_deg =
-          facyl::axisAngle(objects[best].cylinder.axis, truth.axis) * 180.f / static_cast<float>(M_PI);
+        r.axis_error_deg = facyl::axisAngle(objects[r.cluster].cylinder.axis, truth.axis) * 180.f /
+                           static_cast<float>(M_PI);
       }
       for (auto& [id, r] : rows)
         all.push_back(r);
@@ -371,7 +371,7 @@ main(int argc, char** argv)
         truth[f[1]][std::stoi(f[2])] = {f[3], f[4], f[8]};
     }
     std::vector<Row> all;
-    std::vector<std::tuple<float, float, float, float>> stray;
+    std::vector<Stray> stray;
     std::vector<facyl::RecognitionTiming> timing;
     std::map<std::string, std::vector<std::pair<std::string, float>>> radii; // by note
     for (const auto& [scene_name, objects_truth] : truth) {
@@ -403,19 +403,13 @@ main(int argc, char** argv)
         r.positive = t[0] == "cylinder" || t[0] == "cylinder_handle";
         rows[id] = r;
       }
-      std::vector<int> labels;
       matchClusters(
         objects,
         [&](pcl::index_t i) {
           const std::uint32_t l = labelled[i].label;
           return l >= 20 ? static_cast<int>(l / 10) : (l >= 1 ? 0 : -1);
         },
-        rows, labels);
-      for (std::size_t c = 0; c < objects.size(); ++c)
-        if (!rows.count(labels[c]))
-          if (objects[c].fitted)
-            stray.emplace_back(objects[c].inlier_ratio, objects[c].surface_ratio,
-                               objects[c].curvature_ratio, objects[c].cylinder.angular_coverage);
+        rows, stray);
       for (auto& [id, r] : rows) {
         all.push_back(r);
         const std::string& note = objects_truth.at(id)[2];

@@ -36,13 +36,14 @@ validate(const TabletopRecognizerParameters& p)
   return s.str();
 }
 
+namespace {
+/** Counts the columns of \a points that are not in model.inliers (ascending) and satisfy
+ * \a test(i, d, t): d = point - base, t = its coordinate along the unit axis. */
+template <typename Test>
 std::size_t
-countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-               const Eigen::Matrix3Xf& normals, float distance, float max_angle)
+countOutliers(const CylinderModel& model, const Eigen::Matrix3Xf& points, Test test)
 {
   const Eigen::Vector3f a = model.axis.normalized();
-  const float h = (model.top - model.base).dot(a);
-  const float cos_max = std::cos(max_angle);
   std::size_t count = 0, next = 0;
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     while (next < model.inliers.size() && model.inliers[next] < i)
@@ -50,38 +51,40 @@ countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     if (next < model.inliers.size() && model.inliers[next] == i)
       continue;
     const Eigen::Vector3f d = points.col(i) - model.base;
-    const float t = d.dot(a);
-    const float radial = (d - t * a).norm();
-    const bool on_plane = std::abs(t) <= distance || std::abs(t - h) <= distance;
-    if (on_plane && radial <= model.radius + distance && std::abs(normals.col(i).dot(a)) >= cos_max)
-      ++count;
+    count += test(i, d, d.dot(a), a);
   }
   return count;
+}
+} // namespace
+
+std::size_t
+countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, float distance, float max_angle)
+{
+  const float cos_max = std::cos(max_angle);
+  const float h = (model.top - model.base).dot(model.axis.normalized());
+  return countOutliers(model, points, [&](Eigen::Index i, const Eigen::Vector3f& d, float t,
+                                          const Eigen::Vector3f& a) {
+    const bool on_plane = std::abs(t) <= distance || std::abs(t - h) <= distance;
+    return on_plane && (d - t * a).norm() <= model.radius + distance &&
+           std::abs(normals.col(i).dot(a)) >= cos_max;
+  });
 }
 
 std::size_t
 countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
                      const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio)
 {
-  const Eigen::Vector3f a = model.axis.normalized();
-  const float h = (model.top - model.base).dot(a);
   const float cos_max = std::cos(max_angle);
-  std::size_t count = 0, next = 0;
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    while (next < model.inliers.size() && model.inliers[next] < i)
-      ++next;
-    if (next < model.inliers.size() && model.inliers[next] == i)
-      continue;
-    const Eigen::Vector3f d = points.col(i) - model.base;
-    const float t = d.dot(a);
+  const float h = (model.top - model.base).dot(model.axis.normalized());
+  return countOutliers(model, points, [&](Eigen::Index i, const Eigen::Vector3f& d, float t,
+                                          const Eigen::Vector3f& a) {
     const Eigen::Vector3f radial = d - t * a;
     const float rho = radial.norm();
     if (t < 0.f || t > h || rho > model.radius || rho < inner_ratio * model.radius || !(rho > 0.f))
-      continue;
-    if (-normals.col(i).dot(radial) >= cos_max * rho) // points at the axis
-      ++count;
-  }
-  return count;
+      return false;
+    return -normals.col(i).dot(radial) >= cos_max * rho; // the normal points at the axis
+  });
 }
 
 pcl::Indices

@@ -58,8 +58,8 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     return false;
   }
   std::size_t finite = 0;
-  for (const auto i : *indices_)
-    finite += pcl::isFinite((*input_)[i]);
+  for (auto it = indices_->begin(); it != indices_->end() && finite < 3; ++it)
+    finite += pcl::isFinite((*input_)[*it]);
   if (finite < 3) {
     PCL_ERROR("[facyl::TabletopSegmentation::segment] The cloud has no finite points.\n");
     this->deinitCompute();
@@ -87,14 +87,20 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     if (fitPlane(pts, viewpoint, refined))
       plane_ = refined;
   }
+  // One pass: the table points, and the band of object candidates above it.
+  pcl::Indices band;
   for (const auto i : *indices_) {
     const auto& p = (*input_)[i];
-    if (pcl::isFinite(p) &&
-        std::abs(plane_.head<3>().dot(p.getVector3fMap()) + plane_[3]) < params_.plane_distance)
+    if (!pcl::isFinite(p))
+      continue;
+    const float h = plane_.head<3>().dot(p.getVector3fMap()) + plane_[3];
+    if (std::abs(h) < params_.plane_distance)
       table_indices_.indices.push_back(i);
+    if (h >= params_.min_height && h <= params_.max_height)
+      band.push_back(i);
   }
 
-  // Convex hull of the plane region, then the prism above it.
+  // Convex hull of the table.
   {
     Eigen::Vector3f centre = Eigen::Vector3f::Zero();
     for (const auto i : plane_points)
@@ -128,39 +134,24 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     this->deinitCompute();
     return false;
   }
-  pcl::IndicesPtr band(new pcl::Indices);
-  for (const auto i : *indices_) {
-    const auto& p = (*input_)[i];
-    if (!pcl::isFinite(p))
-      continue;
-    const float h = plane_.head<3>().dot(p.getVector3fMap()) + plane_[3];
-    if (h >= params_.min_height && h <= params_.max_height)
-      band->push_back(i);
-  }
   table_coefficients_.header = input_->header;
   table_coefficients_.values = {plane_[0], plane_[1], plane_[2], plane_[3]};
 
-  // The prism above the hull, as pcl::ExtractPolygonalPrismData computes it, with the polygon
-  // test done in table coordinates.
-  // Objects standing at the border of the visible table (cut by the image edge or hiding the
-  // table behind them) stick out of the hull: the test is per cluster, which keeps them whole.
-  std::vector<std::uint8_t> inside(input_->size(), 0);
-  for (const auto i : *band)
-    inside[i] =
-      pointInPolygon((to_table * (*input_)[i].getVector3fMap()).template head<2>(), polygon);
-  const pcl::Indices& objects = *band;
-
   std::vector<pcl::PointIndices> groups;
   if (organized)
-    clusterOrganized(objects, groups);
+    clusterOrganized(band, groups);
   else
-    clusterUnorganized(objects, groups);
+    clusterUnorganized(band, groups);
   for (auto& g : groups) {
     if (g.indices.size() < params_.min_cluster_size || g.indices.size() > params_.max_cluster_size)
       continue;
+    // The prism test of pcl::ExtractPolygonalPrismData (inside the hull, in table coordinates),
+    // applied per cluster: objects at the border of the visible table (cut by the image edge, or
+    // hiding the table behind them) stick out of the hull and are kept whole.
     std::size_t in_hull = 0;
     for (const auto i : g.indices)
-      in_hull += inside[i];
+      in_hull +=
+        pointInPolygon((to_table * (*input_)[i].getVector3fMap()).template head<2>(), polygon);
     if (static_cast<float>(in_hull) < params_.min_hull_share * static_cast<float>(g.indices.size()))
       continue;
     std::sort(g.indices.begin(), g.indices.end());
@@ -188,10 +179,12 @@ TabletopSegmentation<PointT>::findTableOrganized(pcl::Indices& plane_points)
 {
   const int step = params_.plane_step;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
-  std::vector<std::uint8_t> allowed(input_->size(), fake_indices_ ? 1 : 0);
-  if (!fake_indices_)
+  std::vector<std::uint8_t> allowed; // only when indices were given
+  if (!fake_indices_) {
+    allowed.assign(input_->size(), 0);
     for (const auto i : *indices_)
       allowed[i] = 1;
+  }
   pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
   small->width = static_cast<std::uint32_t>((w + step - 1) / step);
   small->height = static_cast<std::uint32_t>((h + step - 1) / step);
@@ -203,7 +196,7 @@ TabletopSegmentation<PointT>::findTableOrganized(pcl::Indices& plane_points)
       const std::size_t idx = static_cast<std::size_t>(v) * w + u;
       const auto& p = (*input_)[idx];
       auto& q = (*small)[k];
-      if (allowed[idx] && pcl::isFinite(p))
+      if ((fake_indices_ || allowed[idx]) && pcl::isFinite(p))
         q.getVector3fMap() = p.getVector3fMap();
       else
         q.x = q.y = q.z = nan;
