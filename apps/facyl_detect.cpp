@@ -147,6 +147,158 @@ struct Settings {
   bool many{false};
 };
 
+/** Camera for drawing: given, or estimated from an organized cloud (every 17th pixel). */
+facyl::PinholeCamera
+drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
+{
+  facyl::PinholeCamera camera = given;
+  if (camera.valid() || !cloud.isOrganized())
+    return camera;
+  const auto samples = static_cast<Eigen::Index>(cloud.size() / 17 + 1);
+  Eigen::Matrix3Xf pts(3, samples);
+  Eigen::Matrix2Xf px(2, samples);
+  Eigen::Index n = 0;
+  for (std::size_t i = 0; i < cloud.size(); i += 17)
+    if (pcl::isFinite(cloud[i])) {
+      pts.col(n) = cloud[i].getVector3fMap();
+      px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud.width),
+                                    static_cast<float>(i / cloud.width));
+    }
+  facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), static_cast<int>(cloud.width),
+                         static_cast<int>(cloud.height), camera);
+  return camera;
+}
+
+/** One object of the JSON output. */
+void
+writeObject(std::ostream& out, std::size_t id, const facyl::RecognizedObject& o)
+{
+  const auto& b = o.cluster.box;
+  const auto& e = o.evidence;
+  const auto optional = [](float v) {
+    return std::isfinite(v) ? facyl_cli::number(v) : std::string("null");
+  };
+  out << "{\"id\":" << id << ",\"centroid\":" << facyl_cli::vector(o.cluster.centroid)
+      << ",\"n_points\":" << o.cluster.indices.indices.size() << ",\"bbox\":";
+  if (b[0] < 0)
+    out << "null";
+  else
+    out << "[" << b[0] << "," << b[1] << "," << b[2] << "," << b[3] << "]";
+  out << ",\"p_cylinder\":" << optional(e.p_cylinder)
+      << ",\"inlier_ratio\":" << facyl_cli::number(e.inlier_ratio)
+      << ",\"surface_ratio\":" << facyl_cli::number(e.surface_ratio)
+      << ",\"curvature_ratio\":" << optional(e.curvature_ratio)
+      << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
+  if (e.fitted)
+    out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)
+        << ",\"axis\":" << facyl_cli::vector(o.cylinder.axis)
+        << ",\"radius\":" << facyl_cli::number(o.cylinder.radius)
+        << ",\"height\":" << facyl_cli::number(o.cylinder.height)
+        << ",\"angular_coverage\":" << facyl_cli::number(o.cylinder.angular_coverage) << "}";
+  else
+    out << "null";
+  out << "}";
+}
+
+/** The scene's JSON object, without its closing brace (a warning may follow). */
+void
+writeScene(std::ostream& out, const std::string& file, const Cloud& cloud,
+           const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
+           const std::vector<facyl::RecognizedObject>& objects,
+           const facyl::RecognitionTiming& t)
+{
+  const auto& tc = rec.getTableCoefficients().values;
+  out << "{\"file\":" << facyl_cli::quote(file) << ",\"organized\":"
+      << (cloud.isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":["
+      << facyl_cli::number(tc[0]) << "," << facyl_cli::number(tc[1]) << ","
+      << facyl_cli::number(tc[2]) << "," << facyl_cli::number(tc[3]) << "]},\"objects\":[";
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    out << (k ? "," : "");
+    writeObject(out, k, objects[k]);
+  }
+  out << "],\"timing_ms\":{\"segmentation\":" << facyl_cli::number(t.segmentation)
+      << ",\"classification\":" << facyl_cli::number(t.classification)
+      << ",\"fitting\":" << facyl_cli::number(t.fitting) << ",\"total\":"
+      << facyl_cli::number(t.total) << "}";
+}
+
+/** The overlay image: the RGB frame (or the points projected with the camera) with a box per
+ * object (green: cylinder, red: not) and the fitted cylinders' outlines.
+ * \return an empty string, or why there is no overlay. */
+std::string
+drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCamera& camera,
+            const std::vector<facyl::RecognizedObject>& objects)
+{
+  Canvas canvas;
+  if (cloud.isOrganized()) {
+    canvas.width = static_cast<int>(cloud.width);
+    canvas.height = static_cast<int>(cloud.height);
+    canvas.rgb.resize(3 * cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const auto& p = cloud[i];
+      canvas.rgb[3 * i] = p.r, canvas.rgb[3 * i + 1] = p.g, canvas.rgb[3 * i + 2] = p.b;
+    }
+  } else if (camera.valid()) {
+    canvas.width = camera.width;
+    canvas.height = camera.height;
+    canvas.rgb.assign(3 * static_cast<std::size_t>(camera.width) * camera.height, 0);
+    for (const auto& p : cloud)
+      if (pcl::isFinite(p) && p.z > 0.f) {
+        const Eigen::Vector2f q = camera.project(p.getVector3fMap());
+        canvas.put(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())),
+                   {p.r, p.g, p.b});
+      }
+  }
+  if (canvas.rgb.empty())
+    return "no overlay: an unorganized cloud needs --camera";
+  const std::array<unsigned char, 3> green{0, 230, 0}, red{230, 0, 0}, yellow{255, 230, 0};
+  for (const auto& o : objects) {
+    const auto& b = o.cluster.box;
+    if (b[0] >= 0) {
+      const auto& c = o.is_cylinder ? green : red;
+      const Eigen::Vector2f p00(b[0], b[1]), p10(b[2], b[1]), p11(b[2], b[3]), p01(b[0], b[3]);
+      canvas.line(p00, p10, c, 2), canvas.line(p10, p11, c, 2);
+      canvas.line(p11, p01, c, 2), canvas.line(p01, p00, c, 2);
+    }
+    if (o.is_cylinder && camera.valid())
+      drawCylinder(canvas, camera, o.cylinder, yellow);
+  }
+  pcl::io::saveRgbPNGFile(path, canvas.rgb.data(), canvas.width, canvas.height);
+  if (!std::filesystem::exists(path))
+    return "cannot write the overlay " + path;
+  return {};
+}
+
+/** Each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png) in \a dir.
+ * \return an empty string, or what could not be written. */
+std::string
+saveClusters(const std::string& dir, const std::string& file, const Cloud& cloud,
+             bool has_colour, const std::vector<facyl::RecognizedObject>& objects)
+{
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const auto& o = objects[k];
+    const std::string base =
+      (std::filesystem::path(dir) / (stemOf(file) + "_obj" + std::to_string(k))).string();
+    Cloud part;
+    pcl::copyPointCloud(cloud, o.cluster.indices, part);
+    if (pcl::io::savePCDFileBinaryCompressed(base + ".pcd", part) < 0)
+      return "cannot write " + base + ".pcd";
+    const auto& b = o.cluster.box;
+    if (b[0] >= 0 && cloud.isOrganized() && has_colour) {
+      const int w = b[2] - b[0] + 1, h = b[3] - b[1] + 1;
+      std::vector<unsigned char> crop(3 * static_cast<std::size_t>(w) * h);
+      for (int v = 0; v < h; ++v)
+        for (int u = 0; u < w; ++u) {
+          const auto& p = cloud.at(b[0] + u, b[1] + v);
+          unsigned char* q = &crop[3 * (static_cast<std::size_t>(v) * w + u)];
+          q[0] = p.r, q[1] = p.g, q[2] = p.b;
+        }
+      pcl::io::saveRgbPNGFile(base + ".png", crop.data(), w, h);
+    }
+  }
+  return {};
+}
+
 bool
 processScene(const std::string& file, const Settings& s, std::ostream& out)
 {
@@ -181,141 +333,100 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
   // Median over the repetitions, by total.
   std::sort(timings.begin(), timings.end(),
             [](const auto& a, const auto& b) { return a.total < b.total; });
-  const facyl::RecognitionTiming t = timings[timings.size() / 2];
+  writeScene(out, file, *cloud, rec, objects, timings[timings.size() / 2]);
 
-  // Camera for drawing: given, or estimated from an organized cloud (every 17th pixel).
-  facyl::PinholeCamera camera = s.camera;
-  if (!s.overlay.empty() && !camera.valid() && cloud->isOrganized()) {
-    const auto samples = static_cast<Eigen::Index>(cloud->size() / 17 + 1);
-    Eigen::Matrix3Xf pts(3, samples);
-    Eigen::Matrix2Xf px(2, samples);
-    Eigen::Index n = 0;
-    for (std::size_t i = 0; i < cloud->size(); i += 17)
-      if (pcl::isFinite((*cloud)[i])) {
-        pts.col(n) = (*cloud)[i].getVector3fMap();
-        px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud->width),
-                                      static_cast<float>(i / cloud->width));
-      }
-    facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), static_cast<int>(cloud->width),
-                           static_cast<int>(cloud->height), camera);
-  }
-
-  const auto& tc = rec.getTableCoefficients().values;
-  out << "{\"file\":" << facyl_cli::quote(file) << ",\"organized\":"
-      << (cloud->isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":["
-      << facyl_cli::number(tc[0]) << "," << facyl_cli::number(tc[1]) << ","
-      << facyl_cli::number(tc[2]) << "," << facyl_cli::number(tc[3]) << "]},\"objects\":[";
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    const auto& o = objects[k];
-    const auto& b = o.cluster.box;
-    out << (k ? "," : "") << "{\"id\":" << k << ",\"centroid\":"
-        << facyl_cli::vector(o.cluster.centroid) << ",\"n_points\":"
-        << o.cluster.indices.indices.size() << ",\"bbox\":";
-    if (b[0] < 0)
-      out << "null";
-    else
-      out << "[" << b[0] << "," << b[1] << "," << b[2] << "," << b[3] << "]";
-    out << ",\"p_cylinder\":"
-        << (std::isfinite(o.p_cylinder) ? facyl_cli::number(o.p_cylinder) : std::string("null"))
-        << ",\"inlier_ratio\":" << facyl_cli::number(o.inlier_ratio)
-        << ",\"surface_ratio\":" << facyl_cli::number(o.surface_ratio) << ",\"curvature_ratio\":"
-        << (std::isfinite(o.curvature_ratio) ? facyl_cli::number(o.curvature_ratio)
-                                             : std::string("null"))
-        << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
-    if (o.fitted)
-      out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)
-          << ",\"axis\":" << facyl_cli::vector(o.cylinder.axis)
-          << ",\"radius\":" << facyl_cli::number(o.cylinder.radius)
-          << ",\"height\":" << facyl_cli::number(o.cylinder.height)
-          << ",\"angular_coverage\":" << facyl_cli::number(o.cylinder.angular_coverage) << "}";
-    else
-      out << "null";
-    out << "}";
-  }
-  out << "],\"timing_ms\":{\"segmentation\":" << facyl_cli::number(t.segmentation)
-      << ",\"classification\":" << facyl_cli::number(t.classification)
-      << ",\"fitting\":" << facyl_cli::number(t.fitting) << ",\"total\":"
-      << facyl_cli::number(t.total) << "}";
-
-  bool ok = true;
   std::string warning;
   if (!s.overlay.empty()) {
-    std::string path = s.overlay;
-    if (s.many)
-      path = (std::filesystem::path(s.overlay) / (stemOf(file) + ".png")).string();
-    Canvas canvas;
-    if (cloud->isOrganized()) {
-      canvas.width = static_cast<int>(cloud->width);
-      canvas.height = static_cast<int>(cloud->height);
-      canvas.rgb.resize(3 * cloud->size());
-      for (std::size_t i = 0; i < cloud->size(); ++i) {
-        const auto& p = (*cloud)[i];
-        canvas.rgb[3 * i] = p.r, canvas.rgb[3 * i + 1] = p.g, canvas.rgb[3 * i + 2] = p.b;
-      }
-    } else if (camera.valid()) {
-      canvas.width = camera.width;
-      canvas.height = camera.height;
-      canvas.rgb.assign(3 * static_cast<std::size_t>(camera.width) * camera.height, 0);
-      for (const auto& p : *cloud)
-        if (pcl::isFinite(p) && p.z > 0.f) {
-          const Eigen::Vector2f q = camera.project(p.getVector3fMap());
-          canvas.put(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())),
-                     {p.r, p.g, p.b});
-        }
-    }
-    if (canvas.rgb.empty()) {
-      warning = "no overlay: an unorganized cloud needs --camera";
-      ok = false;
-    } else {
-      const std::array<unsigned char, 3> green{0, 230, 0}, red{230, 0, 0}, yellow{255, 230, 0};
-      for (const auto& o : objects) {
-        const auto& b = o.cluster.box;
-        if (b[0] >= 0) {
-          const auto& c = o.is_cylinder ? green : red;
-          const Eigen::Vector2f p00(b[0], b[1]), p10(b[2], b[1]), p11(b[2], b[3]), p01(b[0], b[3]);
-          canvas.line(p00, p10, c, 2), canvas.line(p10, p11, c, 2);
-          canvas.line(p11, p01, c, 2), canvas.line(p01, p00, c, 2);
-        }
-        if (o.is_cylinder && camera.valid())
-          drawCylinder(canvas, camera, o.cylinder, yellow);
-      }
-      if (pcl::io::saveRgbPNGFile(path, canvas.rgb.data(), canvas.width, canvas.height),
-          !std::filesystem::exists(path)) {
-        warning = "cannot write the overlay " + path;
-        ok = false;
-      }
-    }
+    const std::string path =
+      s.many ? (std::filesystem::path(s.overlay) / (stemOf(file) + ".png")).string() : s.overlay;
+    warning = drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects);
   }
   if (!s.clusters_dir.empty()) {
-    for (std::size_t k = 0; k < objects.size(); ++k) {
-      const auto& o = objects[k];
-      const std::string base =
-        (std::filesystem::path(s.clusters_dir) / (stemOf(file) + "_obj" + std::to_string(k))).string();
-      Cloud part;
-      pcl::copyPointCloud(*cloud, o.cluster.indices, part);
-      if (pcl::io::savePCDFileBinaryCompressed(base + ".pcd", part) < 0) {
-        warning = "cannot write " + base + ".pcd";
-        ok = false;
-        break;
-      }
-      const auto& b = o.cluster.box;
-      if (b[0] >= 0 && cloud->isOrganized() && has_colour) {
-        const int w = b[2] - b[0] + 1, h = b[3] - b[1] + 1;
-        std::vector<unsigned char> crop(3 * static_cast<std::size_t>(w) * h);
-        for (int v = 0; v < h; ++v)
-          for (int u = 0; u < w; ++u) {
-            const auto& p = cloud->at(b[0] + u, b[1] + v);
-            unsigned char* q = &crop[3 * (static_cast<std::size_t>(v) * w + u)];
-            q[0] = p.r, q[1] = p.g, q[2] = p.b;
-          }
-        pcl::io::saveRgbPNGFile(base + ".png", crop.data(), w, h);
-      }
-    }
+    const std::string w = saveClusters(s.clusters_dir, file, *cloud, has_colour, objects);
+    warning = warning.empty() ? w : warning;
   }
   if (!warning.empty())
     out << ",\"warning\":" << facyl_cli::quote(warning);
   out << "}" << std::endl;
-  return ok;
+  return warning.empty();
+}
+
+/** Settings from the command line. \throws std::invalid_argument for bad usage. */
+Settings
+parseSettings(int argc, char** argv, std::vector<std::string>& files)
+{
+  Settings s;
+  const facyl_cli::Arguments args(
+    argc, argv,
+    {"--min-inlier-ratio", "--score", "--max-curvature-ratio", "--prior", "--radius-limits",
+     "--orientations", "--max-fit-points", "--neighbours", "--seed", "--plane-distance",
+     "--height-limits", "--cluster-tolerance", "--cluster-size", "--camera", "--overlay",
+     "--save-clusters", "--repeat", "--min-coverage"},
+    {"--no-retry", "--retry-inside", "--any-normal-sign"});
+  files = args.positional();
+  if (files.empty())
+    throw std::invalid_argument("give at least one scene (see -h)");
+  auto& p = s.params;
+  auto& d = p.decision;
+  d.min_score = static_cast<float>(args.number("--min-inlier-ratio", d.min_score));
+  const std::string score = args.text("--score", "surface");
+  if (score != "surface" && score != "inlier")
+    throw std::invalid_argument("--score must be surface or inlier");
+  d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
+                               : facyl::CylinderDecision::Score::InlierRatio;
+  d.max_curvature_ratio =
+    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
+  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
+  p.retry_upright_lying = !args.has("--no-retry");
+  p.retry_any_normal_sign = args.has("--retry-inside");
+  p.hough.outward_normals = !args.has("--any-normal-sign");
+  if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
+    throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
+  const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
+  p.hough.radius_min = static_cast<float>(radii.first);
+  p.hough.radius_max = static_cast<float>(radii.second);
+  p.orientations = static_cast<std::size_t>(args.integer("--orientations", 450, 10));
+  p.max_fit_points = static_cast<std::size_t>(args.integer("--max-fit-points", 1200, 50));
+  p.neighbours = static_cast<int>(args.integer("--neighbours", 16, 5));
+  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
+  auto& g = p.segmentation;
+  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance));
+  const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
+  g.min_height = static_cast<float>(heights.first);
+  g.max_height = static_cast<float>(heights.second);
+  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance));
+  const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
+                                static_cast<double>(g.max_cluster_size));
+  if (!(sizes.first >= 1 && sizes.second >= sizes.first))
+    throw std::invalid_argument("--cluster-size: expected 1 <= A <= B");
+  g.min_cluster_size = static_cast<std::size_t>(sizes.first);
+  g.max_cluster_size = static_cast<std::size_t>(sizes.second);
+  if (args.has("--camera")) {
+    std::istringstream in(args.text("--camera", ""));
+    char c1 = 0, c2 = 0, c3 = 0;
+    facyl::PinholeCamera& cam = s.camera;
+    if (!(in >> cam.fx >> c1 >> cam.fy >> c2 >> cam.cx >> c3 >> cam.cy) || c1 != ',' ||
+        c2 != ',' || c3 != ',' || !(cam.fx > 0.f) || !(cam.fy > 0.f))
+      throw std::invalid_argument("--camera: expected fx,fy,cx,cy with fx, fy > 0");
+    cam.width = static_cast<int>(std::ceil(2.f * cam.cx + 1.f));
+    cam.height = static_cast<int>(std::ceil(2.f * cam.cy + 1.f));
+  }
+  s.overlay = args.text("--overlay", "");
+  s.clusters_dir = args.text("--save-clusters", "");
+  s.repeat = static_cast<int>(args.integer("--repeat", 1, 1));
+  s.many = files.size() > 1;
+  const std::string why = facyl::validate(p);
+  if (!why.empty())
+    throw std::invalid_argument(why);
+  if (!s.many && !s.overlay.empty()) {
+    const auto parent = std::filesystem::path(s.overlay).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent))
+      throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
+  }
+  for (const std::string& dir : {s.clusters_dir, s.many ? s.overlay : std::string()})
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+      throw std::invalid_argument("folder '" + dir + "' does not exist");
+  return s;
 }
 
 } // namespace
@@ -330,76 +441,7 @@ main(int argc, char** argv)
   Settings s;
   std::vector<std::string> files;
   try {
-    const facyl_cli::Arguments args(
-      argc, argv,
-      {"--min-inlier-ratio", "--score", "--max-curvature-ratio", "--prior", "--radius-limits", "--orientations", "--max-fit-points",
-       "--neighbours", "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
-       "--cluster-size", "--camera", "--overlay", "--save-clusters", "--repeat",
-       "--min-coverage"},
-      {"--no-retry", "--retry-inside", "--any-normal-sign"});
-    files = args.positional();
-    if (files.empty())
-      throw std::invalid_argument("give at least one scene (see -h)");
-    auto& p = s.params;
-    p.min_inlier_ratio = static_cast<float>(args.number("--min-inlier-ratio", p.min_inlier_ratio));
-    const std::string score = args.text("--score", "surface");
-    if (score != "surface" && score != "inlier")
-      throw std::invalid_argument("--score must be surface or inlier");
-    p.score = score == "surface" ? facyl::TabletopRecognizerParameters::Score::SurfaceRatio
-                                 : facyl::TabletopRecognizerParameters::Score::InlierRatio;
-    p.max_curvature_ratio =
-      static_cast<float>(args.number("--max-curvature-ratio", p.max_curvature_ratio));
-    p.retry_upright_lying = !args.has("--no-retry");
-    p.retry_any_normal_sign = args.has("--retry-inside");
-    p.hough.outward_normals = !args.has("--any-normal-sign");
-    p.min_angular_coverage =
-      static_cast<float>(args.number("--min-coverage", p.min_angular_coverage));
-    if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
-      throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
-    const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
-    p.hough.radius_min = static_cast<float>(radii.first);
-    p.hough.radius_max = static_cast<float>(radii.second);
-    p.orientations = static_cast<std::size_t>(args.integer("--orientations", 450, 10));
-    p.max_fit_points = static_cast<std::size_t>(args.integer("--max-fit-points", 1200, 50));
-    p.neighbours = static_cast<int>(args.integer("--neighbours", 16, 5));
-    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
-    auto& g = p.segmentation;
-    g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance));
-    const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
-    g.min_height = static_cast<float>(heights.first);
-    g.max_height = static_cast<float>(heights.second);
-    g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance));
-    const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
-                                  static_cast<double>(g.max_cluster_size));
-    if (!(sizes.first >= 1 && sizes.second >= sizes.first))
-      throw std::invalid_argument("--cluster-size: expected 1 <= A <= B");
-    g.min_cluster_size = static_cast<std::size_t>(sizes.first);
-    g.max_cluster_size = static_cast<std::size_t>(sizes.second);
-    if (args.has("--camera")) {
-      std::istringstream in(args.text("--camera", ""));
-      char c1 = 0, c2 = 0, c3 = 0;
-      facyl::PinholeCamera& cam = s.camera;
-      if (!(in >> cam.fx >> c1 >> cam.fy >> c2 >> cam.cx >> c3 >> cam.cy) || c1 != ',' ||
-          c2 != ',' || c3 != ',' || !(cam.fx > 0.f) || !(cam.fy > 0.f))
-        throw std::invalid_argument("--camera: expected fx,fy,cx,cy with fx, fy > 0");
-      cam.width = static_cast<int>(std::ceil(2.f * cam.cx + 1.f));
-      cam.height = static_cast<int>(std::ceil(2.f * cam.cy + 1.f));
-    }
-    s.overlay = args.text("--overlay", "");
-    s.clusters_dir = args.text("--save-clusters", "");
-    s.repeat = static_cast<int>(args.integer("--repeat", 1, 1));
-    s.many = files.size() > 1;
-    const std::string why = facyl::validate(p);
-    if (!why.empty())
-      throw std::invalid_argument(why);
-    if (!s.many && !s.overlay.empty()) {
-      const auto parent = std::filesystem::path(s.overlay).parent_path();
-      if (!parent.empty() && !std::filesystem::is_directory(parent))
-        throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
-    }
-    for (const std::string& dir : {s.clusters_dir, s.many ? s.overlay : std::string()})
-      if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw std::invalid_argument("folder '" + dir + "' does not exist");
+    s = parseSettings(argc, argv, files);
   }
   catch (const std::exception& e) {
     std::fprintf(stderr, "facyl_detect: %s\n", e.what());

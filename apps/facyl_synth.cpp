@@ -23,15 +23,21 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [options] PREFIX\n"
-    "Renders random tabletop scenes (pinhole 640x480 RGB-D camera, Kinect-like depth noise,\n"
-    "quantisation and missing pixels) and writes PREFIX.pcd, PREFIX_rgb.png, PREFIX_ids.png,\n"
-    "PREFIX_class.png and PREFIX.json; with --count N > 1, PREFIX_0000 ... PREFIX_{N-1}.\n"
+    "Renders random tabletop scenes (pinhole 640x480 RGB-D camera with a depth sensor model)\n"
+    "and writes PREFIX.pcd, PREFIX_rgb.png, PREFIX_ids.png, PREFIX_class.png and PREFIX.json;\n"
+    "with --count N > 1, PREFIX_0000 ... PREFIX_{N-1}.\n"
+    "  --layout L         spread (default: objects apart on a large table) | cluttered\n"
+    "                     (touching, stacked and leaning objects; small, round or large\n"
+    "                     tables with legs over a floor, sometimes a wall; wider camera poses)\n"
+    "  --sensor S         kinect (default: structured light, disparity quantised to 1/8 px)\n"
+    "                     | stereo (RealSense D4xx-like: speckled holes, fattened edges,\n"
+    "                     colour/depth misregistration)\n"
     "  --seed S           seed of the first scene (default 0); scene k uses S + k\n"
     "  --count N          number of scenes (default 1)\n"
-    "  --objects MIN,MAX  objects per scene (default 3,10)\n"
+    "  --objects MIN,MAX  objects per scene (default 3,10; cluttered 4,10)\n"
     "  --cylinder-share P probability that an object is a cylinder (default 0.5)\n"
     "  --lying-share P    probability that a can or tube lies (default 0.25)\n"
-    "  --noise K          axial depth noise sigma = K z^2 (default 0.0015)\n"
+    "  --noise K          axial depth noise sigma = K z^2 (default: the sensor's)\n"
     "  --no-quantisation  no disparity quantisation\n"
     "Class codes in PREFIX_class.png: 0 background, 1 table, 2 cylinder, 3 box, 4 sphere,\n"
     "5 cone, 6 bowl.\n",
@@ -52,14 +58,22 @@ main(int argc, char** argv)
   try {
     const facyl_cli::Arguments args(argc, argv,
                                     {"--seed", "--count", "--objects", "--cylinder-share",
-                                     "--lying-share", "--noise"},
+                                     "--lying-share", "--noise", "--layout", "--sensor"},
                                     {"--no-quantisation"});
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
     prefix = args.positional()[0];
+    const std::string layout = args.text("--layout", "spread");
+    if (layout == "cluttered")
+      p = facyl::clutteredSceneParameters();
+    else if (layout != "spread")
+      throw std::invalid_argument("--layout must be spread or cluttered");
+    if (!facyl::parseSensorPreset(args.text("--sensor", "kinect"), p.sensor, p.camera))
+      throw std::invalid_argument("--sensor must be kinect or stereo");
     p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
     count = static_cast<std::size_t>(args.integer("--count", 1, 1));
-    const std::string objects = args.text("--objects", "3,10");
+    const std::string objects = args.text(
+      "--objects", std::to_string(p.min_objects) + "," + std::to_string(p.max_objects));
     unsigned lo = 0, hi = 0;
     char comma = 0, extra = 0;
     if (std::sscanf(objects.c_str(), "%u%c%u%c", &lo, &comma, &hi, &extra) != 3 || comma != ',')

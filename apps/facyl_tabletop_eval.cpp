@@ -1,14 +1,17 @@
 /*
  * facyl_tabletop_eval: measures TabletopCylinderRecognizer against ground truth.
  *   --sim N       N simulated scenes (facyl_synth's renderer, seeds S..S+N-1)
- *   --mosd DIR    the labelled mOSD scenes learn33..44 (DIR/labels.csv)
+ *   --mosd DIR    the mOSD learn scenes: segmentation of learn0..44 by scene group, and
+ *                 detection on the labelled learn33..44 (DIR/labels.csv)
  * Prints figures (markdown) and, with --csv FILE, one row per object.
  */
 #include "cli.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/segmentation_score.h>
 #include <facyl/simulation/tabletop_scene.h>
 
+#include <pcl/common/point_tests.h>
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
@@ -19,25 +22,28 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <tuple>
 
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+using Recognizer = facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>;
 
-/** One evaluated object (a ground-truth object, or a cluster matching none). */
+/** One evaluated ground-truth object. */
 struct Row {
   std::string scene, kind, pose;
   int object{-1};
-  std::size_t cluster{0};   ///< its best (largest) cluster, when found
   bool positive{false};     ///< ground truth: a cylinder
-  bool found{false};        ///< a cluster maps to it
-  std::size_t clusters{0};  ///< clusters mapping to it
-  bool merged{false};       ///< its best cluster holds >= 20% of another object's points too
-  float inlier_ratio{0.f}, surface_ratio{0.f}, curvature_ratio{NAN}, coverage{0.f}; ///< best cluster
-  bool fitted{false};
+  bool touching{false};     ///< ground truth: in contact with another object
+  bool found{false};        ///< an output object maps to it (most of its points are this one's)
+  std::size_t pieces{0};    ///< output objects mapping to it
+  facyl::SegmentOutcome segment; ///< how the segmentation recovered it
+  facyl::CylinderEvidence evidence; ///< of its best (largest) output object
   float radius{NAN}, true_radius{NAN}, axis_error_deg{NAN};
+  std::size_t best{0};      ///< index of that output object
 };
+
+/** Evidence of an output object that matches no ground-truth object. */
+using Stray = facyl::CylinderEvidence;
 
 double
 median(std::vector<double> v)
@@ -56,23 +62,29 @@ percentile(std::vector<double> v, double q)
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
 }
 
-/** (inlier ratio, surface ratio, curvature ratio, angular coverage) of a fitted cluster that
- * matches no object. */
-using Stray = std::tuple<float, float, float, float>;
-
-/** Maps each cluster to the label most of its points carry; fills the rows' cluster fields and
- * adds the fitted clusters that match no row to \a stray. */
+/** Per point: object id (> 0) of the objects scored, 0 for the rest, -1 without depth. */
 template <typename LabelOf>
+std::vector<int>
+truthVector(const Cloud& cloud, LabelOf label_of)
+{
+  std::vector<int> truth(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    truth[i] = pcl::isFinite(cloud[i]) ? label_of(i) : -1;
+  return truth;
+}
+
+/** Maps each output object to the ground-truth label most of its points carry and fills the
+ * rows' detection fields; output objects matching no row go to \a stray. */
 void
-matchClusters(const std::vector<facyl::RecognizedObject>& objects, LabelOf label_of,
-              std::map<int, Row>& rows, std::vector<Stray>& stray)
+matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vector<int>& truth,
+             std::map<int, Row>& rows, std::vector<Stray>& stray)
 {
   std::map<int, std::size_t> best_size;
   for (std::size_t k = 0; k < objects.size(); ++k) {
     const auto& o = objects[k];
     std::map<int, std::size_t> votes;
     for (const auto i : o.cluster.indices.indices)
-      ++votes[label_of(i)];
+      ++votes[truth[static_cast<std::size_t>(i)]];
     int label = -1;
     std::size_t most = 0;
     for (const auto& [l, c] : votes)
@@ -80,69 +92,96 @@ matchClusters(const std::vector<facyl::RecognizedObject>& objects, LabelOf label
         label = l, most = c;
     auto it = rows.find(label);
     if (it == rows.end()) {
-      if (o.fitted)
-        stray.emplace_back(o.inlier_ratio, o.surface_ratio, o.curvature_ratio,
-                           o.cylinder.angular_coverage);
+      if (o.evidence.fitted)
+        stray.push_back(o.evidence);
       continue;
     }
     Row& r = it->second;
     r.found = true;
-    ++r.clusters;
+    ++r.pieces;
     if (o.cluster.indices.indices.size() < best_size[label])
       continue;
     best_size[label] = o.cluster.indices.indices.size();
-    r.cluster = k;
-    r.inlier_ratio = o.inlier_ratio;
-    r.surface_ratio = o.surface_ratio;
-    r.curvature_ratio = o.curvature_ratio;
-    r.coverage = o.fitted ? o.cylinder.angular_coverage : 0.f;
-    r.fitted = o.fitted;
-    r.radius = o.fitted ? o.cylinder.radius : NAN;
-    r.merged = false;
-    for (const auto& [l, c] : votes)
-      if (l != label && rows.count(l) && c >= 0.2 * static_cast<double>(most))
-        r.merged = true;
+    r.best = k;
+    r.evidence = o.evidence;
+    r.radius = o.evidence.fitted ? o.cylinder.radius : NAN;
   }
 }
 
-struct Decision {
-  bool use_surface;
-  float threshold;
-  float max_curvature_ratio{1.f};
-  float min_coverage{0.f};
-  bool
-  operator()(float inlier, float surface, bool fitted, float curvature_ratio, float coverage) const
-  {
-    return fitted && (use_surface ? surface : inlier) >= threshold &&
-           !(curvature_ratio > max_curvature_ratio) && coverage >= min_coverage;
-  }
-};
-
-/** Precision and recall over rows (ground-truth objects) and false clusters. */
+/** Segmentation outcome of every row (output objects as segments). */
 void
-report(const std::vector<Row>& rows, const std::vector<Stray>& stray,
-       const std::string& title, float max_kr, float min_coverage)
+scoreRows(const std::vector<facyl::RecognizedObject>& objects, const std::vector<int>& truth,
+          std::map<int, Row>& rows)
+{
+  std::vector<pcl::PointIndices> segments;
+  for (const auto& o : objects)
+    segments.push_back(o.cluster.indices);
+  for (const auto& outcome : facyl::scoreSegments(truth, segments, 1)) {
+    const auto it = rows.find(outcome.object);
+    if (it != rows.end())
+      it->second.segment = outcome;
+  }
+}
+
+bool
+called(const Row& r, const facyl::CylinderDecision& d)
+{
+  return r.found && facyl::acceptCylinder(r.evidence, d);
+}
+
+/** Precision and recall over rows (ground-truth objects) and stray objects, for both scores
+ * at several thresholds (the other settings of \a base). */
+void
+reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
+                const std::string& title, const facyl::CylinderDecision& base)
 {
   std::printf("\n%s\n\n| score | threshold | TP | FP | FN | precision | recall |\n"
               "|---|---|---|---|---|---|---|\n",
               title.c_str());
-  for (bool surface : {false, true})
+  for (const auto score :
+       {facyl::CylinderDecision::Score::InlierRatio, facyl::CylinderDecision::Score::SurfaceRatio})
     for (float t : {0.3f, 0.4f, 0.5f, 0.6f, 0.7f}) {
-      const Decision d{surface, t, max_kr, min_coverage};
+      facyl::CylinderDecision d = base;
+      d.score = score;
+      d.min_score = t;
       std::size_t tp = 0, fp = 0, fn = 0;
       for (const Row& r : rows) {
-        const bool yes = r.found && d(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage);
+        const bool yes = called(r, d);
         tp += r.positive && yes;
         fn += r.positive && !yes;
         fp += !r.positive && yes;
       }
-      for (const auto& [inlier, surface_ratio, kr, coverage] : stray)
-        fp += d(inlier, surface_ratio, true, kr, coverage);
-      std::printf("| %s | %.1f | %zu | %zu | %zu | %.3f | %.3f |\n",
-                  surface ? "surface ratio" : "inlier ratio (eq. 4)", t, tp, fp, fn,
+      for (const Stray& e : stray)
+        fp += facyl::acceptCylinder(e, d);
+      const bool is_default = score == base.score && std::abs(t - base.min_score) < 1e-6f;
+      std::printf("| %s | %.1f%s | %zu | %zu | %zu | %.3f | %.3f |\n",
+                  score == facyl::CylinderDecision::Score::SurfaceRatio ? "surface ratio"
+                                                                         : "inlier ratio (eq. 4)",
+                  t, is_default ? " (default)" : "", tp, fp, fn,
                   tp + fp ? static_cast<double>(tp) / static_cast<double>(tp + fp) : NAN,
                   tp + fn ? static_cast<double>(tp) / static_cast<double>(tp + fn) : NAN);
     }
+}
+
+/** Segmentation totals of rows selected by \a keep, as a table line. */
+template <typename Keep>
+void
+segmentationLine(const std::vector<Row>& rows, const std::string& name, Keep keep)
+{
+  facyl::SegmentTotals t;
+  for (const Row& r : rows)
+    if (keep(r))
+      t.add(r.segment);
+  std::printf("| %s | %zu | %zu (%.1f%%) | %zu | %zu |\n", name.c_str(), t.objects, t.recovered,
+              100.0 * t.recoveredShare(), t.merged, t.split);
+}
+
+void
+segmentationHeader(const std::string& title)
+{
+  std::printf("\n%s\n\n| objects | n | recovered (IoU >= 0.5) | merged | split |\n"
+              "|---|---|---|---|---|\n",
+              title.c_str());
 }
 
 void
@@ -152,24 +191,441 @@ timingReport(const std::vector<facyl::RecognitionTiming>& t)
   for (const auto& x : t)
     s.push_back(x.segmentation), c.push_back(x.classification), f.push_back(x.fitting),
       total.push_back(x.total);
-  std::printf("\nTiming per frame (ms, median over %zu frames; first frame excluded): "
-              "segmentation %.2f, classification %.2f, fitting %.2f, total %.2f (p90 %.2f)\n",
+  std::printf("\nTiming per frame (ms, median over %zu frames): segmentation %.2f, "
+              "classification %.2f, fitting %.2f, total %.2f (p90 %.2f)\n",
               t.size(), median(s), median(c), median(f), median(total), percentile(total, 0.9));
+}
+
+struct Options {
+  std::size_t sim{0};
+  std::uint64_t seed{1000};
+  bool cluttered{false};
+  std::string sensor{"kinect"};
+  std::string mosd, csv;
+  facyl::TabletopRecognizerParameters params;
+};
+
+class CsvWriter {
+public:
+  explicit CsvWriter(const std::string& path)
+  {
+    if (path.empty())
+      return;
+    out_.open(path);
+    out_ << "set,scene,object,kind,pose,positive,touching,found,pieces,recovered,iou,merged,"
+            "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,radius,"
+            "true_radius,axis_error_deg\n";
+  }
+  void
+  write(const std::string& set, const std::vector<Row>& rows)
+  {
+    if (!out_.is_open())
+      return;
+    for (const Row& r : rows) {
+      const auto& e = r.evidence;
+      out_ << set << "," << r.scene << "," << r.object << "," << r.kind << "," << r.pose << ","
+           << r.positive << "," << r.touching << "," << r.found << "," << r.pieces << ","
+           << r.segment.recovered << "," << r.segment.best_iou << "," << r.segment.merged << ","
+           << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << ","
+           << e.surface_ratio << "," << e.curvature_ratio << "," << e.angular_coverage << ","
+           << r.radius << "," << r.true_radius << "," << r.axis_error_deg << "\n";
+    }
+  }
+
+private:
+  std::ofstream out_;
+};
+
+// ---------------------------------------------------------------- simulated scenes
+
+/** Rows of the objects of a simulated scene with enough visible pixels to be a cluster. */
+std::map<int, Row>
+simulatedRows(const facyl::RenderedScene& scene, std::uint64_t seed, std::size_t min_pixels)
+{
+  std::map<int, Row> rows;
+  for (std::size_t i = 0; i < scene.scene.objects.size(); ++i) {
+    const auto& o = scene.scene.objects[i];
+    if (scene.visible_pixels[i] < min_pixels)
+      continue;
+    Row r;
+    r.scene = std::to_string(seed);
+    r.object = static_cast<int>(i + 2);
+    r.kind = o.kind;
+    r.pose = o.lying ? "lying" : (o.leaning ? "leaning" : (o.support >= 0 ? "stacked" : "upright"));
+    r.positive = o.cls == facyl::SceneClass::Cylinder;
+    r.touching = !o.touches.empty();
+    if (r.positive)
+      r.true_radius = o.radius;
+    rows[r.object] = r;
+  }
+  return rows;
+}
+
+void
+reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
+                const Options& opt, std::size_t failures, std::size_t wrong_plane)
+{
+  std::size_t cylinders = 0, touching = 0;
+  for (const Row& r : all)
+    cylinders += r.positive, touching += r.touching;
+  std::printf("## Simulated scenes: %zu (%s layout, %s sensor, seeds %llu..%llu), %zu objects "
+              "with >= %zu visible pixels (%zu cylinders, %zu touching another object); "
+              "%zu scenes failed (no table), %zu with a wrong support plane\n",
+              opt.sim, opt.cluttered ? "cluttered" : "spread", opt.sensor.c_str(),
+              static_cast<unsigned long long>(opt.seed),
+              static_cast<unsigned long long>(opt.seed + opt.sim - 1), all.size(),
+              opt.params.segmentation.min_cluster_size, cylinders, touching, failures,
+              wrong_plane);
+  segmentationHeader("Segmentation (output objects as segments):");
+  segmentationLine(all, "all", [](const Row&) { return true; });
+  segmentationLine(all, "touching another", [](const Row& r) { return r.touching; });
+  segmentationLine(all, "free-standing", [](const Row& r) { return !r.touching; });
+  segmentationLine(all, "cylinders", [](const Row& r) { return r.positive; });
+  reportDetection(all, stray, "Detection (a ground-truth object is called a cylinder when its "
+                              "largest output object is; an output object matching no object "
+                              "and called a cylinder is a false positive):",
+                  opt.params.decision);
+  const auto& d = opt.params.decision;
+  std::map<std::string, std::pair<std::size_t, std::size_t>> fp_by; // kind: (called, total)
+  for (const Row& r : all)
+    if (!r.positive) {
+      auto& c = fp_by[r.kind];
+      ++c.second;
+      c.first += called(r, d);
+    }
+  std::printf("\nDistractors called cylinders (default decision):");
+  for (const auto& [k, c] : fp_by)
+    std::printf(" %s %zu/%zu;", k.c_str(), c.first, c.second);
+  std::printf("\n");
+  std::vector<double> radius_rel, axis;
+  std::map<std::string, std::vector<double>> axis_by, radius_by;
+  for (const Row& r : all)
+    if (r.positive && called(r, d)) {
+      const double rel = std::abs(r.radius - r.true_radius) / r.true_radius * 100.0;
+      radius_rel.push_back(rel);
+      axis.push_back(r.axis_error_deg);
+      axis_by[r.kind + " " + r.pose].push_back(r.axis_error_deg);
+      radius_by[r.kind + " " + r.pose].push_back(rel);
+    }
+  std::printf("\nDetected cylinders (default decision): %zu; radius error median %.2f%%, p90 "
+              "%.2f%%; axis error median %.2f deg, p90 %.2f deg\n",
+              radius_rel.size(), median(radius_rel), percentile(radius_rel, 0.9), median(axis),
+              percentile(axis, 0.9));
+  for (const auto& [k, v] : axis_by)
+    std::printf("- %s: %zu, axis median %.2f deg (p90 %.2f), radius median %.2f%% (p90 %.2f%%)\n",
+                k.c_str(), v.size(), median(v), percentile(v, 0.9), median(radius_by[k]),
+                percentile(radius_by[k], 0.9));
+}
+
+int
+evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
+{
+  std::vector<Row> all;
+  std::vector<Stray> stray;
+  std::vector<facyl::RecognitionTiming> timing;
+  std::size_t failures = 0, wrong_plane = 0;
+  for (std::size_t k = 0; k < opt.sim; ++k) {
+    facyl::TabletopSceneParameters sp =
+      opt.cluttered ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
+    facyl::parseSensorPreset(opt.sensor, sp.sensor, sp.camera);
+    sp.seed = opt.seed + k;
+    const facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
+    Cloud::Ptr cloud(new Cloud(scene.cloud));
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    std::map<int, Row> rows =
+      simulatedRows(scene, sp.seed, opt.params.segmentation.min_cluster_size);
+    if (!rec.recognize(objects)) {
+      ++failures;
+      for (auto& [id, r] : rows)
+        all.push_back(r);
+      continue;
+    }
+    if (k > 0) // the first frame pays for the buffers
+      timing.push_back(rec.getTiming());
+    const auto& c = rec.getTableCoefficients().values;
+    if (Eigen::Vector3f(c[0], c[1], c[2]).dot(scene.table_plane.head<3>()) < std::cos(0.1f) ||
+        std::abs(c[3] - scene.table_plane[3]) > 0.03f)
+      ++wrong_plane;
+    const std::vector<int> truth = truthVector(*cloud, [&](std::size_t i) {
+      return scene.object_id[i] >= 2 ? static_cast<int>(scene.object_id[i]) : 0;
+    });
+    matchObjects(objects, truth, rows, stray);
+    scoreRows(objects, truth, rows);
+    for (auto& [id, r] : rows) {
+      if (r.positive && r.evidence.fitted) {
+        const facyl::CylinderTruth t =
+          facyl::cylinderTruth(scene.scene, scene.scene.objects[static_cast<std::size_t>(id - 2)]);
+        r.axis_error_deg =
+          facyl::axisAngle(objects[r.best].cylinder.axis, t.axis) * 180.f / static_cast<float>(M_PI);
+      }
+      all.push_back(r);
+    }
+  }
+  csv.write(opt.cluttered ? "sim-cluttered-" + opt.sensor : "sim-" + opt.sensor, all);
+  reportSimulated(all, stray, opt, failures, wrong_plane);
+  timingReport(timing);
+  return 0;
+}
+
+// ---------------------------------------------------------------- mOSD
+
+/** mOSD label field: object id = label / 10 for labels >= 20, 0 for the table (1..9). */
+int
+mosdObject(std::uint32_t label)
+{
+  return label >= 20 ? static_cast<int>(label / 10) : 0;
+}
+
+bool
+loadMosd(const std::string& file, pcl::PointCloud<pcl::PointXYZRGBL>& labelled, Cloud& cloud)
+{
+  if (pcl::io::loadPCDFile(file, labelled) < 0)
+    return false;
+  pcl::copyPointCloud(labelled, cloud);
+  return true;
+}
+
+/** scene -> object -> (class, pose, notes), from labels.csv. */
+std::map<std::string, std::map<int, std::array<std::string, 3>>>
+readMosdLabels(std::istream& in)
+{
+  std::map<std::string, std::map<int, std::array<std::string, 3>>> truth;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::string cur;
+    bool quoted = false;
+    for (char ch : line) {
+      if (ch == '"')
+        quoted = !quoted;
+      else if (ch == ',' && !quoted)
+        f.push_back(cur), cur.clear();
+      else
+        cur += ch;
+    }
+    f.push_back(cur);
+    if (f.size() >= 9)
+      truth[f[1]][std::stoi(f[2])] = {f[3], f[4], f[8]};
+  }
+  return truth;
+}
+
+/** Segmentation of learn0..44, by the dataset's scene groups. */
+int
+evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
+{
+  const std::pair<int, int> groups[] = {{0, 16}, {17, 24}, {25, 32}, {33, 44}};
+  const char* names[] = {"boxes (learn0-16)", "stacked boxes (learn17-24)",
+                         "occluded objects (learn25-32)", "cylindric objects (learn33-44)"};
+  std::vector<std::vector<Row>> by_group(4);
+  std::vector<facyl::RecognitionTiming> timing;
+  int status = 0;
+  for (int g = 0; g < 4; ++g)
+    for (int k = groups[g].first; k <= groups[g].second; ++k) {
+      const std::string name = "learn" + std::to_string(k);
+      const std::string file = (std::filesystem::path(opt.mosd) / (name + ".pcd")).string();
+      if (!std::filesystem::exists(file))
+        continue;
+      pcl::PointCloud<pcl::PointXYZRGBL> labelled;
+      Cloud::Ptr cloud(new Cloud);
+      if (!loadMosd(file, labelled, *cloud)) {
+        std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s\n", file.c_str());
+        status = 1;
+        continue;
+      }
+      const std::vector<int> truth = truthVector(
+        *cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
+      std::map<int, Row> rows;
+      for (const auto& outcome :
+           facyl::scoreSegments(truth, {}, opt.params.segmentation.min_cluster_size)) {
+        Row r;
+        r.scene = name;
+        r.object = outcome.object;
+        rows[r.object] = r;
+      }
+      rec.setInputCloud(cloud);
+      std::vector<facyl::RecognizedObject> objects;
+      // Run twice: the second run gives the steady-state timing of a stream.
+      if (rec.recognize(objects) && rec.recognize(objects))
+        timing.push_back(rec.getTiming());
+      else
+        std::fprintf(stderr, "facyl_tabletop_eval: %s: no table\n", name.c_str());
+      scoreRows(objects, truth, rows);
+      for (auto& [id, r] : rows)
+        by_group[static_cast<std::size_t>(g)].push_back(r);
+    }
+  segmentationHeader("## mOSD learn scenes: segmentation against the dataset's labels (objects "
+                     "with >= " +
+                     std::to_string(opt.params.segmentation.min_cluster_size) + " points)");
+  std::vector<Row> all;
+  for (int g = 0; g < 4; ++g) {
+    segmentationLine(by_group[g], names[g], [](const Row&) { return true; });
+    all.insert(all.end(), by_group[g].begin(), by_group[g].end());
+  }
+  segmentationLine(all, "all", [](const Row&) { return true; });
+  csv.write("mosd-segmentation", all);
+  timingReport(timing);
+  return status;
+}
+
+/** Detection on the labelled cylinder scenes learn33..44. */
+int
+evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
+{
+  std::ifstream labels_file(std::filesystem::path(opt.mosd) / "labels.csv");
+  if (!labels_file) {
+    std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s/labels.csv\n", opt.mosd.c_str());
+    return 1;
+  }
+  const auto truth_table = readMosdLabels(labels_file);
+  std::vector<Row> all;
+  std::vector<Stray> stray;
+  std::map<std::string, std::vector<std::pair<std::string, float>>> radii; // by note
+  int status = 0;
+  const auto& d = opt.params.decision;
+  for (const auto& [scene_name, objects_truth] : truth_table) {
+    const std::string file = (std::filesystem::path(opt.mosd) / (scene_name + ".pcd")).string();
+    pcl::PointCloud<pcl::PointXYZRGBL> labelled;
+    Cloud::Ptr cloud(new Cloud);
+    if (!loadMosd(file, labelled, *cloud)) {
+      std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s\n", file.c_str());
+      status = 1;
+      continue;
+    }
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    if (!rec.recognize(objects)) {
+      std::fprintf(stderr, "facyl_tabletop_eval: %s: no table\n", scene_name.c_str());
+      status = 1;
+      continue;
+    }
+    std::map<int, Row> rows;
+    for (const auto& [id, t] : objects_truth) {
+      Row r;
+      r.scene = scene_name;
+      r.object = id;
+      r.kind = t[0];
+      r.pose = t[1];
+      r.positive = t[0] == "cylinder" || t[0] == "cylinder_handle";
+      rows[id] = r;
+    }
+    const std::vector<int> truth = truthVector(
+      *cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
+    matchObjects(objects, truth, rows, stray);
+    scoreRows(objects, truth, rows);
+    for (auto& [id, r] : rows) {
+      all.push_back(r);
+      const std::string& note = objects_truth.at(id)[2];
+      if (called(r, d))
+        for (const char* key :
+             {"sticker", "plain white mug", "flower canister", "small white canister", "Pringles"})
+          if (note.find(key) != std::string::npos)
+            radii[key].emplace_back(scene_name, r.radius);
+    }
+  }
+  csv.write("mosd", all);
+  std::printf("\n## mOSD learn33-44 (%s): %zu labelled objects\n", opt.mosd.c_str(), all.size());
+  for (const Row& r : all)
+    std::printf("- %s obj %d %s %s: pieces %zu%s%s, inlier ratio %.3f, surface ratio %.3f, "
+                "radius %s%s\n",
+                r.scene.c_str(), r.object, r.kind.c_str(), r.pose.c_str(), r.pieces,
+                r.segment.merged ? " (merged with another object)" : "",
+                r.segment.split ? " (split)" : "", r.evidence.inlier_ratio,
+                r.evidence.surface_ratio,
+                r.evidence.fitted ? (std::to_string(r.radius * 1000.f).substr(0, 5) + " mm").c_str()
+                                  : "-",
+                called(r, d) ? ", called a cylinder" : "");
+  std::vector<Row> strict = all;
+  for (Row& r : strict)
+    r.positive = r.kind == "cylinder";
+  reportDetection(strict, stray,
+                  "Positives = class `cylinder` only (mugs and handled containers count as the "
+                  "rest):",
+                  d);
+  reportDetection(all, stray, "Positives = `cylinder` and `cylinder_handle`:", d);
+  std::printf("\nRadius of recurring objects (decided cylinders):\n");
+  for (const auto& [key, v] : radii) {
+    std::vector<double> r;
+    std::string where;
+    for (const auto& [s, x] : v)
+      r.push_back(x * 1000.0), where += " " + s;
+    double mean = 0, var = 0;
+    for (double x : r)
+      mean += x / static_cast<double>(r.size());
+    for (double x : r)
+      var += (x - mean) * (x - mean) / static_cast<double>(r.size());
+    std::printf("- %s: n=%zu (%s), mean %.1f mm, std %.1f mm, range %.1f-%.1f mm\n", key.c_str(),
+                r.size(), where.c_str() + 1, mean, std::sqrt(var),
+                *std::min_element(r.begin(), r.end()), *std::max_element(r.begin(), r.end()));
+  }
+  return status;
 }
 
 void
 printHelp(const char* self)
 {
   std::printf(
-    "Usage: %s [--sim N] [--seed S] [--mosd DIR] [--score inlier|surface] [--threshold R]\n"
+    "Usage: %s [--sim N] [--seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
+    "          [--mosd DIR] [--score inlier|surface] [--threshold R]\n"
     "          [--max-curvature-ratio C] [--min-coverage V] [--no-retry] [--retry-inside]\n"
-    "          [--any-normal-sign] [--normal-angle A] [--distance D]\n"
-    "          [--csv FILE]\n"
-    "Runs TabletopCylinderRecognizer (default settings) on N simulated scenes and/or the\n"
-    "labelled mOSD scenes and prints detection precision/recall for several thresholds, radius\n"
-    "and axis errors of the detected cylinders (with --score/--threshold, default surface 0.5),\n"
-    "and the stage timing.\n",
+    "          [--any-normal-sign] [--normal-angle A] [--distance D] [--csv FILE]\n"
+    "Runs TabletopCylinderRecognizer on N simulated scenes (seeds S.., default 1000) and/or\n"
+    "the mOSD learn scenes and prints: segmentation (objects recovered as one segment with\n"
+    "IoU >= 0.5, merged, split; in simulation also for the objects touching another), cylinder\n"
+    "precision/recall for both scores at several thresholds, radius and axis errors of the\n"
+    "detected cylinders, and the stage timing. Decision settings as in facyl_detect.\n",
     self);
+}
+
+Options
+parseOptions(int argc, char** argv)
+{
+  Options opt;
+  const facyl_cli::Arguments args(
+    argc, argv,
+    {"--sim", "--seed", "--layout", "--sensor", "--mosd", "--score", "--threshold", "--csv",
+     "--normal-angle", "--distance", "--max-curvature-ratio", "--min-coverage"},
+    {"--no-retry", "--retry-inside", "--any-normal-sign"});
+  if (!args.positional().empty())
+    throw std::invalid_argument("unexpected argument " + args.positional()[0]);
+  opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
+  opt.seed = static_cast<std::uint64_t>(args.integer("--seed", 1000, 0));
+  const std::string layout = args.text("--layout", "spread");
+  if (layout != "spread" && layout != "cluttered")
+    throw std::invalid_argument("--layout must be spread or cluttered");
+  opt.cluttered = layout == "cluttered";
+  opt.sensor = args.text("--sensor", "kinect");
+  facyl::TabletopSceneParameters probe;
+  if (!facyl::parseSensorPreset(opt.sensor, probe.sensor, probe.camera))
+    throw std::invalid_argument("--sensor must be kinect or stereo");
+  opt.mosd = args.text("--mosd", "");
+  opt.csv = args.text("--csv", "");
+  auto& p = opt.params;
+  auto& d = p.decision;
+  const std::string score = args.text("--score", "surface");
+  if (score != "inlier" && score != "surface")
+    throw std::invalid_argument("--score must be inlier or surface");
+  d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
+                               : facyl::CylinderDecision::Score::InlierRatio;
+  d.min_score = static_cast<float>(args.number("--threshold", d.min_score));
+  d.max_curvature_ratio =
+    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
+  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
+  p.hough.normal_angle_threshold =
+    static_cast<float>(args.number("--normal-angle", p.hough.normal_angle_threshold));
+  p.hough.distance_threshold =
+    static_cast<float>(args.number("--distance", p.hough.distance_threshold));
+  p.retry_upright_lying = !args.has("--no-retry");
+  p.retry_any_normal_sign = args.has("--retry-inside");
+  p.hough.outward_normals = !args.has("--any-normal-sign");
+  const std::string why = facyl::validate(p);
+  if (!why.empty())
+    throw std::invalid_argument(why);
+  if (opt.sim == 0 && opt.mosd.empty())
+    throw std::invalid_argument("give --sim N and/or --mosd DIR");
+  return opt;
 }
 
 } // namespace
@@ -181,276 +637,23 @@ main(int argc, char** argv)
     printHelp(argv[0]);
     return 0;
   }
-  std::size_t sim = 0;
-  std::uint64_t seed = 1000;
-  std::string mosd, csv;
-  Decision decision{true, 0.5f};
-  facyl::TabletopRecognizerParameters params;
+  Options opt;
   try {
-    const facyl_cli::Arguments args(argc, argv,
-                                    {"--sim", "--seed", "--mosd", "--score", "--threshold", "--csv",
-                                     "--normal-angle", "--distance", "--max-curvature-ratio",
-                                     "--min-coverage"},
-                                    {"--no-retry", "--retry-inside", "--any-normal-sign"});
-    if (!args.positional().empty())
-      throw std::invalid_argument("unexpected argument " + args.positional()[0]);
-    sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
-    seed = static_cast<std::uint64_t>(args.integer("--seed", 1000, 0));
-    mosd = args.text("--mosd", "");
-    csv = args.text("--csv", "");
-    const std::string score = args.text("--score", "surface");
-    if (score != "inlier" && score != "surface")
-      throw std::invalid_argument("--score must be inlier or surface");
-    decision.use_surface = score == "surface";
-    decision.threshold = static_cast<float>(args.number("--threshold", 0.5));
-    params.hough.normal_angle_threshold =
-      static_cast<float>(args.number("--normal-angle", params.hough.normal_angle_threshold));
-    params.hough.distance_threshold =
-      static_cast<float>(args.number("--distance", params.hough.distance_threshold));
-    params.max_curvature_ratio =
-      static_cast<float>(args.number("--max-curvature-ratio", params.max_curvature_ratio));
-    decision.max_curvature_ratio = params.max_curvature_ratio;
-    params.retry_upright_lying = !args.has("--no-retry");
-    params.retry_any_normal_sign = args.has("--retry-inside");
-    params.hough.outward_normals = !args.has("--any-normal-sign");
-    params.min_angular_coverage =
-      static_cast<float>(args.number("--min-coverage", params.min_angular_coverage));
-    decision.min_coverage = params.min_angular_coverage;
-    const std::string why = facyl::validate(params);
-    if (!why.empty())
-      throw std::invalid_argument(why);
-    if (sim == 0 && mosd.empty())
-      throw std::invalid_argument("give --sim N and/or --mosd DIR");
+    opt = parseOptions(argc, argv);
   }
   catch (const std::exception& e) {
     std::fprintf(stderr, "facyl_tabletop_eval: %s\n", e.what());
     return 2;
   }
-  std::ofstream csv_out;
-  if (!csv.empty()) {
-    csv_out.open(csv);
-    csv_out << "set,scene,object,kind,pose,positive,found,clusters,merged,fitted,inlier_ratio,"
-               "surface_ratio,curvature_ratio,radius,true_radius,axis_error_deg\n";
-  }
-  auto write_rows = [&](const std::string& set, const std::vector<Row>& rows) {
-    if (!csv_out.is_open())
-      return;
-    for (const Row& r : rows)
-      csv_out << set << "," << r.scene << "," << r.object << "," << r.kind << "," << r.pose << ","
-              << r.positive << "," << r.found << "," << r.clusters << "," << r.merged << ","
-              << r.fitted << "," << r.inlier_ratio << "," << r.surface_ratio << "," << r.curvature_ratio << "," << r.radius
-              << "," << r.true_radius << "," << r.axis_error_deg << "\n";
-  };
-
-  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
-  rec.setParameters(params);
+  CsvWriter csv(opt.csv);
+  Recognizer rec;
+  rec.setParameters(opt.params);
   int status = 0;
-
-  if (sim > 0) {
-    std::vector<Row> all;
-    std::vector<Stray> stray;
-    std::vector<facyl::RecognitionTiming> timing;
-    std::size_t failures = 0;
-    for (std::size_t k = 0; k < sim; ++k) {
-      facyl::TabletopSceneParameters sp;
-      sp.seed = seed + k;
-      const facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
-      Cloud::Ptr cloud(new Cloud(scene.cloud));
-      rec.setInputCloud(cloud);
-      std::vector<facyl::RecognizedObject> objects;
-      if (!rec.recognize(objects)) {
-        ++failures;
-        continue;
-      }
-      if (k > 0)
-        timing.push_back(rec.getTiming());
-      std::map<int, Row> rows;
-      for (std::size_t i = 0; i < scene.scene.objects.size(); ++i) {
-        const auto& o = scene.scene.objects[i];
-        if (scene.visible_pixels[i] < rec.getParameters().segmentation.min_cluster_size)
-          continue; // too little of it is seen to be a cluster
-        Row r;
-        r.scene = std::to_string(sp.seed);
-        r.object = static_cast<int>(i + 2);
-        r.kind = o.kind;
-        r.pose = o.lying ? "lying" : "upright";
-        r.positive = o.cls == facyl::SceneClass::Cylinder;
-        if (r.positive)
-          r.true_radius = o.radius;
-        rows[r.object] = r;
-      }
-      matchClusters(objects, [&](pcl::index_t i) { return static_cast<int>(scene.object_id[i]); },
-                    rows, stray);
-      // Axis errors of the best cluster of each cylinder.
-      for (auto& [id, r] : rows) {
-        if (!r.positive || !r.fitted)
-          continue;
-        const facyl::CylinderTruth truth =
-          facyl::cylinderTruth(scene.scene, scene.scene.objects[static_cast<std::size_t>(id - 2)]);
-        r.axis_error_deg = facyl::axisAngle(objects[r.cluster].cylinder.axis, truth.axis) * 180.f /
-                           static_cast<float>(M_PI);
-      }
-      for (auto& [id, r] : rows)
-        all.push_back(r);
-    }
-    write_rows("sim", all);
-    std::size_t cylinders = 0, found = 0, merged = 0, split = 0;
-    for (const Row& r : all) {
-      cylinders += r.positive;
-      found += r.found;
-      merged += r.merged;
-      split += r.clusters > 1;
-    }
-    std::printf("## Simulated scenes: %zu (seeds %llu..%llu), %zu objects with >= %zu visible "
-                "pixels (%zu cylinders); %zu scenes without a table\n",
-                sim, static_cast<unsigned long long>(seed),
-                static_cast<unsigned long long>(seed + sim - 1), all.size(),
-                rec.getParameters().segmentation.min_cluster_size, cylinders, failures);
-    std::printf("Clusters: %zu of %zu objects found; %zu merged with a neighbour; %zu split\n",
-                found, all.size(), merged, split);
-    report(all, stray, "Detection (object level; a cluster matching no object and called a "
-                       "cylinder is a false positive):",
-           params.max_curvature_ratio, params.min_angular_coverage);
-    std::map<std::string, std::pair<std::size_t, std::size_t>> fp_by; // kind: (called, total)
-    for (const Row& r : all)
-      if (!r.positive) {
-        auto& c = fp_by[r.kind];
-        ++c.second;
-        c.first += r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage);
-      }
-    std::printf("\nDistractors called cylinders (%s >= %.2f):",
-                decision.use_surface ? "surface ratio" : "inlier ratio", decision.threshold);
-    for (const auto& [k, c] : fp_by)
-      std::printf(" %s %zu/%zu;", k.c_str(), c.first, c.second);
-    std::printf("\n");
-    std::vector<double> radius_rel, axis;
-    std::map<std::string, std::vector<double>> axis_by, radius_by;
-    for (const Row& r : all)
-      if (r.positive && r.found && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage)) {
-        const double rel = std::abs(r.radius - r.true_radius) / r.true_radius * 100.0;
-        radius_rel.push_back(rel);
-        axis.push_back(r.axis_error_deg);
-        axis_by[r.kind + " " + r.pose].push_back(r.axis_error_deg);
-        radius_by[r.kind + " " + r.pose].push_back(rel);
-      }
-    std::printf("\nDetected cylinders (%s >= %.2f): %zu; radius error median %.2f%%, p90 %.2f%%; "
-                "axis error median %.2f deg, p90 %.2f deg\n",
-                decision.use_surface ? "surface ratio" : "inlier ratio", decision.threshold,
-                radius_rel.size(), median(radius_rel), percentile(radius_rel, 0.9), median(axis),
-                percentile(axis, 0.9));
-    for (const auto& [k, v] : axis_by)
-      std::printf("- %s: %zu, axis median %.2f deg (p90 %.2f), radius median %.2f%%\n", k.c_str(),
-                  v.size(), median(v), percentile(v, 0.9), median(radius_by[k]));
-    timingReport(timing);
-  }
-
-  if (!mosd.empty()) {
-    std::ifstream labels_file(std::filesystem::path(mosd) / "labels.csv");
-    if (!labels_file) {
-      std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s/labels.csv\n", mosd.c_str());
-      return 1;
-    }
-    // scene -> object -> (class, pose, notes)
-    std::map<std::string, std::map<int, std::array<std::string, 3>>> truth;
-    std::string line;
-    std::getline(labels_file, line);
-    while (std::getline(labels_file, line)) {
-      std::vector<std::string> f;
-      std::string cur;
-      bool quoted = false;
-      for (char ch : line) {
-        if (ch == '"')
-          quoted = !quoted;
-        else if (ch == ',' && !quoted)
-          f.push_back(cur), cur.clear();
-        else
-          cur += ch;
-      }
-      f.push_back(cur);
-      if (f.size() >= 9)
-        truth[f[1]][std::stoi(f[2])] = {f[3], f[4], f[8]};
-    }
-    std::vector<Row> all;
-    std::vector<Stray> stray;
-    std::vector<facyl::RecognitionTiming> timing;
-    std::map<std::string, std::vector<std::pair<std::string, float>>> radii; // by note
-    for (const auto& [scene_name, objects_truth] : truth) {
-      const std::string file = (std::filesystem::path(mosd) / (scene_name + ".pcd")).string();
-      pcl::PointCloud<pcl::PointXYZRGBL> labelled;
-      if (pcl::io::loadPCDFile(file, labelled) < 0) {
-        std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s\n", file.c_str());
-        status = 1;
-        continue;
-      }
-      Cloud::Ptr cloud(new Cloud);
-      pcl::copyPointCloud(labelled, *cloud);
-      rec.setInputCloud(cloud);
-      std::vector<facyl::RecognizedObject> objects;
-      // Run twice: the second run gives the steady-state timing of a stream.
-      if (!rec.recognize(objects) || !rec.recognize(objects)) {
-        std::fprintf(stderr, "facyl_tabletop_eval: %s: no table\n", scene_name.c_str());
-        status = 1;
-        continue;
-      }
-      timing.push_back(rec.getTiming());
-      std::map<int, Row> rows;
-      for (const auto& [id, t] : objects_truth) {
-        Row r;
-        r.scene = scene_name;
-        r.object = id;
-        r.kind = t[0];
-        r.pose = t[1];
-        r.positive = t[0] == "cylinder" || t[0] == "cylinder_handle";
-        rows[id] = r;
-      }
-      matchClusters(
-        objects,
-        [&](pcl::index_t i) {
-          const std::uint32_t l = labelled[i].label;
-          return l >= 20 ? static_cast<int>(l / 10) : (l >= 1 ? 0 : -1);
-        },
-        rows, stray);
-      for (auto& [id, r] : rows) {
-        all.push_back(r);
-        const std::string& note = objects_truth.at(id)[2];
-        if (r.fitted && decision(r.inlier_ratio, r.surface_ratio, r.fitted, r.curvature_ratio, r.coverage))
-          for (const char* key : {"sticker", "plain white mug", "flower canister", "small white canister", "Pringles"})
-            if (note.find(key) != std::string::npos)
-              radii[key].emplace_back(scene_name, r.radius);
-      }
-    }
-    write_rows("mosd", all);
-    std::printf("\n## mOSD learn scenes (%s): %zu labelled objects\n", mosd.c_str(), all.size());
-    for (const Row& r : all)
-      std::printf("- %s obj %d %s %s: clusters %zu%s, inlier ratio %.3f, surface ratio %.3f, "
-                  "radius %s\n",
-                  r.scene.c_str(), r.object, r.kind.c_str(), r.pose.c_str(), r.clusters,
-                  r.merged ? " (merged with another object)" : "", r.inlier_ratio,
-                  r.surface_ratio,
-                  r.fitted ? (std::to_string(r.radius * 1000.f).substr(0, 5) + " mm").c_str() : "-");
-    std::vector<Row> strict = all;
-    for (Row& r : strict)
-      r.positive = r.kind == "cylinder";
-    report(strict, stray, "Positives = class `cylinder` only (mugs and handled containers count "
-                          "as the rest):",
-           params.max_curvature_ratio, params.min_angular_coverage);
-    report(all, stray, "Positives = `cylinder` and `cylinder_handle`:", params.max_curvature_ratio, params.min_angular_coverage);
-    std::printf("\nRadius of recurring objects (decided cylinders):\n");
-    for (const auto& [key, v] : radii) {
-      std::vector<double> r;
-      std::string where;
-      for (const auto& [s, x] : v)
-        r.push_back(x * 1000.0), where += " " + s;
-      double mean = 0, var = 0;
-      for (double x : r)
-        mean += x / static_cast<double>(r.size());
-      for (double x : r)
-        var += (x - mean) * (x - mean) / static_cast<double>(r.size());
-      std::printf("- %s: n=%zu (%s), mean %.1f mm, std %.1f mm, range %.1f-%.1f mm\n", key.c_str(),
-                  r.size(), where.c_str() + 1, mean, std::sqrt(var),
-                  *std::min_element(r.begin(), r.end()), *std::max_element(r.begin(), r.end()));
-    }
-    timingReport(timing);
+  if (opt.sim > 0)
+    status = std::max(status, evaluateSimulated(opt, rec, csv));
+  if (!opt.mosd.empty()) {
+    status = std::max(status, evaluateMosdSegmentation(opt, rec, csv));
+    status = std::max(status, evaluateMosdDetection(opt, rec, csv));
   }
   return status;
 }

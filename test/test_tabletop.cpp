@@ -42,6 +42,20 @@ majorityId(const facyl::RenderedScene& s, const pcl::Indices& indices)
     ->first;
 }
 
+/** majorityId for indices into the scene's finite points, in pixel order. */
+int
+majorityIdOfUnorganized(const facyl::RenderedScene& s, const pcl::Indices& indices)
+{
+  std::vector<pcl::index_t> pixel_of;
+  for (std::size_t i = 0; i < s.cloud.size(); ++i)
+    if (pcl::isFinite(s.cloud[i]))
+      pixel_of.push_back(static_cast<pcl::index_t>(i));
+  pcl::Indices pixels;
+  for (const auto i : indices)
+    pixels.push_back(pixel_of[static_cast<std::size_t>(i)]);
+  return majorityId(s, pixels);
+}
+
 } // namespace
 
 // ---------------------------------------------------------------- geometry helpers
@@ -307,12 +321,17 @@ TEST(TabletopSegmentation, UnorganizedCloudsWithACamera)
   ASSERT_TRUE(seg.segment(clusters));
   const auto& c = seg.getTableCoefficients().values;
   EXPECT_NEAR(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), 1.f, 1e-3f);
-  std::size_t big = 0;
-  for (std::size_t k = 0; k < s.scene.objects.size(); ++k)
-    big += s.visible_pixels[k] >= 1000;
-  EXPECT_EQ(clusters.size(), big);
-  for (const auto& cl : clusters)
+  // Every object seen well is one cluster; every cluster is an object.
+  std::map<int, std::size_t> clusters_of;
+  for (const auto& cl : clusters) {
     EXPECT_GE(cl.box[0], 0);
+    ++clusters_of[majorityIdOfUnorganized(s, cl.indices.indices)];
+  }
+  for (std::size_t k = 0; k < s.scene.objects.size(); ++k)
+    if (s.visible_pixels[k] >= 1000) {
+      EXPECT_EQ(clusters_of[static_cast<int>(k + 2)], 1u) << "object " << k + 2;
+    }
+  EXPECT_EQ(clusters_of.count(0) + clusters_of.count(1), 0u);
 }
 
 TEST(TabletopSegmentation, ReportsBadInput)
@@ -365,7 +384,7 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
                                              by_id[id]->cluster.indices.indices.size()))
         by_id[id] = &o;
       if (o.is_cylinder) {
-        EXPECT_TRUE(o.fitted);
+        EXPECT_TRUE(o.evidence.fitted);
         EXPECT_FALSE(o.cylinder.inliers.empty());
         for (const auto i : o.cylinder.inliers) // inliers index the input cloud, in the cluster
           ASSERT_TRUE(std::binary_search(o.cluster.indices.indices.begin(),
@@ -449,8 +468,8 @@ TEST(TabletopCylinderRecognizer, ClassifierRejectsBeforeFitting)
   EXPECT_EQ(no->calls, static_cast<int>(objects.size()));
   EXPECT_TRUE(no->crop_ok);
   for (const auto& o : objects) {
-    EXPECT_FLOAT_EQ(o.p_cylinder, 0.1f);
-    EXPECT_FALSE(o.fitted);
+    EXPECT_FLOAT_EQ(o.evidence.p_cylinder, 0.1f);
+    EXPECT_FALSE(o.evidence.fitted);
     EXPECT_FALSE(o.is_cylinder);
   }
   EXPECT_EQ(rec.getTiming().fitting, 0.0);
@@ -459,7 +478,7 @@ TEST(TabletopCylinderRecognizer, ClassifierRejectsBeforeFitting)
   ASSERT_TRUE(rec.recognize(objects));
   std::size_t fitted = 0;
   for (const auto& o : objects)
-    fitted += o.fitted;
+    fitted += o.evidence.fitted;
   EXPECT_GT(fitted, 0u);
 }
 
@@ -473,7 +492,7 @@ TEST(TabletopCylinderRecognizer, ReportsBadInput)
   rec.setInputCloud(empty);
   EXPECT_FALSE(rec.recognize(objects));
   facyl::TabletopRecognizerParameters p;
-  p.min_inlier_ratio = 1.5f;
+  p.decision.min_score = 1.5f;
   EXPECT_FALSE(facyl::validate(p).empty());
   p = facyl::TabletopRecognizerParameters{};
   p.hough.radius_min = 0.3f;
@@ -557,7 +576,7 @@ TEST(RealData, MosdLabelledScenes)
         return a.second < b.second;
       });
       seen[best->first] = true;
-      const bool small = o.fitted && o.cylinder.radius < 0.05f && o.cylinder.radius > 0.03f;
+      const bool small = o.evidence.fitted && o.cylinder.radius < 0.05f && o.cylinder.radius > 0.03f;
       mugs += o.is_cylinder && small;
     }
     objects_seen += seen.size();
@@ -602,7 +621,7 @@ TEST(RealData, LidDominatedAndLyingTins)
           tin = &o;
       }
       ASSERT_NE(tin, nullptr) << name;
-      const float r = tin->fitted ? tin->cylinder.radius : 0.f;
+      const float r = tin->evidence.fitted ? tin->cylinder.radius : 0.f;
       radii += " " + std::to_string(static_cast<int>(std::lround(r * 1000.f)));
       right += tin->is_cylinder && r > 0.09f && r < 0.11f;
     }

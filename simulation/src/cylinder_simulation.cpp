@@ -2,11 +2,11 @@
  * facyl: fast cylinder detection for PCL.
  */
 #include <facyl/simulation/cylinder_simulation.h>
+#include <facyl/simulation/random.h>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -43,6 +43,17 @@ makePoint(const Eigen::Vector3f& p, const Eigen::Vector3f& n)
   q.curvature = 0.f;
   return q;
 }
+/** Three standard normal deviates, drawn in order (the order of a constructor's arguments'
+ * evaluation is unspecified). */
+Eigen::Vector3f
+gaussian3(Random& rng)
+{
+  Eigen::Vector3f g;
+  g.x() = rng.normal();
+  g.y() = rng.normal();
+  g.z() = rng.normal();
+  return g;
+}
 } // namespace
 
 SimulatedCylinder
@@ -51,21 +62,18 @@ simulateCylinder(const CylinderSimulationParameters& params)
   const std::string why = validate(params);
   if (!why.empty())
     throw std::invalid_argument("facyl::simulateCylinder: " + why);
-  std::mt19937_64 rng(params.seed);
-  std::uniform_real_distribution<float> unit(0.f, 1.f);
-  std::normal_distribution<float> gauss(0.f, 1.f);
+  Random rng(params.seed);
 
   Eigen::Vector3f axis = params.axis;
   if (params.random_axis)
     do
-      axis = Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng));
+      axis = gaussian3(rng);
     while (!(axis.norm() > 1e-6f));
   axis.normalize();
   const Eigen::Vector3f u = axis.unitOrthogonal(), v = axis.cross(u);
   const float r = params.radius, h = params.height, sigma = params.noise * r;
   const auto noisy = [&](const Eigen::Vector3f& p) {
-    return sigma > 0.f ? Eigen::Vector3f(p + sigma * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)))
-                       : p;
+    return sigma > 0.f ? Eigen::Vector3f(p + sigma * gaussian3(rng)) : p;
   };
 
   SimulatedCylinder out;
@@ -73,17 +81,17 @@ simulateCylinder(const CylinderSimulationParameters& params)
   const auto lateral = static_cast<std::size_t>(std::lround(visible * params.lateral_points));
   const float sector = 2.f * static_cast<float>(M_PI) * visible;
   for (std::size_t i = 0; i < lateral; ++i) {
-    const float theta = sector * unit(rng);
+    const float theta = sector * rng.uniform(0.f, 1.f);
     const Eigen::Vector3f radial = std::cos(theta) * u + std::sin(theta) * v;
-    const Eigen::Vector3f p = params.base + h * unit(rng) * axis + r * radial;
+    const Eigen::Vector3f p = params.base + h * rng.uniform(0.f, 1.f) * axis + r * radial;
     out.cloud.push_back(makePoint(noisy(p), radial));
     out.is_lid.push_back(0);
   }
   const auto lids = static_cast<std::size_t>(std::lround(params.lid_ratio * params.lateral_points));
   for (std::size_t i = 0; i < lids; ++i) {
     const bool top = (i % 2) == 1;
-    const float rho = r * std::sqrt(unit(rng));
-    const float theta = 2.f * static_cast<float>(M_PI) * unit(rng);
+    const float rho = r * std::sqrt(rng.uniform(0.f, 1.f));
+    const float theta = 2.f * static_cast<float>(M_PI) * rng.uniform(0.f, 1.f);
     const Eigen::Vector3f p = params.base + (top ? h : 0.f) * axis +
                               rho * (std::cos(theta) * u + std::sin(theta) * v);
     out.cloud.push_back(makePoint(noisy(p), top ? axis : Eigen::Vector3f(-axis)));
@@ -112,16 +120,16 @@ simulatePlane(const Eigen::Vector3f& centre, const Eigen::Vector3f& normal, floa
                                 "normal non-zero");
   if (!(sigma >= 0.f))
     throw std::invalid_argument("facyl::simulatePlane: sigma must be >= 0");
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<float> unit(-0.5f, 0.5f);
-  std::normal_distribution<float> gauss(0.f, 1.f);
+  Random rng(seed);
   const Eigen::Vector3f n = normal.normalized();
   const Eigen::Vector3f u = n.unitOrthogonal(), v = n.cross(u);
   pcl::PointCloud<pcl::PointNormal> cloud;
   for (std::size_t i = 0; i < points; ++i) {
-    Eigen::Vector3f p = centre + size_u * unit(rng) * u + size_v * unit(rng) * v;
+    const float a = rng.uniform(-0.5f, 0.5f);
+    const float b = rng.uniform(-0.5f, 0.5f);
+    Eigen::Vector3f p = centre + size_u * a * u + size_v * b * v;
     if (sigma > 0.f)
-      p += sigma * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng));
+      p += sigma * gaussian3(rng);
     cloud.push_back(makePoint(p, n));
   }
   cloud.width = static_cast<std::uint32_t>(cloud.size());

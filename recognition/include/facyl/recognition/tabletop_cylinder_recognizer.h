@@ -3,8 +3,11 @@
  */
 #pragma once
 
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/recognition/shape_classifier.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/sample_consensus_alt/cylinder_model.h>
 #include <facyl/sample_consensus_alt/orientation_accumulator.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
@@ -37,6 +40,7 @@ tabletopHoughDefaults()
 struct TabletopRecognizerParameters {
   TabletopSegmentationParameters segmentation;
   HoughCylinderParameters hough{tabletopHoughDefaults()};
+  CylinderDecision decision;      ///< what makes a fitted object a cylinder
   /** Orientation prior, expressed in the table frame (up = table normal). */
   OrientationPrior prior{OrientationPrior::Vertical};
   std::size_t orientations{450};  ///< accumulator cells N_d, >= 10
@@ -49,17 +53,6 @@ struct TabletopRecognizerParameters {
   bool retry_any_normal_sign{false};
   std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, >= 50
   int neighbours{16};             ///< k of the normal/curvature estimation, >= 5
-  /** Decision score: the inlier ratio of eq. 4 (the paper), or the surface ratio, which also
-   * counts the points on the fitted cylinder's end caps (lids) as explained. */
-  enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
-  float min_inlier_ratio{0.5f};   ///< decision: score at least this, in [0, 1]
-  float min_probability{0.5f};    ///< decision: classifier probability at least this, in [0, 1]
-  /** Decision: the inliers' curvature ratio (RecognizedObject::curvature_ratio) at most this,
-   * in (0, 1]; 1 turns the check off. Rejects most spheres and bowls. */
-  float max_curvature_ratio{0.35f};
-  /** Decision: the inliers cover at least this share of the circumference (a camera sees about
-   * half of a cylinder), in [0, 1]; a large cylinder fitted to a shallow arc covers less. */
-  float min_angular_coverage{0.2f};
   std::uint64_t seed{0};
 };
 
@@ -69,20 +62,11 @@ validate(const TabletopRecognizerParameters& params);
 
 /** \brief One object on the table and what was decided about it. */
 struct RecognizedObject {
-  TabletopCluster cluster;
-  /** Classifier probability of "cylinder"; NaN without a classifier (or when it cannot tell). */
-  float p_cylinder{std::numeric_limits<float>::quiet_NaN()};
-  bool fitted{false};       ///< a cylinder was fitted (not rejected by the classifier, fit found)
-  float inlier_ratio{0.f};  ///< paper eq. 4 on the points fitted; 0 when not fitted
-  /** (lateral inliers + points on the end caps + points on the inner wall of an open
-   * container) / points fitted */
-  float surface_ratio{0.f};
-  /** Median |k_min| / median |k_max| over the lateral inliers: near 0 on a cylinder, near 1 on
-   * a sphere or bowl; NaN when not fitted. */
-  float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
-  bool is_cylinder{false};  ///< the decision
-  /** The fitted cylinder (valid when fitted); its inliers index the input cloud and come from
-   * the subsample that was fitted. */
+  TabletopCluster cluster;  ///< the object's points, pixel box and centroid
+  CylinderEvidence evidence; ///< what the decision looked at
+  bool is_cylinder{false};  ///< the decision (acceptCylinder)
+  /** The fitted cylinder (valid when evidence.fitted); its inliers index the input cloud and
+   * come from the subsample that was fitted. */
   CylinderModel cylinder;
 };
 
@@ -96,10 +80,8 @@ struct RecognitionTiming {
 
 /** \brief The paper's tabletop framework (III-A): table and clusters (TabletopSegmentation), an
  * optional shape classifier, then a Hough cylinder fit per cluster (normals and curvatures by
- * NormalCurvatureEstimation, prior in the table frame) and the decision
- * `p_cylinder >= min_probability` (when classified), `score >= min_inlier_ratio` (score: eq. 4
- * inlier ratio, or the surface ratio), `curvature_ratio <= max_curvature_ratio` and
- * `cylinder.angular_coverage >= min_angular_coverage`.
+ * NormalCurvatureEstimation, prior in the table frame) and the decision acceptCylinder (see
+ * CylinderDecision).
  *
  * \code
  * facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
@@ -109,7 +91,8 @@ struct RecognitionTiming {
  *   for (const auto& o : objects) if (o.is_cylinder) use(o.cylinder);
  * \endcode
  * Errors (bad parameters, no cloud, no table) are reported with PCL_ERROR and make
- * recognize() return false with no objects.
+ * recognize() return false with no objects. recognize() is not reentrant on one object;
+ * distinct objects may run concurrently.
  */
 template <typename PointT>
 class TabletopCylinderRecognizer : public pcl::PCLBase<PointT> {
@@ -125,6 +108,7 @@ public:
   setParameters(const TabletopRecognizerParameters& params)
   {
     params_ = params;
+    configured_ = false;
   }
   const TabletopRecognizerParameters&
   getParameters() const
@@ -173,31 +157,37 @@ public:
   }
 
 private:
+  /** The points of a cluster that are fitted, with their cues. */
+  struct FitInput;
+  /** One fit of a FitInput and its evidence. */
+  struct Fit;
+
+  /** Builds the cue estimation and the estimators (one per prior of the retries). */
+  void
+  configure();
   ObjectView
   makeView(const TabletopCluster& cluster) const;
+  /** Subsamples \a cluster and estimates normals and curvatures. */
+  FitInput
+  prepareFit(const TabletopCluster& cluster);
+  /** Fits \a input with the configured prior, then (when not accepted) the retries. */
+  Fit
+  fitWithRetries(const FitInput& input);
+  Fit
+  fitOnce(const FitInput& input, std::size_t estimator);
+  /** Classifies, fits and decides one cluster. */
+  RecognizedObject
+  recognizeCluster(TabletopCluster cluster);
 
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;
   ShapeClassifier::Ptr classifier_;
   TabletopSegmentation<PointT> segmentation_;
   RecognitionTiming timing_;
+  bool configured_{false};
+  NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;
+  std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators_;
 };
-
-/** \brief Number of \a points (3 x n, unit \a normals alongside) that lie on an end cap of
- * \a model: within \a distance of the plane through model.base or model.top normal to the axis,
- * at most radius + distance from the axis, with a normal within \a max_angle (rad) of the axis.
- * Points listed in model.inliers (column indices, ascending) are not counted. */
-std::size_t
-countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-               const Eigen::Matrix3Xf& normals, float distance, float max_angle);
-
-/** \brief Number of \a points (with unit \a normals) on the inner wall of \a model seen as an
- * open container (a cup's inside, seen through its opening): between inner_ratio x radius and
- * the radius from the axis, within the axial extent of the model, with a normal within
- * \a max_angle (rad) of pointing at the axis. Points in model.inliers are not counted. */
-std::size_t
-countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-                     const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio);
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */

@@ -3,9 +3,7 @@
  */
 #pragma once
 
-#include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
-#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/type_traits.h>
@@ -15,6 +13,49 @@
 #include <cmath>
 
 namespace facyl {
+
+template <typename PointT>
+struct TabletopCylinderRecognizer<PointT>::FitInput {
+  pcl::Indices subset;                          ///< the cluster's points that are fitted
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points;   ///< the subset's coordinates
+  pcl::PointCloud<NormalCurvature>::Ptr cues;   ///< their normals and curvatures
+  Eigen::Matrix3Xf columns;                     ///< points with a normal, as columns
+  Eigen::Matrix3Xf normals;                     ///< their normals
+  pcl::Indices column_of;                       ///< subset position -> column, -1 without
+};
+
+template <typename PointT>
+struct TabletopCylinderRecognizer<PointT>::Fit {
+  CylinderModel model; ///< inliers index FitInput::points
+  CylinderEvidence evidence;
+  bool accepted{false};
+};
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::configure()
+{
+  cues_estimation_.setKSearch(params_.neighbours);
+  // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
+  // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
+  // face from pulling the axis. Optionally a last try allows any normal sign: the inside of
+  // an open container can make a cluster of its own (so can the inside of a bowl).
+  const bool any_sign = params_.retry_upright_lying && params_.hough.outward_normals &&
+                        params_.retry_any_normal_sign;
+  estimators_.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
+  const OrientationPrior priors[4] = {params_.prior, OrientationPrior::VerticalStrong,
+                                      OrientationPrior::Horizontal, params_.prior};
+  for (std::size_t e = 0; e < estimators_.size(); ++e) {
+    HoughCylinderParameters hp = params_.hough;
+    if (e == 3)
+      hp.outward_normals = false;
+    estimators_[e].setParameters(hp);
+    estimators_[e].setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
+    estimators_[e].setNumberOfOrientations(params_.orientations);
+    estimators_[e].setSeed(params_.seed);
+  }
+  configured_ = true;
+}
 
 template <typename PointT>
 bool
@@ -37,6 +78,8 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
     PCL_ERROR("[facyl::TabletopCylinderRecognizer::recognize] No input cloud, or an empty one.\n");
     return false;
   }
+  if (!configured_)
+    configure();
 
   std::vector<TabletopCluster> clusters;
   segmentation_.setParameters(params_.segmentation);
@@ -44,150 +87,135 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   segmentation_.setIndices(indices_); // nullptr: the whole cloud
   segmentation_.setCamera(camera_);
   const bool segmented = segmentation_.segment(clusters);
-  const auto t1 = Clock::now();
-  timing_.segmentation = ms(t0, t1);
+  timing_.segmentation = ms(t0, Clock::now());
   if (!segmented) {
     timing_.total = ms(t0, Clock::now());
     return false;
   }
-
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation;
-  cues_estimation.setKSearch(params_.neighbours);
-  cues_estimation.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
-  // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
-  // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
-  // face from pulling the axis.
-  // Optionally a last try allows any normal sign: the inside of an open container can make a
-  // cluster of its own (so can the inside of a bowl).
-  const bool any_sign = params_.retry_upright_lying && params_.hough.outward_normals &&
-                        params_.retry_any_normal_sign;
-  std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators(
-    params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1);
-  const OrientationPrior priors[4] = {params_.prior, OrientationPrior::VerticalStrong,
-                                      OrientationPrior::Horizontal, params_.prior};
-  for (std::size_t e = 0; e < estimators.size(); ++e) {
-    auto& hough = estimators[e];
-    HoughCylinderParameters hp = params_.hough;
-    if (e == 3)
-      hp.outward_normals = false;
-    hough.setParameters(hp);
-    hough.setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
+  cues_estimation_.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
+  for (auto& hough : estimators_)
     hough.setReferenceFrame(segmentation_.getTableFrame().linear());
-    hough.setNumberOfOrientations(params_.orientations);
-    hough.setSeed(params_.seed);
-  }
-
-  for (auto& cluster : clusters) {
-    RecognizedObject object;
-    object.cluster = std::move(cluster);
-    auto tc = Clock::now();
-    if (classifier_) {
-      object.p_cylinder = classifier_->cylinderProbability(makeView(object.cluster));
-      const auto tc1 = Clock::now();
-      timing_.classification += ms(tc, tc1);
-      tc = tc1;
-      if (std::isfinite(object.p_cylinder) && object.p_cylinder < params_.min_probability) {
-        objects.push_back(std::move(object));
-        continue;
-      }
-    }
-    const pcl::Indices subset = evenSubsample(object.cluster.indices.indices, params_.max_fit_points);
-    pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
-    points->reserve(subset.size());
-    for (const auto i : subset) {
-      const auto& p = (*input_)[i];
-      points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-    }
-    pcl::PointCloud<NormalCurvature>::Ptr cues(new pcl::PointCloud<NormalCurvature>);
-    cues_estimation.setInputCloud(points);
-    cues_estimation.compute(*cues);
-    // Points with a normal, as columns (the estimator's inliers skip the rest).
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(points->size()));
-    Eigen::Matrix3Xf nrm(3, static_cast<Eigen::Index>(points->size()));
-    pcl::Indices column_of(points->size(), -1);
-    Eigen::Index n = 0;
-    for (std::size_t k = 0; k < points->size(); ++k) {
-      const auto& c = (*cues)[k];
-      if (!pcl::isFinite((*points)[k]) || !std::isfinite(c.normal_x))
-        continue;
-      pts.col(n) = (*points)[k].getVector3fMap();
-      nrm.col(n) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
-      column_of[k] = static_cast<pcl::index_t>(n++);
-    }
-    struct Fit {
-      bool fitted{false};
-      CylinderModel model; // inliers index `points`
-      float inlier_ratio{0.f}, surface_ratio{0.f};
-      float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
-      float score{-1.f};
-      bool accepted{false};
-    };
-    const auto fit_with = [&](HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>& hough) {
-      Fit f;
-      hough.setInputCloud(points);
-      hough.setInputNormals(cues);
-      std::vector<CylinderModel> models;
-      if (!hough.segment(models) || models.empty())
-        return f;
-      f.fitted = true;
-      f.model = std::move(models.front());
-      f.inlier_ratio = f.model.inlier_ratio;
-      CylinderModel in_columns = f.model;
-      for (auto& i : in_columns.inliers)
-        i = column_of[static_cast<std::size_t>(i)];
-      const std::size_t caps =
-        countCapPoints(in_columns, pts.leftCols(n), nrm.leftCols(n),
-                       2.f * f.model.distance_threshold, params_.hough.normal_angle_threshold);
-      const std::size_t inner =
-        params_.hough.outward_normals
-          ? countInnerWallPoints(in_columns, pts.leftCols(n), nrm.leftCols(n),
-                                 params_.hough.normal_angle_threshold, 0.8f)
-          : 0;
-      f.surface_ratio =
-        std::min(1.f, f.inlier_ratio + static_cast<float>(caps + inner) /
-                                         static_cast<float>(points->size()));
-      std::vector<float> k_max, k_min;
-      for (const auto i : f.model.inliers) {
-        const auto& c = (*cues)[static_cast<std::size_t>(i)];
-        if (std::isfinite(c.pc1) && std::isfinite(c.pc2))
-          k_max.push_back(std::abs(c.pc1)), k_min.push_back(std::abs(c.pc2));
-      }
-      if (!k_max.empty()) {
-        const auto mid = k_max.size() / 2;
-        std::nth_element(k_max.begin(), k_max.begin() + mid, k_max.end());
-        std::nth_element(k_min.begin(), k_min.begin() + mid, k_min.end());
-        f.curvature_ratio = k_max[mid] > 0.f ? k_min[mid] / k_max[mid] : 1.f;
-      }
-      f.score = params_.score == TabletopRecognizerParameters::Score::SurfaceRatio
-                  ? f.surface_ratio
-                  : f.inlier_ratio;
-      f.accepted = f.score >= params_.min_inlier_ratio &&
-                   !(f.curvature_ratio > params_.max_curvature_ratio) &&
-                   f.model.angular_coverage >= params_.min_angular_coverage;
-      return f;
-    };
-    Fit best = fit_with(estimators[0]);
-    for (std::size_t e = 1; e < estimators.size() && !best.accepted; ++e) {
-      Fit f = fit_with(estimators[e]);
-      if (f.fitted && (f.accepted || f.score > best.score))
-        best = std::move(f);
-    }
-    if (best.fitted) {
-      object.fitted = true;
-      object.cylinder = std::move(best.model);
-      for (auto& i : object.cylinder.inliers)
-        i = subset[static_cast<std::size_t>(i)];
-      object.inlier_ratio = best.inlier_ratio;
-      object.surface_ratio = best.surface_ratio;
-      object.curvature_ratio = best.curvature_ratio;
-      object.is_cylinder = best.accepted;
-    }
-    timing_.fitting += ms(tc, Clock::now());
-    objects.push_back(std::move(object));
-  }
+  for (auto& cluster : clusters)
+    objects.push_back(recognizeCluster(std::move(cluster)));
   timing_.total = ms(t0, Clock::now());
   return true;
+}
+
+template <typename PointT>
+RecognizedObject
+TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster)
+{
+  using Clock = std::chrono::steady_clock;
+  const auto ms = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  RecognizedObject object;
+  object.cluster = std::move(cluster);
+  auto t = Clock::now();
+  if (classifier_) {
+    object.evidence.p_cylinder = classifier_->cylinderProbability(makeView(object.cluster));
+    const auto t1 = Clock::now();
+    timing_.classification += ms(t, t1);
+    t = t1;
+    if (object.evidence.p_cylinder < params_.decision.min_probability)
+      return object; // rejected before fitting
+  }
+  const FitInput input = prepareFit(object.cluster);
+  Fit best = fitWithRetries(input);
+  if (best.evidence.fitted) {
+    best.evidence.p_cylinder = object.evidence.p_cylinder;
+    object.evidence = best.evidence;
+    object.cylinder = std::move(best.model);
+    for (auto& i : object.cylinder.inliers)
+      i = input.subset[static_cast<std::size_t>(i)];
+    object.is_cylinder = acceptCylinder(object.evidence, params_.decision);
+  }
+  timing_.fitting += ms(t, Clock::now());
+  return object;
+}
+
+template <typename PointT>
+typename TabletopCylinderRecognizer<PointT>::FitInput
+TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
+{
+  FitInput in;
+  in.subset = evenSubsample(cluster.indices.indices, params_.max_fit_points);
+  in.points.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  in.points->reserve(in.subset.size());
+  for (const auto i : in.subset) {
+    const auto& p = (*input_)[i];
+    in.points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  }
+  in.cues.reset(new pcl::PointCloud<NormalCurvature>);
+  cues_estimation_.setInputCloud(in.points);
+  cues_estimation_.compute(*in.cues);
+  // Points with a normal, as columns (the estimator's inliers skip the rest).
+  const auto n = static_cast<Eigen::Index>(in.points->size());
+  in.columns.resize(3, n);
+  in.normals.resize(3, n);
+  in.column_of.assign(in.points->size(), -1);
+  Eigen::Index m = 0;
+  for (std::size_t k = 0; k < in.points->size(); ++k) {
+    const auto& c = (*in.cues)[k];
+    if (!pcl::isFinite((*in.points)[k]) || !std::isfinite(c.normal_x))
+      continue;
+    in.columns.col(m) = (*in.points)[k].getVector3fMap();
+    in.normals.col(m) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
+    in.column_of[k] = static_cast<pcl::index_t>(m++);
+  }
+  in.columns.conservativeResize(3, m);
+  in.normals.conservativeResize(3, m);
+  return in;
+}
+
+template <typename PointT>
+typename TabletopCylinderRecognizer<PointT>::Fit
+TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input, std::size_t estimator)
+{
+  Fit f;
+  auto& hough = estimators_[estimator];
+  hough.setInputCloud(input.points);
+  hough.setInputNormals(input.cues);
+  std::vector<CylinderModel> models;
+  if (!hough.segment(models) || models.empty())
+    return f;
+  f.model = std::move(models.front());
+  CylinderEvidence& e = f.evidence;
+  e.fitted = true;
+  e.inlier_ratio = f.model.inlier_ratio;
+  e.angular_coverage = f.model.angular_coverage;
+  e.curvature_ratio = curvatureRatio(*input.cues, f.model.inliers);
+  // The surface ratio: lateral inliers, plus the points on the caps and on the inner wall.
+  CylinderModel in_columns = f.model;
+  for (auto& i : in_columns.inliers)
+    i = input.column_of[static_cast<std::size_t>(i)];
+  const std::size_t caps =
+    countCapPoints(in_columns, input.columns, input.normals, 2.f * f.model.distance_threshold,
+                   params_.hough.normal_angle_threshold);
+  const std::size_t inner = params_.hough.outward_normals
+                              ? countInnerWallPoints(in_columns, input.columns, input.normals,
+                                                     params_.hough.normal_angle_threshold, 0.8f)
+                              : 0;
+  e.surface_ratio = std::min(1.f, e.inlier_ratio + static_cast<float>(caps + inner) /
+                                                     static_cast<float>(input.points->size()));
+  f.accepted = acceptCylinder(e, params_.decision);
+  return f;
+}
+
+template <typename PointT>
+typename TabletopCylinderRecognizer<PointT>::Fit
+TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input)
+{
+  Fit best = fitOnce(input, 0);
+  for (std::size_t e = 1; e < estimators_.size() && !best.accepted; ++e) {
+    Fit f = fitOnce(input, e);
+    if (f.evidence.fitted &&
+        (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
+         !best.evidence.fitted))
+      best = std::move(f);
+  }
+  return best;
 }
 
 template <typename PointT>

@@ -1,0 +1,124 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * What decides that a fitted object is a cylinder: the evidence of a fit and the one rule
+ * (acceptCylinder) that the recognizer, the tools and the evaluators all call.
+ */
+#pragma once
+
+#include <facyl/features/point_types.h>
+#include <facyl/sample_consensus_alt/cylinder_model.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/types.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace facyl {
+
+/** \brief The decision rule's settings. */
+struct CylinderDecision {
+  /** The fit score: the paper's inlier ratio (eq. 4), or the surface ratio, which also counts
+   * the points on the fitted cylinder's end caps and inner wall as explained. */
+  enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
+  float min_score{0.5f};            ///< score at least this, in [0, 1]
+  float min_probability{0.5f};      ///< classifier probability at least this, in [0, 1]
+  /** The inliers' curvature ratio at most this, in (0, 1]; 1 turns the check off. Rejects
+   * most spheres and bowls. */
+  float max_curvature_ratio{0.35f};
+  /** The inliers cover at least this share of the circumference, in [0, 1] (a camera sees
+   * about half of a cylinder; a large cylinder fitted to a shallow arc covers less). */
+  float min_angular_coverage{0.2f};
+};
+
+/** \brief Checks \a decision. \return an empty string, or what is wrong. */
+std::string
+validate(const CylinderDecision& decision);
+
+/** \brief What the decision looks at for one object. */
+struct CylinderEvidence {
+  bool fitted{false};      ///< a cylinder was fitted
+  /** Classifier probability of "cylinder"; NaN without a classifier (or when it cannot tell). */
+  float p_cylinder{std::numeric_limits<float>::quiet_NaN()};
+  float inlier_ratio{0.f}; ///< paper eq. 4 on the points fitted
+  /** (lateral inliers + points on the end caps + points on the inner wall of an open
+   * container) / points fitted */
+  float surface_ratio{0.f};
+  /** Median |k_min| / median |k_max| over the lateral inliers: near 0 on a cylinder, near 1
+   * on a sphere or bowl; NaN when unknown. */
+  float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
+  float angular_coverage{0.f}; ///< share of the circumference with inliers
+
+  /** \brief The score \a decision uses. */
+  float
+  score(const CylinderDecision& decision) const
+  {
+    return decision.score == CylinderDecision::Score::SurfaceRatio ? surface_ratio
+                                                                   : inlier_ratio;
+  }
+};
+
+/** \brief The decision: fitted, p_cylinder >= min_probability when known, score >= min_score,
+ * curvature ratio <= max_curvature_ratio (when known) and angular coverage >=
+ * min_angular_coverage. */
+bool
+acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
+
+/** \brief Median |k_min| / median |k_max| of \a cues over \a inliers (indices into cues):
+ * 0 on an ideal cylinder, 1 on a sphere. NaN when no inlier has finite curvatures; 1 when the
+ * median |k_max| is 0. */
+float
+curvatureRatio(const pcl::PointCloud<NormalCurvature>& cues, const pcl::Indices& inliers);
+
+/** \brief True if \a p (unit normal \a n) lies on an end cap of \a model: within \a distance
+ * of the plane through model.base or model.top normal to the axis, at most radius +
+ * \a distance from the axis, with a normal within acos(\a cos_max) of the axis. */
+bool
+onCap(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+      float distance, float cos_max);
+
+/** \brief True if \a p (unit normal \a n) lies on the inner wall of \a model seen as an open
+ * container (a cup's inside, seen through its opening): between inner_ratio x radius and the
+ * radius from the axis, within the axial extent, with a normal within acos(\a cos_max) of
+ * pointing at the axis. */
+bool
+onInnerWall(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+            float cos_max, float inner_ratio);
+
+/** \brief Number of \a points (3 x n, unit \a normals alongside) on an end cap of \a model
+ * (onCap with cos(max_angle)). Points listed in model.inliers (column indices, ascending) are
+ * not counted. */
+std::size_t
+countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, float distance, float max_angle);
+
+/** \brief Number of \a points (with unit \a normals) on the inner wall of \a model
+ * (onInnerWall with cos(max_angle)). Points in model.inliers are not counted. */
+std::size_t
+countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                     const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio);
+
+/** \brief Which points a cylinder explains, for handing a cylinder found in a larger cluster
+ * its own points. */
+struct ExplainSettings {
+  float distance{0.005f};  ///< lateral: |distance to the surface| at most this; caps: 2x
+  float max_angle{0.6f};   ///< rad: normal vs the surface's normal (lateral, caps)
+  bool outward{true};      ///< lateral normals must point away from the axis
+  bool inner_wall{true};   ///< count the inner wall of an open container
+  float inner_ratio{0.8f}; ///< see onInnerWall
+  float axial_margin{0.01f}; ///< lateral points may lie this far beyond base and top
+};
+
+/** \brief Flags (1: explained) of the columns of \a points on \a model's lateral surface
+ * (within its axial extent grown by the margin), on its end caps, or on its inner wall.
+ * \param normals unit normals alongside the points, or an empty matrix: every point is then
+ *        judged by its position alone. */
+std::vector<std::uint8_t>
+explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                const Eigen::Matrix3Xf& normals, const ExplainSettings& settings);
+
+} // namespace facyl
