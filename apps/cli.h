@@ -105,6 +105,29 @@ private:
   std::vector<std::string> positional_;
 };
 
+/** "A,B" option as two numbers (\a a, \a b when absent). */
+inline std::pair<double, double>
+pairOption(const Arguments& args, const std::string& name, double a, double b)
+{
+  const std::string text = args.text(name, "");
+  if (text.empty())
+    return {a, b};
+  std::istringstream in(text);
+  char comma = 0;
+  if (!(in >> a >> comma >> b) || comma != ',' || !in.eof() || !std::isfinite(a) ||
+      !std::isfinite(b))
+    throw std::invalid_argument("option " + name + ": expected A,B, got '" + text + "'");
+  return {a, b};
+}
+
+/** The union of option name sets. */
+inline std::set<std::string>
+joined(std::set<std::string> a, const std::set<std::string>& b)
+{
+  a.insert(b.begin(), b.end());
+  return a;
+}
+
 /** True if -h or --help is among the arguments. */
 inline bool
 wantsHelp(int argc, char** argv)

@@ -4,6 +4,7 @@
  */
 #include "cli.h"
 #include "pcd_input.h"
+#include "recognizer_options.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
@@ -28,54 +29,18 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [options] SCENE.pcd...\n"
-    "Finds the table, the objects on it and the cylinders among them; prints one JSON object\n"
-    "per scene. Organized clouds (RGB-D frames) and unorganized clouds are accepted.\n"
-    "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C and\n"
-    "angular coverage >= V):\n"
-    "  --score S              surface (default: lateral inliers + points on the end caps, over\n"
-    "                         all points) | inlier (the paper's eq. 4 inlier ratio)\n"
-    "  --min-inlier-ratio R   score threshold (default 0.5)\n"
-    "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
-    "                         (default 0.35; 1 turns the check off)\n"
-    "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
-    "  --no-retry             no second fit with upright/lying priors when the first fails\n"
-    "  --retry-inside         a last retry also fits concave clusters (the inside of an open\n"
-    "                         container; bowls too)\n"
-    "  --any-normal-sign      inliers' normals may point at the axis (default: away from it)\n"
-    "Fit:\n"
-    "  --prior P              orientation prior in the table frame: uniform | vertical (default)\n"
-    "                         | vertical-strong | horizontal\n"
-    "  --radius-limits A,B    radius interval in m (default 0.01,0.25)\n"
-    "  --orientations N       accumulator cells (default 450)\n"
-    "  --max-fit-points N     clusters are subsampled to N points for the fit (default 1200)\n"
-    "  --neighbours K         k of the normal/curvature estimation (default 16)\n"
-    "  --seed S               accumulator seed (default 0)\n"
-    "Segmentation:\n"
-    "  --plane-distance D     table inlier distance in m (default 0.015)\n"
-    "  --height-limits A,B    object points lie A..B m above the table (default 0.01,0.5)\n"
-    "  --cluster-tolerance D  Euclidean cluster tolerance in m (default 0.02)\n"
-    "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n"
-    "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
+    "Finds the supports (tables), the objects on them and the cylinders among them; prints\n"
+    "one JSON object per scene. Organized clouds (RGB-D frames) and unorganized clouds are\n"
+    "accepted.\n%s"
     "Output:\n"
+    "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
     "  --overlay PATH         RGB image with boxes (green: cylinder, red: not) and fitted\n"
     "                         outlines; with several scenes PATH is a folder (<stem>.png)\n"
-    "  --save-clusters DIR    each cluster's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
+    "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
-    "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad usage.\n",
-    self);
-}
-
-std::pair<double, double>
-pairOption(const facyl_cli::Arguments& args, const std::string& name, double a, double b)
-{
-  const std::string text = args.text(name, "");
-  if (text.empty())
-    return {a, b};
-  std::istringstream in(text);
-  char comma = 0;
-  if (!(in >> a >> comma >> b) || comma != ',' || !in.eof())
-    throw std::invalid_argument("option " + name + ": expected A,B, got '" + text + "'");
-  return {a, b};
+    "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad "
+    "usage.\n",
+    self, facyl_cli::recognizerOptionsHelp());
 }
 
 // ---- drawing on an RGB buffer ----
@@ -142,6 +107,7 @@ stemOf(const std::string& file)
 struct Settings {
   facyl::TabletopRecognizerParameters params;
   facyl::PinholeCamera camera;
+  Eigen::Vector3f up{Eigen::Vector3f::Zero()};
   std::string overlay, clusters_dir;
   int repeat{1};
   bool many{false};
@@ -178,7 +144,8 @@ writeObject(std::ostream& out, std::size_t id, const facyl::RecognizedObject& o)
   const auto optional = [](float v) {
     return std::isfinite(v) ? facyl_cli::number(v) : std::string("null");
   };
-  out << "{\"id\":" << id << ",\"centroid\":" << facyl_cli::vector(o.cluster.centroid)
+  out << "{\"id\":" << id << ",\"support\":" << o.cluster.support
+      << ",\"centroid\":" << facyl_cli::vector(o.cluster.centroid)
       << ",\"n_points\":" << o.cluster.indices.indices.size() << ",\"bbox\":";
   if (b[0] < 0)
     out << "null";
@@ -207,11 +174,20 @@ writeScene(std::ostream& out, const std::string& file, const Cloud& cloud,
            const std::vector<facyl::RecognizedObject>& objects,
            const facyl::RecognitionTiming& t)
 {
+  const auto plane = [](const Eigen::Vector4f& c) {
+    return "[" + facyl_cli::number(c[0]) + "," + facyl_cli::number(c[1]) + "," +
+           facyl_cli::number(c[2]) + "," + facyl_cli::number(c[3]) + "]";
+  };
+  const auto& supports = rec.getSupports();
   const auto& tc = rec.getTableCoefficients().values;
   out << "{\"file\":" << facyl_cli::quote(file) << ",\"organized\":"
-      << (cloud.isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":["
-      << facyl_cli::number(tc[0]) << "," << facyl_cli::number(tc[1]) << ","
-      << facyl_cli::number(tc[2]) << "," << facyl_cli::number(tc[3]) << "]},\"objects\":[";
+      << (cloud.isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":"
+      << plane(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3]))
+      << ",\"found\":" << (rec.tableFound() ? "true" : "false") << "},\"supports\":[";
+  for (std::size_t k = 0; k < supports.size(); ++k)
+    out << (k ? "," : "") << "{\"coefficients\":" << plane(supports[k].plane)
+        << ",\"objects\":" << supports[k].objects << "}";
+  out << "],\"objects\":[";
   for (std::size_t k = 0; k < objects.size(); ++k) {
     out << (k ? "," : "");
     writeObject(out, k, objects[k]);
@@ -322,12 +298,13 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
   rec.setParameters(s.params);
   rec.setCamera(s.camera);
+  rec.setUpDirection(s.up);
   rec.setInputCloud(cloud);
   std::vector<facyl::RecognizedObject> objects;
   std::vector<facyl::RecognitionTiming> timings;
   for (int r = 0; r < s.repeat; ++r) {
     if (!rec.recognize(objects))
-      return fail("no table found: no plane with enough points (see the message above)");
+      return fail("no table found: no large plane (see the message above)");
     timings.push_back(rec.getTiming());
   }
   // Median over the repetitions, by total.
@@ -358,49 +335,13 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   Settings s;
   const facyl_cli::Arguments args(
     argc, argv,
-    {"--min-inlier-ratio", "--score", "--max-curvature-ratio", "--prior", "--radius-limits",
-     "--orientations", "--max-fit-points", "--neighbours", "--seed", "--plane-distance",
-     "--height-limits", "--cluster-tolerance", "--cluster-size", "--camera", "--overlay",
-     "--save-clusters", "--repeat", "--min-coverage"},
-    {"--no-retry", "--retry-inside", "--any-normal-sign"});
+    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                      {"--camera", "--overlay", "--save-clusters", "--repeat"}),
+    facyl_cli::recognizerSwitches());
   files = args.positional();
   if (files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
-  auto& p = s.params;
-  auto& d = p.decision;
-  d.min_score = static_cast<float>(args.number("--min-inlier-ratio", d.min_score));
-  const std::string score = args.text("--score", "surface");
-  if (score != "surface" && score != "inlier")
-    throw std::invalid_argument("--score must be surface or inlier");
-  d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
-                               : facyl::CylinderDecision::Score::InlierRatio;
-  d.max_curvature_ratio =
-    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
-  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
-  p.retry_upright_lying = !args.has("--no-retry");
-  p.retry_any_normal_sign = args.has("--retry-inside");
-  p.hough.outward_normals = !args.has("--any-normal-sign");
-  if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
-    throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
-  const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
-  p.hough.radius_min = static_cast<float>(radii.first);
-  p.hough.radius_max = static_cast<float>(radii.second);
-  p.orientations = static_cast<std::size_t>(args.integer("--orientations", 450, 10));
-  p.max_fit_points = static_cast<std::size_t>(args.integer("--max-fit-points", 1200, 50));
-  p.neighbours = static_cast<int>(args.integer("--neighbours", 16, 5));
-  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
-  auto& g = p.segmentation;
-  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance));
-  const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
-  g.min_height = static_cast<float>(heights.first);
-  g.max_height = static_cast<float>(heights.second);
-  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance));
-  const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
-                                static_cast<double>(g.max_cluster_size));
-  if (!(sizes.first >= 1 && sizes.second >= sizes.first))
-    throw std::invalid_argument("--cluster-size: expected 1 <= A <= B");
-  g.min_cluster_size = static_cast<std::size_t>(sizes.first);
-  g.max_cluster_size = static_cast<std::size_t>(sizes.second);
+  facyl_cli::applyRecognizerOptions(args, s.params, s.up);
   if (args.has("--camera")) {
     std::istringstream in(args.text("--camera", ""));
     char c1 = 0, c2 = 0, c3 = 0;
@@ -415,9 +356,6 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.clusters_dir = args.text("--save-clusters", "");
   s.repeat = static_cast<int>(args.integer("--repeat", 1, 1));
   s.many = files.size() > 1;
-  const std::string why = facyl::validate(p);
-  if (!why.empty())
-    throw std::invalid_argument(why);
   if (!s.many && !s.overlay.empty()) {
     const auto parent = std::filesystem::path(s.overlay).parent_path();
     if (!parent.empty() && !std::filesystem::is_directory(parent))

@@ -6,6 +6,7 @@
  * Prints figures (markdown) and, with --csv FILE, one row per object.
  */
 #include "cli.h"
+#include "recognizer_options.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/segmentation_score.h>
@@ -197,6 +198,7 @@ timingReport(const std::vector<facyl::RecognitionTiming>& t)
 }
 
 struct Options {
+  Eigen::Vector3f up{Eigen::Vector3f::Zero()};
   std::size_t sim{0};
   std::uint64_t seed{1000};
   bool cluttered{false};
@@ -213,8 +215,8 @@ public:
       return;
     out_.open(path);
     out_ << "set,scene,object,kind,pose,positive,touching,found,pieces,recovered,iou,merged,"
-            "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,radius,"
-            "true_radius,axis_error_deg\n";
+            "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,arc_gap,taper,"
+            "radius,true_radius,axis_error_deg\n";
   }
   void
   write(const std::string& set, const std::vector<Row>& rows)
@@ -228,7 +230,7 @@ public:
            << r.segment.recovered << "," << r.segment.best_iou << "," << r.segment.merged << ","
            << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << ","
            << e.surface_ratio << "," << e.curvature_ratio << "," << e.angular_coverage << ","
-           << r.radius << "," << r.true_radius << "," << r.axis_error_deg << "\n";
+           << e.arc_gap << "," << e.taper << "," << r.radius << "," << r.true_radius << "," << r.axis_error_deg << "\n";
     }
   }
 
@@ -345,8 +347,14 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       timing.push_back(rec.getTiming());
     const auto& c = rec.getTableCoefficients().values;
     if (Eigen::Vector3f(c[0], c[1], c[2]).dot(scene.table_plane.head<3>()) < std::cos(0.1f) ||
-        std::abs(c[3] - scene.table_plane[3]) > 0.03f)
+        std::abs(c[3] - scene.table_plane[3]) > 0.03f) {
       ++wrong_plane;
+      std::fprintf(stderr, "scene %llu: table (%.3f %.3f %.3f %.3f) is not the true one "
+                           "(%.3f %.3f %.3f %.3f)\n",
+                   static_cast<unsigned long long>(sp.seed), c[0], c[1], c[2], c[3],
+                   scene.table_plane[0], scene.table_plane[1], scene.table_plane[2],
+                   scene.table_plane[3]);
+    }
     const std::vector<int> truth = truthVector(*cloud, [&](std::size_t i) {
       return scene.object_id[i] >= 2 ? static_cast<int>(scene.object_id[i]) : 0;
     });
@@ -567,16 +575,14 @@ void
 printHelp(const char* self)
 {
   std::printf(
-    "Usage: %s [--sim N] [--seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
-    "          [--mosd DIR] [--score inlier|surface] [--threshold R]\n"
-    "          [--max-curvature-ratio C] [--min-coverage V] [--no-retry] [--retry-inside]\n"
-    "          [--any-normal-sign] [--normal-angle A] [--distance D] [--csv FILE]\n"
+    "Usage: %s [--sim N] [--first-seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
+    "          [--mosd DIR] [--csv FILE] [recognizer options]\n"
     "Runs TabletopCylinderRecognizer on N simulated scenes (seeds S.., default 1000) and/or\n"
     "the mOSD learn scenes and prints: segmentation (objects recovered as one segment with\n"
     "IoU >= 0.5, merged, split; in simulation also for the objects touching another), cylinder\n"
     "precision/recall for both scores at several thresholds, radius and axis errors of the\n"
-    "detected cylinders, and the stage timing. Decision settings as in facyl_detect.\n",
-    self);
+    "detected cylinders, and the stage timing. --csv writes one row per object.\n%s",
+    self, facyl_cli::recognizerOptionsHelp());
 }
 
 Options
@@ -585,13 +591,13 @@ parseOptions(int argc, char** argv)
   Options opt;
   const facyl_cli::Arguments args(
     argc, argv,
-    {"--sim", "--seed", "--layout", "--sensor", "--mosd", "--score", "--threshold", "--csv",
-     "--normal-angle", "--distance", "--max-curvature-ratio", "--min-coverage"},
-    {"--no-retry", "--retry-inside", "--any-normal-sign"});
+    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                      {"--sim", "--first-seed", "--layout", "--sensor", "--mosd", "--csv"}),
+    facyl_cli::recognizerSwitches());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
   opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
-  opt.seed = static_cast<std::uint64_t>(args.integer("--seed", 1000, 0));
+  opt.seed = static_cast<std::uint64_t>(args.integer("--first-seed", 1000, 0));
   const std::string layout = args.text("--layout", "spread");
   if (layout != "spread" && layout != "cluttered")
     throw std::invalid_argument("--layout must be spread or cluttered");
@@ -602,27 +608,7 @@ parseOptions(int argc, char** argv)
     throw std::invalid_argument("--sensor must be kinect or stereo");
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");
-  auto& p = opt.params;
-  auto& d = p.decision;
-  const std::string score = args.text("--score", "surface");
-  if (score != "inlier" && score != "surface")
-    throw std::invalid_argument("--score must be inlier or surface");
-  d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
-                               : facyl::CylinderDecision::Score::InlierRatio;
-  d.min_score = static_cast<float>(args.number("--threshold", d.min_score));
-  d.max_curvature_ratio =
-    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
-  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
-  p.hough.normal_angle_threshold =
-    static_cast<float>(args.number("--normal-angle", p.hough.normal_angle_threshold));
-  p.hough.distance_threshold =
-    static_cast<float>(args.number("--distance", p.hough.distance_threshold));
-  p.retry_upright_lying = !args.has("--no-retry");
-  p.retry_any_normal_sign = args.has("--retry-inside");
-  p.hough.outward_normals = !args.has("--any-normal-sign");
-  const std::string why = facyl::validate(p);
-  if (!why.empty())
-    throw std::invalid_argument(why);
+  facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
   if (opt.sim == 0 && opt.mosd.empty())
     throw std::invalid_argument("give --sim N and/or --mosd DIR");
   return opt;
@@ -648,6 +634,7 @@ main(int argc, char** argv)
   CsvWriter csv(opt.csv);
   Recognizer rec;
   rec.setParameters(opt.params);
+  rec.setUpDirection(opt.up);
   int status = 0;
   if (opt.sim > 0)
     status = std::max(status, evaluateSimulated(opt, rec, csv));

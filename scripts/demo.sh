@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # New user, step 1: install what is needed, build (Release), and find every cylinder on the
-# table of the bundled RGB-D frame (data/default_scene.pcd, rendered by facyl_synth --seed 1).
+# table of the bundled RGB-D frame (data/default_scene.pcd, rendered by facyl_synth --layout cluttered --seed 20).
 # Writes build/default_scene_overlay.png. Any arguments are passed to facyl_detect instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 namespace facyl {
@@ -21,6 +22,10 @@ validate(const CylinderDecision& d)
     s << "min_angular_coverage " << d.min_angular_coverage << " must be in [0, 1]";
   else if (!(d.min_probability >= 0.f && d.min_probability <= 1.f))
     s << "min_probability " << d.min_probability << " must be in [0, 1]";
+  else if (!(d.max_arc_gap >= 0.f && d.max_arc_gap <= 1.f))
+    s << "max_arc_gap " << d.max_arc_gap << " must be in [0, 1]";
+  else if (!(d.max_taper > 0.f && d.max_taper <= 1.f))
+    s << "max_taper " << d.max_taper << " must be in (0, 1]";
   return s.str();
 }
 
@@ -29,7 +34,8 @@ acceptCylinder(const CylinderEvidence& e, const CylinderDecision& d)
 {
   return e.fitted && !(e.p_cylinder < d.min_probability) && e.score(d) >= d.min_score &&
          !(e.curvature_ratio > d.max_curvature_ratio) &&
-         e.angular_coverage >= d.min_angular_coverage;
+         e.angular_coverage >= d.min_angular_coverage && !(e.arc_gap > d.max_arc_gap) &&
+         !(e.taper > d.max_taper);
 }
 
 float
@@ -71,6 +77,13 @@ length(const CylinderModel& m)
 {
   return (m.top - m.base).dot(m.axis.normalized());
 }
+/** Half-thickness of the slab around base and top where caps are looked for: lids sit a
+ * little below a can's rim, and the ends are estimated from the lateral inliers. */
+float
+capSlab(const CylinderModel& m, float distance)
+{
+  return std::max(distance, 0.1f * m.radius);
+}
 
 /** Counts the columns of \a points not in model.inliers (ascending) for which test(i) holds. */
 template <typename Test>
@@ -95,7 +108,8 @@ onCap(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3
 {
   const AxialPosition x = axial(model, p);
   const float h = length(model);
-  const bool on_plane = std::abs(x.t) <= distance || std::abs(x.t - h) <= distance;
+  const float slab = capSlab(model, distance);
+  const bool on_plane = std::abs(x.t) <= slab || std::abs(x.t - h) <= slab;
   return on_plane && x.radial.norm() <= model.radius + distance &&
          std::abs(n.dot(model.axis.normalized())) >= cos_max;
 }
@@ -132,13 +146,14 @@ countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   });
 }
 
-std::vector<std::uint8_t>
+std::vector<Explained>
 explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
                 const Eigen::Matrix3Xf& normals, const ExplainSettings& s)
 {
   const bool with_normals = normals.cols() == points.cols();
   const float cos_max = std::cos(s.max_angle), h = length(model), d = s.distance;
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(points.cols()), 0);
+  const Eigen::Vector3f a = model.axis.normalized();
+  std::vector<Explained> out(static_cast<std::size_t>(points.cols()), Explained::No);
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const AxialPosition x = axial(model, points.col(i));
     const float rho = x.radial.norm();
@@ -150,18 +165,171 @@ explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
       const float along = n.dot(x.radial);
       lateral = (s.outward ? along : std::abs(along)) >= cos_max * rho;
     }
-    bool cap = false, inner = false;
-    if (!lateral) {
-      const bool on_plane = std::abs(x.t) <= 2.f * d || std::abs(x.t - h) <= 2.f * d;
-      cap = on_plane && rho <= model.radius + 2.f * d &&
-            (!normal_known || std::abs(n.dot(model.axis.normalized())) >= cos_max);
-      inner = s.inner_wall && x.t >= 0.f && x.t <= h && rho <= model.radius &&
-              rho >= s.inner_ratio * model.radius &&
-              (!normal_known || -n.dot(x.radial) >= cos_max * rho);
+    auto& e = out[static_cast<std::size_t>(i)];
+    if (lateral) {
+      e = Explained::Lateral;
+      continue;
     }
-    out[static_cast<std::size_t>(i)] = lateral || cap || inner;
+    const float slab = capSlab(model, 2.f * d);
+    const bool on_plane = std::abs(x.t) <= slab || std::abs(x.t - h) <= slab;
+    if (on_plane && rho <= model.radius + 2.f * d &&
+        (!normal_known || std::abs(n.dot(a)) >= cos_max))
+      e = Explained::Cap;
+    else if (s.inner_wall && x.t >= 0.f && x.t <= h && rho <= model.radius &&
+             rho >= s.inner_ratio * model.radius &&
+             (!normal_known || -n.dot(x.radial) >= cos_max * rho))
+      e = Explained::InnerWall;
   }
   return out;
+}
+
+float
+taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive)
+{
+  const Eigen::Vector3f a = model.axis.normalized();
+  std::vector<float> t, rho;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    if (!alive.empty() && !alive[static_cast<std::size_t>(i)])
+      continue;
+    const AxialPosition x = axial(model, points.col(i));
+    const float r = x.radial.norm();
+    if (r < 0.5f * model.radius || r > 1.5f * model.radius ||
+        std::abs(normals.col(i).dot(a)) > 0.7071f)
+      continue;
+    t.push_back(x.t);
+    rho.push_back(r);
+  }
+  const auto fit = [&](const std::vector<std::uint8_t>& use, float& slope, float& offset) {
+    double n = 0, st = 0, sr = 0, stt = 0, str = 0;
+    for (std::size_t k = 0; k < t.size(); ++k)
+      if (use[k]) {
+        n += 1, st += t[k], sr += rho[k], stt += double(t[k]) * t[k], str += double(t[k]) * rho[k];
+      }
+    const double var = stt - st * st / std::max(n, 1.0);
+    if (n < 20 || !(var > 1e-10 * n))
+      return false;
+    slope = static_cast<float>((str - st * sr / n) / var);
+    offset = static_cast<float>((sr - slope * st) / n);
+    return true;
+  };
+  std::vector<std::uint8_t> use(t.size(), 1);
+  float slope = 0.f, offset = 0.f;
+  if (!fit(use, slope, offset))
+    return std::numeric_limits<float>::quiet_NaN();
+  // Once more without the outliers (handles, neighbours): residuals beyond 3 robust sigmas.
+  std::vector<float> residual(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k)
+    residual[k] = std::abs(rho[k] - (offset + slope * t[k]));
+  std::vector<float> sorted = residual;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const float cut = 3.f * 1.4826f * sorted[sorted.size() / 2] + 1e-6f;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    use[k] = residual[k] <= cut;
+  if (!fit(use, slope, offset))
+    return std::numeric_limits<float>::quiet_NaN();
+  return std::abs(slope);
+}
+
+float
+convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                    const std::vector<Eigen::Index>& part, const std::vector<Eigen::Index>& rest,
+                    float distance, float tolerance)
+{
+  const float d2 = distance * distance;
+  std::size_t pairs = 0, convex = 0;
+  for (const Eigen::Index a : part)
+    for (const Eigen::Index b : rest) {
+      const Eigen::Vector3f d = points.col(a) - points.col(b);
+      const float n2 = d.squaredNorm();
+      if (n2 > d2 || !(n2 > 0.f))
+        continue;
+      ++pairs;
+      convex += (normals.col(a) - normals.col(b)).dot(d) >= tolerance * std::sqrt(n2);
+    }
+  return pairs ? static_cast<float>(convex) / static_cast<float>(pairs)
+               : std::numeric_limits<float>::quiet_NaN();
+}
+
+float
+arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points)
+{
+  constexpr int sectors = 36;
+  const Eigen::Vector3f a = model.axis.normalized();
+  const Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
+  int count[sectors] = {0};
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f d = points.col(i) - model.base;
+    const float angle = std::atan2(d.dot(e2), d.dot(e1)); // (-pi, pi]
+    const int k = static_cast<int>(std::floor((angle + static_cast<float>(M_PI)) /
+                                              (2.f * static_cast<float>(M_PI)) * sectors));
+    ++count[std::clamp(k, 0, sectors - 1)];
+  }
+  int occupied = 0;
+  for (const int c : count)
+    occupied += c >= 2;
+  if (occupied < 2)
+    return 0.f;
+  // Empty runs around the circle; the longest one is outside the span, the next is the gap.
+  std::vector<int> runs;
+  int start = 0;
+  while (count[start] >= 2)
+    ++start; // an empty sector to start from (occupied < sectors or there is no gap)
+  for (int k = 0, run = 0; k <= sectors; ++k) {
+    const bool empty = k < sectors && count[(start + k) % sectors] < 2;
+    if (empty)
+      ++run;
+    else if (run > 0) {
+      runs.push_back(run);
+      run = 0;
+    }
+  }
+  if (runs.size() < 2)
+    return 0.f;
+  std::sort(runs.begin(), runs.end(), std::greater<int>());
+  return static_cast<float>(runs[1]) / sectors;
+}
+
+CylinderEvidence
+localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+              const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive,
+              const ExplainSettings& settings, float radial_margin, float axial_margin,
+              float margin, std::vector<Explained>* explained)
+{
+  const std::vector<Explained> why = explainedPoints(model, points, normals, settings);
+  const float reach =
+    model.radius + std::max(radial_margin * model.radius, margin) + 2.f * settings.distance;
+  const float beyond = std::max(axial_margin * model.radius, margin), h = length(model);
+  std::size_t region = 0, lateral = 0, any = 0;
+  std::vector<Eigen::Index> on_surface;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!alive.empty() && !alive[k])
+      continue;
+    const AxialPosition x = axial(model, points.col(i));
+    const bool inside = x.radial.norm() <= reach && x.t >= -beyond && x.t <= h + beyond;
+    if (!inside && why[k] == Explained::No)
+      continue;
+    ++region;
+    if (why[k] == Explained::Lateral) {
+      ++lateral;
+      on_surface.push_back(i);
+    }
+    any += why[k] != Explained::No;
+  }
+  CylinderEvidence e;
+  e.fitted = true;
+  e.angular_coverage = model.angular_coverage;
+  if (region > 0) {
+    e.inlier_ratio = static_cast<float>(lateral) / static_cast<float>(region);
+    e.surface_ratio = static_cast<float>(any) / static_cast<float>(region);
+  }
+  e.arc_gap = arcGap(model, points(Eigen::all, on_surface));
+  if (normals.cols() == points.cols())
+    e.taper = taperAlongAxis(model, points, normals, alive);
+  if (explained)
+    *explained = why;
+  return e;
 }
 
 } // namespace facyl

@@ -23,10 +23,18 @@ validate(const TabletopRecognizerParameters& p)
   std::ostringstream s;
   if (p.orientations < 10)
     s << "orientations " << p.orientations << " must be >= 10";
+  else if (!(p.fit_point_angle >= 0.f && p.fit_point_angle <= 0.1f))
+    s << "fit_point_angle " << p.fit_point_angle << " must be in [0, 0.1] rad";
   else if (p.max_fit_points < 50)
     s << "max_fit_points " << p.max_fit_points << " must be >= 50";
   else if (p.neighbours < 5)
     s << "neighbours " << p.neighbours << " must be >= 5";
+  else if (p.max_cylinders_per_cluster < 1 || p.max_cylinders_per_cluster > 20)
+    s << "max_cylinders_per_cluster " << p.max_cylinders_per_cluster << " must be in [1, 20]";
+  else if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))
+    s << "min_explained_share " << p.min_explained_share << " must be in (0, 1]";
+  else if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))
+    s << "recovery_margin " << p.recovery_margin << " must be in [0, 1] m";
   return s.str();
 }
 
@@ -42,6 +50,17 @@ evenSubsample(const pcl::Indices& indices, std::size_t max_count)
   const double step = static_cast<double>(indices.size()) / static_cast<double>(max_count);
   for (std::size_t k = 0; k < max_count; ++k)
     out.push_back(indices[static_cast<std::size_t>(static_cast<double>(k) * step)]);
+  return out;
+}
+
+pcl::Indices
+pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride)
+{
+  pcl::Indices out;
+  const auto w = static_cast<pcl::index_t>(width);
+  for (const auto i : indices)
+    if ((i % w) % stride == 0 && (i / w) % stride == 0)
+      out.push_back(i);
   return out;
 }
 

@@ -31,6 +31,16 @@ validate(const TabletopSegmentationParameters& p)
     why << "plane step " << p.plane_step << " must be in [1, 16]";
   else if (p.plane_samples < 100)
     why << "plane_samples " << p.plane_samples << " must be >= 100";
+  else if (p.max_planes < 1 || p.max_planes > 8)
+    why << "max_planes " << p.max_planes << " must be in [1, 8]";
+  else if (!(p.max_support_tilt > 0.f && p.max_support_tilt < 1.58f))
+    why << "max_support_tilt " << p.max_support_tilt << " must be in (0, pi/2]";
+  else if (!(p.min_support_area >= 0.f) || !std::isfinite(p.min_support_area))
+    why << "min_support_area must be >= 0";
+  else if (!(p.contact_height > 0.f) || !std::isfinite(p.contact_height))
+    why << "contact_height must be > 0";
+  else if (const std::string o = validate(p.objects); !o.empty())
+    why << "objects: " << o;
   return why.str();
 }
 

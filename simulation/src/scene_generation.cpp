@@ -2,6 +2,7 @@
  * facyl: fast cylinder detection for PCL.
  * Random tabletop scenes: table, objects (apart, touching, stacked, leaning) and camera.
  */
+#include <facyl/features/polygon.h>
 #include <facyl/simulation/random.h>
 #include <facyl/simulation/tabletop_scene.h>
 
@@ -52,34 +53,6 @@ struct Footprint {
   std::vector<Eigen::Vector2f> hull; ///< counter-clockwise
   float z0{0.f}, z1{0.f};
 };
-
-std::vector<Eigen::Vector2f>
-convexHull(std::vector<Eigen::Vector2f> p)
-{
-  std::sort(p.begin(), p.end(), [](const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  if (p.size() < 3)
-    return p;
-  const auto cross = [](const Eigen::Vector2f& o, const Eigen::Vector2f& a,
-                        const Eigen::Vector2f& b) {
-    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
-  };
-  std::vector<Eigen::Vector2f> h(2 * p.size());
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0.f)
-      --k;
-    h[k++] = p[i];
-  }
-  for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0.f)
-      --k;
-    h[k++] = p[i];
-  }
-  h.resize(k - 1);
-  return h;
-}
 
 /** Points that bound the object's shape, in its local frame. */
 std::vector<Eigen::Vector3f>
@@ -150,7 +123,7 @@ footprintOf(const SceneObject& o)
     f.z0 = std::min(f.z0, w.z());
     f.z1 = std::max(f.z1, w.z());
   }
-  f.hull = convexHull(xy);
+  f.hull = convexHull2D(xy);
   return f;
 }
 

@@ -33,6 +33,14 @@ struct CylinderDecision {
   /** The inliers cover at least this share of the circumference, in [0, 1] (a camera sees
    * about half of a cylinder; a large cylinder fitted to a shallow arc covers less). */
   float min_angular_coverage{0.2f};
+  /** The largest gap inside the arc of the circumference that the inliers span, as a share
+   * of the circumference, at most this (when known: cylinders found inside larger clusters).
+   * A thin cylinder fitted to the edge of a box has inliers only near its two tangent lines. */
+  float max_arc_gap{0.1f};
+  /** The surface's radius changes along the axis by at most this much per unit of length
+   * (tan of the half-angle: 0.15 is 8.5 degrees): a cylinder fits a band of a cone, but the
+   * cone's radius keeps changing beyond it. Slightly tapered cups pass; 1 turns it off. */
+  float max_taper{0.15f};
 };
 
 /** \brief Checks \a decision. \return an empty string, or what is wrong. */
@@ -52,6 +60,12 @@ struct CylinderEvidence {
    * on a sphere or bowl; NaN when unknown. */
   float curvature_ratio{std::numeric_limits<float>::quiet_NaN()};
   float angular_coverage{0.f}; ///< share of the circumference with inliers
+  /** Largest empty arc inside the span of the inliers, share of the circumference; NaN when
+   * unknown. */
+  float arc_gap{std::numeric_limits<float>::quiet_NaN()};
+  /** |d radius / d axial position| of the side surface around the fit (0 on a cylinder,
+   * tan(half-angle) on a cone); NaN when unknown. */
+  float taper{std::numeric_limits<float>::quiet_NaN()};
 
   /** \brief The score \a decision uses. */
   float
@@ -63,8 +77,8 @@ struct CylinderEvidence {
 };
 
 /** \brief The decision: fitted, p_cylinder >= min_probability when known, score >= min_score,
- * curvature ratio <= max_curvature_ratio (when known) and angular coverage >=
- * min_angular_coverage. */
+ * curvature ratio <= max_curvature_ratio (when known), angular coverage >=
+ * min_angular_coverage, arc gap <= max_arc_gap and taper <= max_taper (both when known). */
 bool
 acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
@@ -74,9 +88,10 @@ acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decisio
 float
 curvatureRatio(const pcl::PointCloud<NormalCurvature>& cues, const pcl::Indices& inliers);
 
-/** \brief True if \a p (unit normal \a n) lies on an end cap of \a model: within \a distance
- * of the plane through model.base or model.top normal to the axis, at most radius +
- * \a distance from the axis, with a normal within acos(\a cos_max) of the axis. */
+/** \brief True if \a p (unit normal \a n) lies on an end cap of \a model: within
+ * max(\a distance, 0.1 x radius) of the plane through model.base or model.top normal to the
+ * axis (lids sit a little below a can's rim), at most radius + \a distance from the axis,
+ * with a normal within acos(\a cos_max) of the axis. */
 bool
 onCap(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
       float distance, float cos_max);
@@ -113,12 +128,60 @@ struct ExplainSettings {
   float axial_margin{0.01f}; ///< lateral points may lie this far beyond base and top
 };
 
-/** \brief Flags (1: explained) of the columns of \a points on \a model's lateral surface
- * (within its axial extent grown by the margin), on its end caps, or on its inner wall.
+/** \brief What a cylinder explains a point as. */
+enum class Explained : std::uint8_t { No = 0, Lateral, Cap, InnerWall };
+
+/** \brief For each column of \a points: on \a model's lateral surface (within its axial
+ * extent grown by the margin), on an end cap, on its inner wall, or none of them.
  * \param normals unit normals alongside the points, or an empty matrix: every point is then
  *        judged by its position alone. */
-std::vector<std::uint8_t>
+std::vector<Explained>
 explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
                 const Eigen::Matrix3Xf& normals, const ExplainSettings& settings);
+
+/** \brief How the radius of the side surface around \a model changes along its axis:
+ * |slope| of a robust line fit of the distance to the axis against the position along it, over
+ * the columns of \a points (flagged in \a alive; all when empty) between 0.5 and 1.5 radii
+ * from the axis whose normals are within 45 degrees of perpendicular to it (the side, not the
+ * lids). 0 on a cylinder, tan(half-angle) on a cone. NaN with fewer than 20 such points or no
+ * axial spread.
+ * \param normals unit normals alongside the points */
+float
+taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive);
+
+/** \brief How a part of a cluster meets the rest: over the pairs (a point of the part, a
+ * point of the rest) closer than \a distance, the share that is clearly convex, by the
+ * criterion of LCCP (Stein et al. 2014): (n_a - n_b) . (a - b) >= tolerance |a - b|. Objects
+ * that touch meet at a concave crease, tangentially, or not at all; a part of one object can
+ * continue into the rest convexly (a box edge into its faces). NaN when no pair is that
+ * close.
+ * \param part,rest column indices into \a points (unit \a normals alongside) */
+float
+convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                    const std::vector<Eigen::Index>& part, const std::vector<Eigen::Index>& rest,
+                    float distance, float tolerance);
+
+/** \brief Largest empty arc inside the span of \a points (3 x n) around \a model's axis, as a
+ * share of the circumference, on 36 sectors (a sector holds at least 2 points to count): 0
+ * for a contiguous arc, larger where the points sit at two separate angles. 0 for fewer than
+ * 2 occupied sectors. */
+float
+arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points);
+
+/** \brief Evidence for a cylinder found inside a larger cluster, judged on the points around
+ * it: its region holds the columns of \a points flagged in \a alive (all when empty) within
+ * radius + max(radial_margin x radius, margin) + 2 x distance of the axis and within
+ * max(axial_margin x radius, margin) beyond base and top. surface_ratio is the share of the region it explains, inlier_ratio the
+ * share on its lateral surface; angular_coverage is the model's, curvature_ratio is left NaN
+ * (the caller knows the curvatures). A sphere's band or a cone's, fitted by a cylinder, leaves
+ * the rest of the sphere or cone inside the region unexplained; so does a thin cylinder fitted
+ * to the edge of a box, with the faces beyond the edge (hence the absolute margin).
+ * \param[out] explained when given, the explanation of every column (alive or not). */
+CylinderEvidence
+localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+              const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive,
+              const ExplainSettings& settings, float radial_margin, float axial_margin,
+              float margin, std::vector<Explained>* explained = nullptr);
 
 } // namespace facyl

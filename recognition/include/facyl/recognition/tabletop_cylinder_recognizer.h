@@ -51,6 +51,20 @@ struct TabletopRecognizerParameters {
    * at the axis: clusters made of the inside of an open container are then fitted, and so are
    * the insides of bowls (see docs/tabletop.md for the trade-off). */
   bool retry_any_normal_sign{false};
+  /** Cylinder-first recovery: when the best fit of a cluster explains less than
+   * min_explained_share of its points (or is not accepted), the cluster may hold several
+   * objects (touching, stacked): up to this many cylinders are extracted one after another,
+   * each judged on the points around it, and each accepted one is reported as an object of
+   * its own; the rest of the cluster is one more object. 1 turns the recovery off. */
+  std::size_t max_cylinders_per_cluster{3};
+  float min_explained_share{0.75f}; ///< in (0, 1]
+  /** A cylinder found in a larger cluster is judged on the points within this distance (m,
+   * at least; 15% of its radius beyond its surface, half its radius beyond its ends). */
+  float recovery_margin{0.025f};
+  /** Organized clouds: the points fitted lie on a pixel grid this many radians apart (3
+   * pixels at a 525 px focal length), so normals and curvatures are estimated at the same
+   * angular scale near and far; 0: every pixel. In [0, 0.1]. */
+  float fit_point_angle{0.006f};
   std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, >= 50
   int neighbours{16};             ///< k of the normal/curvature estimation, >= 5
   std::uint64_t seed{0};
@@ -132,6 +146,13 @@ public:
   {
     camera_ = camera;
   }
+  /** \brief Gravity's opposite in the cloud's frame (see TabletopSegmentation::setUpDirection);
+   * zero (default): unknown. */
+  void
+  setUpDirection(const Eigen::Vector3f& up)
+  {
+    up_ = up;
+  }
 
   /** \brief Runs the pipeline. \return false on error (see the class description). */
   bool
@@ -142,6 +163,19 @@ public:
   getTableCoefficients() const
   {
     return segmentation_.getTableCoefficients();
+  }
+  /** \brief Supports of the last run (RecognizedObject::cluster.support indexes them). */
+  const std::vector<SupportPlane>&
+  getSupports() const
+  {
+    return segmentation_.getSupports();
+  }
+  /** \brief False when no object stood on any plane in the last run: the "table" is then the
+   * largest plane. */
+  bool
+  tableFound() const
+  {
+    return segmentation_.tableFound();
   }
   /** \brief Table frame of the last run (z up). */
   const Eigen::Affine3f&
@@ -170,17 +204,30 @@ private:
   /** Subsamples \a cluster and estimates normals and curvatures. */
   FitInput
   prepareFit(const TabletopCluster& cluster);
-  /** Fits \a input with the configured prior, then (when not accepted) the retries. */
+  /** Fits the points of \a input flagged in \a alive (all when empty) with the configured
+   * prior, then (when not accepted) the retries. The evidence is relative to those points. */
   Fit
-  fitWithRetries(const FitInput& input);
+  fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
   Fit
-  fitOnce(const FitInput& input, std::size_t estimator);
-  /** Classifies, fits and decides one cluster. */
-  RecognizedObject
-  recognizeCluster(TabletopCluster cluster);
+  fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
+  /** Classifies, fits and decides one cluster: one object, or several (recovery). */
+  void
+  recognizeCluster(TabletopCluster cluster, std::vector<RecognizedObject>& objects);
+  /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
+   * its best fit. */
+  std::vector<Fit>
+  extractCylinders(const FitInput& input, Fit first);
+  /** Which points a fitted cylinder explains, from the recognizer's settings. */
+  ExplainSettings
+  explainSettings(const CylinderModel& model) const;
+  /** The cluster split into one object per cylinder and the rest. */
+  void
+  splitCluster(const RecognizedObject& whole, const FitInput& input,
+               const std::vector<Fit>& parts, std::vector<RecognizedObject>& objects) const;
 
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;
+  Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   ShapeClassifier::Ptr classifier_;
   TabletopSegmentation<PointT> segmentation_;
   RecognitionTiming timing_;
@@ -193,6 +240,11 @@ private:
  * when there are fewer). */
 pcl::Indices
 evenSubsample(const pcl::Indices& indices, std::size_t max_count);
+
+/** \brief The \a indices of an organized cloud \a width pixels wide whose column and row are
+ * both multiples of \a stride (>= 1). */
+pcl::Indices
+pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride);
 
 } // namespace facyl
 

@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <facyl/segmentation/object_segmentation.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 
 #include <pcl/ModelCoefficients.h>
@@ -21,53 +22,92 @@ namespace facyl {
 struct TabletopSegmentationParameters {
   float plane_distance{0.015f};   ///< table inlier distance, > 0
   float plane_angle{0.05f};       ///< organized: normal deviation inside the plane (rad), > 0
-  std::size_t min_plane_points{3000}; ///< the table needs this many points (full resolution)
-  float min_height{0.01f};        ///< objects: signed height above the table in
+  /** A plane needs this many points (full resolution) to be found; supports must also be
+   * min_support_area large. */
+  std::size_t min_plane_points{1000};
+  float min_height{0.01f};        ///< objects: signed height above the support in
   float max_height{0.5f};         ///< [min_height, max_height], min < max
+  /** How the object points are split into objects:
+   * - EdgeAware (default): organized clouds are cut at depth discontinuities and concave
+   *   creases, then fragments, enclosed parts and parts seen on both sides of an occluder are
+   *   joined (segmentObjectsOrganized); unorganized clouds are clustered with
+   *   pcl::EuclideanClusterExtraction;
+   * - Euclidean: connected components within cluster_tolerance (the paper's clustering). */
+  enum class Clustering { Euclidean, EdgeAware } clustering{Clustering::EdgeAware};
+  ObjectSegmentationParameters objects; ///< settings of the EdgeAware clustering
   float cluster_tolerance{0.02f}; ///< Euclidean cluster tolerance, > 0
   std::size_t min_cluster_size{300};
   std::size_t max_cluster_size{200000};
-  /** A cluster is an object on the table if at least this share of its points lies over the
-   * table's convex hull, in (0, 1] (1: every point, as pcl::ExtractPolygonalPrismData). */
+  /** A cluster is an object on a support if at least this share of its points lies over the
+   * support's convex hull, in (0, 1] (1: every point, as pcl::ExtractPolygonalPrismData). */
   float min_hull_share{0.25f};
+  /** Which planes support objects:
+   * - ObjectsStanding (default): planes of at least min_support_area are candidates (with an
+   *   up direction, only those within max_support_tilt of it); families of parallel candidates
+   *   (a table, the floor, a shelf) compete by the object points standing on them; each
+   *   cluster belongs to the nearest candidate of the winning family under it, and the table
+   *   is the one with the most object points standing on it;
+   * - LargestPlane: the plane with the most points is the table (the paper's choice). */
+  enum class Support { LargestPlane, ObjectsStanding } support{Support::ObjectsStanding};
+  float max_support_tilt{0.35f};  ///< rad, with an up direction: support normal vs up
+  /** Supports are at least this large (m^2, the convex hull of their points): smaller planes
+   * are faces of objects (a box top), and their points stay object points. */
+  float min_support_area{0.1f};
+  /** A cluster stands on a support when it reaches down to within this height of it. */
+  float contact_height{0.03f};
   int plane_step{4};              ///< organized: the plane search sees every step-th pixel, >= 1
   std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
+  std::size_t max_planes{6};      ///< support candidates examined, in [1, 8]
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
 std::string
 validate(const TabletopSegmentationParameters& params);
 
-/** \brief One object above the table. */
+/** \brief One object above a support. */
 struct TabletopCluster {
   pcl::PointIndices indices;   ///< into the input cloud, ascending
   PixelBox box{-1, -1, -1, -1}; ///< pixel box (organized input, or projection with a camera)
   Eigen::Vector3f centroid{Eigen::Vector3f::Zero()};
+  int support{0};              ///< index into TabletopSegmentation::getSupports()
 };
 
-/** \brief Table plane, objects above it, and Euclidean clusters (paper III-A).
+/** \brief A plane that objects stand on (a table, a shelf, the floor). */
+struct SupportPlane {
+  Eigen::Vector4f plane{Eigen::Vector4f::Zero()}; ///< unit normal towards the sensor
+  /** z = the plane's normal (up), origin = centre of its points; maps plane coordinates to
+   * the cloud's. */
+  Eigen::Affine3f frame{Eigen::Affine3f::Identity()};
+  pcl::PointIndices inliers;            ///< points within plane_distance (full resolution)
+  std::vector<Eigen::Vector2f> polygon; ///< convex hull of the inliers, plane coordinates
+  std::size_t objects{0};               ///< clusters assigned to it
+  std::size_t standing_points{0};       ///< points of the clusters standing on it
+};
+
+/** \brief Supports (tables), objects above them, and object clusters (paper III-A).
  *
- * Organized clouds (width x height > 1): normals by pcl::IntegralImageNormalEstimation and
- * planes by pcl::OrganizedMultiPlaneSegmentation on every plane_step-th pixel; the largest plane
- * is the table, refitted on its full-resolution inliers; clusters are connected components
- * (pcl::OrganizedConnectedComponentSegmentation with pcl::EuclideanClusterComparator) of the
- * points above it. Unorganized clouds: pcl::RandomSample, pcl::NormalEstimation and
- * pcl::SACSegmentationFromNormals (SACMODEL_NORMAL_PLANE) find the plane;
- * pcl::EuclideanClusterExtraction the clusters. In both cases the clusters are made of the points
- * within [min_height, max_height] above the plane (on the side of the sensor, whose position is
- * the cloud's sensor_origin_), and a cluster is kept when at least min_hull_share of its points
- * lie over the table's convex hull (pcl::ConvexHull; the prism test of
- * pcl::ExtractPolygonalPrismData, done per point in table coordinates, then per cluster, so
- * that objects at the border of the visible table are kept whole).
+ * Candidate planes: organized clouds (width x height > 1) use pcl::IntegralImageNormalEstimation
+ * and pcl::OrganizedMultiPlaneSegmentation on a grid of every plane_step-th pixel (each grid
+ * cell takes a pixel with depth, so missing pixels do not break the normals), coplanar regions
+ * are joined; unorganized clouds use pcl::RandomSample, pcl::NormalEstimation and repeated
+ * pcl::SACSegmentationFromNormals (SACMODEL_NORMAL_PLANE). Each candidate is refitted on its
+ * points. Objects are the points within [min_height, max_height] above a candidate and on no
+ * candidate, clustered (see Clustering). A cluster belongs to the nearest candidate under it
+ * when at least min_hull_share of its points lie over that candidate's convex hull (the prism
+ * test of pcl::ExtractPolygonalPrismData, per cluster, so objects at the border of the visible
+ * table stay whole); clusters that hold up another candidate (table legs) are not objects. The
+ * table is the candidate with the most object points standing on it; when nothing stands on any
+ * candidate, the largest one (tableFound() is then false).
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
  * seg.setInputCloud(cloud);
  * std::vector<facyl::TabletopCluster> clusters;
- * if (seg.segment(clusters)) { seg.getTableCoefficients(); seg.getTableFrame(); ... }
+ * if (seg.segment(clusters)) { seg.getTableCoefficients(); seg.getSupports(); ... }
  * \endcode
  * Bad input (no cloud, no finite point, no plane, invalid parameters) is reported with
- * PCL_ERROR and makes segment() return false with empty outputs.
+ * PCL_ERROR and makes segment() return false with empty outputs. segment() is not reentrant on
+ * one object; distinct objects may run concurrently.
  */
 template <typename PointT>
 class TabletopSegmentation : public pcl::PCLBase<PointT> {
@@ -116,7 +156,8 @@ public:
     params_.min_cluster_size = min_size;
     params_.max_cluster_size = max_size;
   }
-  /** \brief Camera for the boxes of unorganized clouds (organized clouds use pixel indices). */
+  /** \brief Camera for the boxes of unorganized clouds (organized clouds use pixel indices);
+   * its focal length also sets the pixel footprint of organized clouds (else estimated). */
   void
   setCamera(const PinholeCamera& camera)
   {
@@ -127,11 +168,49 @@ public:
   {
     return camera_;
   }
+  /** \brief Gravity's opposite in the cloud's frame (e.g. from an IMU or tf): supports are
+   * within max_support_tilt of horizontal. Zero (default): unknown, and "up" is the normal of
+   * the family of parallel planes with the most points. */
+  void
+  setUpDirection(const Eigen::Vector3f& up)
+  {
+    up_ = up;
+  }
+  const Eigen::Vector3f&
+  getUpDirection() const
+  {
+    return up_;
+  }
 
-  /** \brief Runs the segmentation. \return false (with PCL_ERROR) if no table was found. */
+  /** \brief Runs the segmentation. \return false (with PCL_ERROR) if no plane was found. */
   bool
   segment(std::vector<TabletopCluster>& clusters);
 
+  /** \brief Supports of the last run that hold objects, and the table (always there). */
+  const std::vector<SupportPlane>&
+  getSupports() const
+  {
+    return supports_;
+  }
+  /** \brief Focal length in pixels of the last organized input (the camera's, or estimated
+   * from the cloud); 0 for unorganized clouds. */
+  float
+  getFocalLength() const
+  {
+    return focal_;
+  }
+  /** \brief Index of the table in getSupports(). */
+  std::size_t
+  getTableIndex() const
+  {
+    return table_;
+  }
+  /** \brief False when no object stands on any plane: the table is then the largest plane. */
+  bool
+  tableFound() const
+  {
+    return table_found_;
+  }
   /** \brief Table plane (a, b, c, d), unit normal towards the sensor (SACMODEL_PLANE layout). */
   const pcl::ModelCoefficients&
   getTableCoefficients() const
@@ -143,13 +222,13 @@ public:
   const Eigen::Affine3f&
   getTableFrame() const
   {
-    return table_frame_;
+    return supports_.empty() ? identity_ : supports_[table_].frame;
   }
-  /** \brief Table inliers (full resolution for organized clouds). */
+  /** \brief Table inliers (full resolution). */
   const pcl::PointIndices&
   getTableIndices() const
   {
-    return table_indices_;
+    return supports_.empty() ? no_indices_ : supports_[table_].inliers;
   }
   /** \brief Vertices of the table's convex hull. */
   const PointCloud&
@@ -159,25 +238,68 @@ public:
   }
 
 private:
+  /** A candidate plane: coefficients and the points that found it (grid or sample). */
+  struct Candidate {
+    Eigen::Vector4f plane;
+    pcl::Indices points; ///< input indices
+    std::size_t support{0}; ///< full-resolution points it stands for
+  };
+  /** Where a cluster goes among a family of supports. */
+  struct Placement {
+    int support{-1};      ///< index into supports_, -1: none (not over one, or a leg)
+    bool standing{false}; ///< reaches down to it and is whole in its object band
+  };
+
   bool
-  findTableOrganized(pcl::Indices& plane_points);
+  findPlanesOrganized(std::vector<Candidate>& candidates);
   bool
-  findTableUnorganized(pcl::Indices& plane_points);
+  findPlanesUnorganized(std::vector<Candidate>& candidates);
+  /** Least-squares refit; supports are large and (with an up direction) horizontal. */
   void
-  clusterOrganized(const pcl::Indices& objects, std::vector<pcl::PointIndices>& out) const;
+  keepSupportCandidates(std::vector<Candidate>& candidates) const;
+  /** One pass over the points: each candidate's inliers; the candidates large enough are
+   * the supports; the object band above them. */
   void
-  clusterUnorganized(const pcl::Indices& objects, std::vector<pcl::PointIndices>& out) const;
+  classifyPoints(const std::vector<Candidate>& candidates, pcl::Indices& band);
+  /** The candidates (indices) of the family of parallel planes that holds the supports. */
+  std::vector<std::size_t>
+  supportFamily(const std::vector<Candidate>& candidates,
+                const std::vector<SupportPlane>& all) const;
+  /** Area of the convex hull of the points that found \a c, in \a frame's plane. */
+  float
+  regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;
+  /** Convex hull of a support's inliers, in its plane's coordinates. */
+  std::vector<Eigen::Vector2f>
+  supportHull(const SupportPlane& support) const;
+  void
+  clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  void
+  clusterUnorganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  /** The support of a cluster (points \a pts) among the supports of \a family. */
+  Placement
+  place(const Eigen::Matrix3Xf& pts, const std::vector<std::size_t>& family) const;
+  /** Each cluster to the support under it; the table; supports without objects dropped. */
+  void
+  chooseSupports(std::vector<pcl::Indices>& groups, std::vector<TabletopCluster>& clusters);
+  TabletopCluster
+  makeCluster(pcl::Indices indices, int support) const;
   void
   reset();
 
   TabletopSegmentationParameters params_;
   PinholeCamera camera_;
-  Eigen::Vector4f plane_{Eigen::Vector4f::Zero()};
+  Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
+  std::vector<SupportPlane> supports_;
+  std::size_t table_{0};
+  bool table_found_{false};
+  float focal_{0.f}; ///< pixels (organized input)
+  Eigen::Vector3f image_down_{Eigen::Vector3f::Zero()}; ///< organized input; zero: unknown
   pcl::ModelCoefficients table_coefficients_;
-  Eigen::Affine3f table_frame_{Eigen::Affine3f::Identity()};
-  pcl::PointIndices table_indices_;
   typename PointCloud::Ptr hull_{new PointCloud};
+  const Eigen::Affine3f identity_{Eigen::Affine3f::Identity()};
+  const pcl::PointIndices no_indices_;
   mutable pcl::PointCloud<pcl::PointXYZ>::Ptr masked_; ///< buffers of clusterOrganized
+  mutable std::vector<std::uint8_t> has_depth_;
   mutable pcl::PointCloud<pcl::Label> labels_;
 };
 

@@ -29,6 +29,7 @@ struct TabletopCylinderRecognizer<PointT>::Fit {
   CylinderModel model; ///< inliers index FitInput::points
   CylinderEvidence evidence;
   bool accepted{false};
+  float explained_share{0.f}; ///< of the points fitted: lateral inliers, caps, inner wall
 };
 
 template <typename PointT>
@@ -86,6 +87,7 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   segmentation_.setInputCloud(input_);
   segmentation_.setIndices(indices_); // nullptr: the whole cloud
   segmentation_.setCamera(camera_);
+  segmentation_.setUpDirection(up_);
   const bool segmented = segmentation_.segment(clusters);
   timing_.segmentation = ms(t0, Clock::now());
   if (!segmented) {
@@ -94,17 +96,25 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   }
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
   cues_estimation_.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
-  for (auto& hough : estimators_)
-    hough.setReferenceFrame(segmentation_.getTableFrame().linear());
-  for (auto& cluster : clusters)
-    objects.push_back(recognizeCluster(std::move(cluster)));
+  int frame_of = -1;
+  for (auto& cluster : clusters) {
+    // The prior is set in the frame of the support the object stands on.
+    if (cluster.support != frame_of) {
+      frame_of = cluster.support;
+      const auto& support = segmentation_.getSupports()[static_cast<std::size_t>(frame_of)];
+      for (auto& hough : estimators_)
+        hough.setReferenceFrame(support.frame.linear());
+    }
+    recognizeCluster(std::move(cluster), objects);
+  }
   timing_.total = ms(t0, Clock::now());
   return true;
 }
 
 template <typename PointT>
-RecognizedObject
-TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster)
+void
+TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster,
+                                                     std::vector<RecognizedObject>& objects)
 {
   using Clock = std::chrono::steady_clock;
   const auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -118,21 +128,168 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster)
     const auto t1 = Clock::now();
     timing_.classification += ms(t, t1);
     t = t1;
-    if (object.evidence.p_cylinder < params_.decision.min_probability)
-      return object; // rejected before fitting
+    if (object.evidence.p_cylinder < params_.decision.min_probability) {
+      objects.push_back(std::move(object)); // rejected before fitting
+      return;
+    }
   }
   const FitInput input = prepareFit(object.cluster);
-  Fit best = fitWithRetries(input);
+  Fit best = fitWithRetries(input, {});
+  const float p_cylinder = object.evidence.p_cylinder;
   if (best.evidence.fitted) {
-    best.evidence.p_cylinder = object.evidence.p_cylinder;
+    best.evidence.p_cylinder = p_cylinder;
     object.evidence = best.evidence;
-    object.cylinder = std::move(best.model);
+    object.cylinder = best.model;
     for (auto& i : object.cylinder.inliers)
       i = input.subset[static_cast<std::size_t>(i)];
     object.is_cylinder = acceptCylinder(object.evidence, params_.decision);
   }
+  // Cylinder-first recovery: a cluster the best fit does not explain may hold several objects.
+  if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
+      (!object.is_cylinder || best.explained_share < params_.min_explained_share)) {
+    std::vector<Fit> parts = extractCylinders(input, std::move(best));
+    if (!parts.empty()) {
+      for (auto& part : parts)
+        part.evidence.p_cylinder = p_cylinder;
+      splitCluster(object, input, parts, objects);
+      timing_.fitting += ms(t, Clock::now());
+      return;
+    }
+  }
+  objects.push_back(std::move(object));
   timing_.fitting += ms(t, Clock::now());
-  return object;
+}
+
+template <typename PointT>
+std::vector<typename TabletopCylinderRecognizer<PointT>::Fit>
+TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit fit)
+{
+  // Judged on the points around each cylinder; the margins make a sphere's or a cone's band
+  // leave the rest of the sphere or cone in its region, and a box edge its faces.
+  constexpr float radial_margin = 0.15f, axial_margin = 0.5f;
+  const float margin = params_.recovery_margin;
+  // Neighbours in the subsample: a few times its spacing.
+  const float junction_distance = 0.02f;
+  std::vector<Fit> parts;
+  std::vector<std::uint8_t> alive(input.points->size(), 0);
+  std::size_t left = 0;
+  for (std::size_t k = 0; k < alive.size(); ++k)
+    left += alive[k] = input.column_of[k] >= 0;
+  const std::size_t min_part = std::max<std::size_t>(30, input.points->size() / 30);
+  for (std::size_t round = 0; round < params_.max_cylinders_per_cluster; ++round) {
+    if (round > 0)
+      fit = fitWithRetries(input, alive);
+    if (!fit.evidence.fitted)
+      break;
+    std::vector<std::uint8_t> alive_columns(static_cast<std::size_t>(input.columns.cols()), 0);
+    for (std::size_t k = 0; k < alive.size(); ++k)
+      if (alive[k])
+        alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
+    std::vector<Explained> why;
+    CylinderEvidence e = localEvidence(fit.model, input.columns, input.normals, alive_columns,
+                                       explainSettings(fit.model), radial_margin, axial_margin,
+                                       margin, &why);
+    e.curvature_ratio = fit.evidence.curvature_ratio;
+    std::vector<Eigen::Index> part, rest;
+    for (std::size_t k = 0; k < alive.size(); ++k)
+      if (alive[k])
+        (why[static_cast<std::size_t>(input.column_of[k])] != Explained::No ? part : rest)
+          .push_back(input.column_of[k]);
+    if (!acceptCylinder(e, params_.decision) || part.size() < min_part)
+      break;
+    // Objects that touch meet at a concave crease; a part of one object (a box's edge)
+    // continues into the rest convexly or smoothly.
+    const float convex = convexJunctionShare(input.columns, input.normals, part, rest,
+                                             junction_distance, 0.1f);
+    if (convex > 0.5f)
+      break;
+    for (std::size_t k = 0; k < alive.size(); ++k)
+      if (alive[k] && why[static_cast<std::size_t>(input.column_of[k])] != Explained::No)
+        alive[k] = 0;
+    const std::size_t explained = part.size();
+    left -= explained;
+    fit.evidence = e;
+    parts.push_back(std::move(fit));
+    if (left < min_part)
+      break;
+  }
+  return parts;
+}
+
+template <typename PointT>
+ExplainSettings
+TabletopCylinderRecognizer<PointT>::explainSettings(const CylinderModel& model) const
+{
+  ExplainSettings s;
+  s.distance = std::max(model.distance_threshold, 1e-4f);
+  s.max_angle = params_.hough.normal_angle_threshold;
+  s.outward = params_.hough.outward_normals;
+  s.inner_wall = params_.hough.outward_normals;
+  s.axial_margin = 2.f * s.distance;
+  return s;
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
+                                                 const FitInput& input,
+                                                 const std::vector<Fit>& parts,
+                                                 std::vector<RecognizedObject>& objects) const
+{
+  // Every point of the cluster goes to the first cylinder that explains its position.
+  const auto& idx = whole.cluster.indices.indices;
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(idx.size()));
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    pts.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
+  std::vector<int> owner(idx.size(), -1);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    ExplainSettings s = explainSettings(parts[p].model);
+    s.distance *= 2.f; // by position alone: a little wider than the inliers' band
+    const std::vector<Explained> why = explainedPoints(parts[p].model, pts, {}, s);
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      if (owner[k] < 0 && why[k] != Explained::No)
+        owner[k] = static_cast<int>(p);
+  }
+  const auto& seg = segmentation_.getParameters();
+  const auto make = [&](int part) {
+    pcl::Indices mine;
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      if (owner[k] == part)
+        mine.push_back(idx[k]);
+    RecognizedObject o;
+    o.cluster.indices.header = whole.cluster.indices.header;
+    o.cluster.support = whole.cluster.support;
+    Eigen::Matrix3Xf mp(3, static_cast<Eigen::Index>(mine.size()));
+    for (std::size_t k = 0; k < mine.size(); ++k)
+      mp.col(static_cast<Eigen::Index>(k)) = (*input_)[mine[k]].getVector3fMap();
+    o.cluster.centroid = mine.empty() ? Eigen::Vector3f::Zero() : Eigen::Vector3f(mp.rowwise().mean());
+    o.cluster.box = input_->isOrganized() ? pixelBox(mine, input_->width) : projectedBox(mp, camera_);
+    o.cluster.indices.indices = std::move(mine);
+    return o;
+  };
+  // What no cylinder explains is an object of its own when it is large (a box beside a
+  // can); a small rest is the unexplained part of the cylinders found (a handle, a rim) and
+  // stays with the first of them.
+  const std::size_t rest = static_cast<std::size_t>(std::count(owner.begin(), owner.end(), -1));
+  const bool rest_is_object =
+    rest >= seg.min_cluster_size &&
+    static_cast<float>(rest) >= (1.f - params_.min_explained_share) * static_cast<float>(idx.size());
+  if (!rest_is_object)
+    std::replace(owner.begin(), owner.end(), -1, 0);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    RecognizedObject o = make(static_cast<int>(p));
+    o.evidence = parts[p].evidence;
+    o.cylinder = parts[p].model;
+    for (auto& i : o.cylinder.inliers)
+      i = input.subset[static_cast<std::size_t>(i)];
+    o.is_cylinder = true;
+    objects.push_back(std::move(o));
+  }
+  if (rest_is_object) {
+    RecognizedObject o = make(-1);
+    o.evidence.p_cylinder = whole.evidence.p_cylinder;
+    objects.push_back(std::move(o));
+  }
 }
 
 template <typename PointT>
@@ -140,7 +297,16 @@ typename TabletopCylinderRecognizer<PointT>::FitInput
 TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
 {
   FitInput in;
-  in.subset = evenSubsample(cluster.indices.indices, params_.max_fit_points);
+  // Organized clouds: a grid of pixels fit_point_angle apart, so that the neighbourhoods of
+  // the cues span the same angle at every depth: depth noise grows with z^2, and the noise
+  // of a curvature with noise / size^2, so the cues stay as reliable far away as near.
+  const int stride =
+    static_cast<int>(std::lround(params_.fit_point_angle * segmentation_.getFocalLength()));
+  if (input_->isOrganized() && stride > 1)
+    in.subset = evenSubsample(pixelGrid(cluster.indices.indices, input_->width, stride),
+                              params_.max_fit_points);
+  else
+    in.subset = evenSubsample(cluster.indices.indices, params_.max_fit_points);
   in.points.reset(new pcl::PointCloud<pcl::PointXYZ>);
   in.points->reserve(in.subset.size());
   for (const auto i : in.subset) {
@@ -171,12 +337,24 @@ TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
 
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::Fit
-TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input, std::size_t estimator)
+TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input,
+                                            const std::vector<std::uint8_t>& alive,
+                                            std::size_t estimator)
 {
   Fit f;
   auto& hough = estimators_[estimator];
   hough.setInputCloud(input.points);
   hough.setInputNormals(input.cues);
+  pcl::IndicesPtr indices; // nullptr: every point
+  std::size_t fitted_points = input.points->size();
+  if (!alive.empty()) {
+    indices.reset(new pcl::Indices);
+    for (std::size_t k = 0; k < alive.size(); ++k)
+      if (alive[k])
+        indices->push_back(static_cast<pcl::index_t>(k));
+    fitted_points = indices->size();
+  }
+  hough.setIndices(indices);
   std::vector<CylinderModel> models;
   if (!hough.segment(models) || models.empty())
     return f;
@@ -186,30 +364,45 @@ TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input, std::size_t e
   e.inlier_ratio = f.model.inlier_ratio;
   e.angular_coverage = f.model.angular_coverage;
   e.curvature_ratio = curvatureRatio(*input.cues, f.model.inliers);
+  std::vector<std::uint8_t> alive_columns;
+  if (!alive.empty()) {
+    alive_columns.assign(static_cast<std::size_t>(input.columns.cols()), 0);
+    for (std::size_t k = 0; k < alive.size(); ++k)
+      if (alive[k] && input.column_of[k] >= 0)
+        alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
+  }
+  e.taper = taperAlongAxis(f.model, input.columns, input.normals, alive_columns);
   // The surface ratio: lateral inliers, plus the points on the caps and on the inner wall.
-  CylinderModel in_columns = f.model;
-  for (auto& i : in_columns.inliers)
-    i = input.column_of[static_cast<std::size_t>(i)];
-  const std::size_t caps =
-    countCapPoints(in_columns, input.columns, input.normals, 2.f * f.model.distance_threshold,
-                   params_.hough.normal_angle_threshold);
-  const std::size_t inner = params_.hough.outward_normals
-                              ? countInnerWallPoints(in_columns, input.columns, input.normals,
-                                                     params_.hough.normal_angle_threshold, 0.8f)
-                              : 0;
+  std::vector<std::uint8_t> counted(static_cast<std::size_t>(input.columns.cols()), 0);
+  for (const auto i : f.model.inliers)
+    counted[static_cast<std::size_t>(input.column_of[static_cast<std::size_t>(i)])] = 1;
+  const float cos_max = std::cos(params_.hough.normal_angle_threshold);
+  std::size_t caps = 0, inner = 0;
+  for (std::size_t k = 0; k < input.column_of.size(); ++k) {
+    const auto c = input.column_of[k];
+    if (c < 0 || (!alive.empty() && !alive[k]) || counted[static_cast<std::size_t>(c)])
+      continue;
+    const Eigen::Vector3f p = input.columns.col(c), n = input.normals.col(c);
+    if (onCap(f.model, p, n, 2.f * f.model.distance_threshold, cos_max))
+      ++caps;
+    else if (params_.hough.outward_normals && onInnerWall(f.model, p, n, cos_max, 0.8f))
+      ++inner;
+  }
   e.surface_ratio = std::min(1.f, e.inlier_ratio + static_cast<float>(caps + inner) /
-                                                     static_cast<float>(input.points->size()));
+                                                     static_cast<float>(fitted_points));
+  f.explained_share = e.surface_ratio;
   f.accepted = acceptCylinder(e, params_.decision);
   return f;
 }
 
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::Fit
-TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input)
+TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input,
+                                                   const std::vector<std::uint8_t>& alive)
 {
-  Fit best = fitOnce(input, 0);
+  Fit best = fitOnce(input, alive, 0);
   for (std::size_t e = 1; e < estimators_.size() && !best.accepted; ++e) {
-    Fit f = fitOnce(input, e);
+    Fit f = fitOnce(input, alive, e);
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
          !best.evidence.fitted))

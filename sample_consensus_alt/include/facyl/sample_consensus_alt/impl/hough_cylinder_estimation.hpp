@@ -214,8 +214,9 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     std::sort(c.inliers.begin(), c.inliers.end());
   }
   if (cylinders.empty()) {
-    PCL_WARN("[facyl::%s::segment] no cylinder found among %zu points.\n", name,
-             indices.size());
+    // A normal outcome (the points hold no cylinder), not something to act on.
+    PCL_DEBUG("[facyl::%s::segment] no cylinder found among %zu points.\n", name,
+              indices.size());
     return false;
   }
   return true;

@@ -3,6 +3,8 @@
  */
 #pragma once
 
+#include <facyl/features/polygon.h>
+#include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 
 #include <pcl/common/io.h>
@@ -18,11 +20,11 @@
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
 #include <pcl/segmentation/organized_multi_plane_segmentation.h>
 #include <pcl/segmentation/sac_segmentation.h>
-#include <pcl/surface/convex_hull.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <unordered_map>
 
 namespace facyl {
@@ -31,10 +33,12 @@ template <typename PointT>
 void
 TabletopSegmentation<PointT>::reset()
 {
-  plane_.setZero();
+  supports_.clear();
+  table_ = 0;
+  table_found_ = false;
+  focal_ = 0.f;
+  image_down_.setZero();
   table_coefficients_.values.clear();
-  table_frame_.setIdentity();
-  table_indices_.indices.clear();
   hull_->clear();
 }
 
@@ -53,6 +57,10 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     PCL_ERROR("[facyl::TabletopSegmentation::segment] No input cloud, or an empty one.\n");
     return false;
   }
+  if (!up_.allFinite()) {
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] The up direction is not finite.\n");
+    return false;
+  }
   if (!this->initCompute()) {
     PCL_ERROR("[facyl::TabletopSegmentation::segment] Invalid input or indices.\n");
     return false;
@@ -66,105 +74,36 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     return false;
   }
 
-  pcl::Indices plane_points;
-  const bool organized = input_->isOrganized();
-  const bool found = organized ? findTableOrganized(plane_points) : findTableUnorganized(plane_points);
-  if (!found) {
-    PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane with at least %zu points found.\n",
-              params_.min_plane_points);
+  std::vector<Candidate> candidates;
+  if (input_->isOrganized())
+    findPlanesOrganized(candidates);
+  else
+    findPlanesUnorganized(candidates);
+  keepSupportCandidates(candidates);
+  if (candidates.empty()) {
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane with at least %zu points "
+              "found%s.\n",
+              params_.min_plane_points,
+              up_.isZero() ? "" : " within max_support_tilt of the up direction");
     reset();
     this->deinitCompute();
     return false;
   }
-
-  // Least-squares refit on the plane region, then every point near it is a table point.
-  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  {
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(plane_points.size()));
-    for (std::size_t k = 0; k < plane_points.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[plane_points[k]].getVector3fMap();
-    Eigen::Vector4f refined;
-    if (fitPlane(pts, viewpoint, refined))
-      plane_ = refined;
-  }
-  // One pass: the table points, and the band of object candidates above it.
   pcl::Indices band;
-  for (const auto i : *indices_) {
-    const auto& p = (*input_)[i];
-    if (!pcl::isFinite(p))
-      continue;
-    const float h = plane_.head<3>().dot(p.getVector3fMap()) + plane_[3];
-    if (std::abs(h) < params_.plane_distance)
-      table_indices_.indices.push_back(i);
-    if (h >= params_.min_height && h <= params_.max_height)
-      band.push_back(i);
-  }
-
-  // Convex hull of the table.
-  {
-    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
-    for (const auto i : plane_points)
-      centre += (*input_)[i].getVector3fMap();
-    table_frame_ = planeFrame(plane_, centre / static_cast<float>(plane_points.size()));
-  }
-  const Eigen::Affine3f to_table = table_frame_.inverse();
-  // Hull of every table point (the plane regions found may miss parts of the table, e.g. the
-  // near edge where a real sensor's depth bends), thinned on organized clouds.
-  typename PointCloud::Ptr region(new PointCloud);
-  region->reserve(table_indices_.indices.size());
-  const auto w = static_cast<pcl::index_t>(input_->width);
-  const pcl::index_t step = organized ? params_.plane_step : 1;
-  const std::size_t stride =
-    organized ? 1 : std::max<std::size_t>(1, table_indices_.indices.size() / params_.plane_samples);
-  for (std::size_t k = 0; k < table_indices_.indices.size(); k += stride) {
-    const auto i = table_indices_.indices[k];
-    if (!organized || ((i % w) % step == 0 && (i / w) % step == 0))
-      region->push_back((*input_)[i]);
-  }
-  pcl::ConvexHull<PointT> convex_hull;
-  convex_hull.setInputCloud(region);
-  convex_hull.setDimension(2);
-  convex_hull.reconstruct(*hull_);
-  std::vector<Eigen::Vector2f> polygon;
-  for (const auto& v : *hull_)
-    polygon.push_back((to_table * v.getVector3fMap()).template head<2>());
-  if (polygon.size() < 3) {
-    PCL_ERROR("[facyl::TabletopSegmentation::segment] The table's hull is degenerate.\n");
+  classifyPoints(candidates, band);
+  if (supports_.empty()) {
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane of at least %g m^2 found.\n",
+              params_.min_support_area);
     reset();
     this->deinitCompute();
     return false;
   }
-  table_coefficients_.header = input_->header;
-  table_coefficients_.values = {plane_[0], plane_[1], plane_[2], plane_[3]};
-
-  std::vector<pcl::PointIndices> groups;
-  if (organized)
+  std::vector<pcl::Indices> groups;
+  if (input_->isOrganized())
     clusterOrganized(band, groups);
   else
     clusterUnorganized(band, groups);
-  for (auto& g : groups) {
-    if (g.indices.size() < params_.min_cluster_size || g.indices.size() > params_.max_cluster_size)
-      continue;
-    // The prism test of pcl::ExtractPolygonalPrismData (inside the hull, in table coordinates),
-    // applied per cluster: objects at the border of the visible table (cut by the image edge, or
-    // hiding the table behind them) stick out of the hull and are kept whole.
-    std::size_t in_hull = 0;
-    for (const auto i : g.indices)
-      in_hull +=
-        pointInPolygon((to_table * (*input_)[i].getVector3fMap()).template head<2>(), polygon);
-    if (static_cast<float>(in_hull) < params_.min_hull_share * static_cast<float>(g.indices.size()))
-      continue;
-    std::sort(g.indices.begin(), g.indices.end());
-    TabletopCluster c;
-    c.indices.header = input_->header;
-    c.indices.indices = std::move(g.indices);
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.indices.indices.size()));
-    for (std::size_t k = 0; k < c.indices.indices.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.indices.indices[k]].getVector3fMap();
-    c.centroid = pts.rowwise().mean();
-    c.box = organized ? pixelBox(c.indices.indices, input_->width) : projectedBox(pts, camera_);
-    clusters.push_back(std::move(c));
-  }
+  chooseSupports(groups, clusters);
   // Largest first, like pcl::EuclideanClusterExtraction.
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
@@ -175,7 +114,7 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
 
 template <typename PointT>
 bool
-TabletopSegmentation<PointT>::findTableOrganized(pcl::Indices& plane_points)
+TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candidates)
 {
   const int step = params_.plane_step;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
@@ -185,33 +124,43 @@ TabletopSegmentation<PointT>::findTableOrganized(pcl::Indices& plane_points)
     for (const auto i : *indices_)
       allowed[i] = 1;
   }
+  // A grid of every step-th pixel; each cell takes a pixel of its block with depth, so that
+  // missing pixels (real sensors lose several percent) do not spread NaN normals.
   pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
   small->width = static_cast<std::uint32_t>((w + step - 1) / step);
   small->height = static_cast<std::uint32_t>((h + step - 1) / step);
   small->is_dense = false;
-  small->resize(static_cast<std::size_t>(small->width) * small->height);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int v = 0, k = 0; v < h; v += step)
-    for (int u = 0; u < w; u += step, ++k) {
-      const std::size_t idx = static_cast<std::size_t>(v) * w + u;
-      const auto& p = (*input_)[idx];
-      auto& q = (*small)[k];
-      if ((fake_indices_ || allowed[idx]) && pcl::isFinite(p))
-        q.getVector3fMap() = p.getVector3fMap();
-      else
-        q.x = q.y = q.z = nan;
-    }
+  small->points.assign(static_cast<std::size_t>(small->width) * small->height,
+                       pcl::PointXYZ(nan, nan, nan));
+  std::vector<pcl::index_t> source(small->size(), -1);
+  for (int v0 = 0, k = 0; v0 < h; v0 += step)
+    for (int u0 = 0; u0 < w; u0 += step, ++k)
+      for (int dv = 0; dv < step && v0 + dv < h && source[k] < 0; ++dv)
+        for (int du = 0; du < step && u0 + du < w; ++du) {
+          const std::size_t idx = static_cast<std::size_t>(v0 + dv) * w + u0 + du;
+          const auto& p = (*input_)[idx];
+          if ((fake_indices_ || allowed[idx]) && pcl::isFinite(p)) {
+            (*small)[k].getVector3fMap() = p.getVector3fMap();
+            source[k] = static_cast<pcl::index_t>(idx);
+            break;
+          }
+        }
+  focal_ = camera_.valid() ? camera_.fx : estimateFocalLength(*small) * static_cast<float>(step);
+  image_down_ = imageDownDirection(*small, input_->sensor_origin_.head(3));
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
   ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
   ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step));
-  ne.setNormalSmoothingSize(std::max(4.f, 10.f / static_cast<float>(step)));
+  // Smoothing over about 32 pixels of the frame: depth noise of active stereo sensors
+  // breaks smaller windows' normals into many small regions.
+  ne.setNormalSmoothingSize(std::max(4.f, 32.f / static_cast<float>(step)));
   ne.setInputCloud(small);
   ne.compute(*normals);
 
   pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
-  mps.setMinInliers(static_cast<unsigned>(
-    std::max<std::size_t>(10, params_.min_plane_points / static_cast<std::size_t>(step * step))));
+  const std::size_t cell = static_cast<std::size_t>(step * step);
+  mps.setMinInliers(static_cast<unsigned>(std::max<std::size_t>(10, params_.min_plane_points / cell / 4)));
   mps.setAngularThreshold(params_.plane_angle);
   mps.setDistanceThreshold(params_.plane_distance);
   mps.setInputNormals(normals);
@@ -219,40 +168,38 @@ TabletopSegmentation<PointT>::findTableOrganized(pcl::Indices& plane_points)
   std::vector<pcl::ModelCoefficients> coefficients;
   std::vector<pcl::PointIndices> inliers;
   mps.segment(coefficients, inliers);
-  std::size_t best = inliers.size();
-  for (std::size_t i = 0; i < inliers.size(); ++i)
-    if (coefficients[i].values.size() == 4 &&
-        (best == inliers.size() || inliers[i].indices.size() > inliers[best].indices.size()))
-      best = i;
-  if (best == inliers.size())
-    return false;
+  // Regions on one plane are one candidate (objects cut a table into several regions).
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  const auto plane_of = [&](std::size_t i) {
-    const auto& c = coefficients[i].values;
-    return orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), viewpoint);
-  };
-  plane_ = plane_of(best);
-  // The table is every region on that plane (objects split it into several).
-  plane_points.clear();
+  std::vector<Eigen::Vector4f> planes;
+  std::vector<std::size_t> order;
   for (std::size_t i = 0; i < inliers.size(); ++i) {
-    if (coefficients[i].values.size() != 4)
-      continue;
-    const Eigen::Vector4f q = plane_of(i);
-    if (i != best && (q.head<3>().dot(plane_.head<3>()) < std::cos(params_.plane_angle) ||
-                      std::abs(q[3] - plane_[3]) > params_.plane_distance))
-      continue;
-    for (const auto k : inliers[i].indices) {
-      const int u = (k % static_cast<int>(small->width)) * step;
-      const int v = (k / static_cast<int>(small->width)) * step;
-      plane_points.push_back(static_cast<pcl::index_t>(v * w + u));
-    }
+    const auto& c = coefficients[i].values;
+    planes.push_back(c.size() == 4 ? orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), viewpoint)
+                                   : Eigen::Vector4f::Zero());
+    if (c.size() == 4 && planes.back().allFinite())
+      order.push_back(i);
   }
-  return plane_points.size() * static_cast<std::size_t>(step * step) >= params_.min_plane_points;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return inliers[a].indices.size() > inliers[b].indices.size();
+  });
+  for (const auto& group :
+       groupCoplanar(planes, order, params_.plane_angle, params_.plane_distance)) {
+    Candidate c;
+    c.plane = planes[group.front()];
+    for (const std::size_t r : group)
+      for (const auto k : inliers[r].indices)
+        if (source[static_cast<std::size_t>(k)] >= 0)
+          c.points.push_back(source[static_cast<std::size_t>(k)]);
+    c.support = c.points.size() * cell;
+    if (c.support >= params_.min_plane_points)
+      candidates.push_back(std::move(c));
+  }
+  return !candidates.empty();
 }
 
 template <typename PointT>
 bool
-TabletopSegmentation<PointT>::findTableUnorganized(pcl::Indices& plane_points)
+TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& candidates)
 {
   // Plane search on a uniform random sample of the points, with normals: like the pixels of an
   // organized frame, the sample follows the sensor's density, so the table outweighs a larger
@@ -261,15 +208,17 @@ TabletopSegmentation<PointT>::findTableUnorganized(pcl::Indices& plane_points)
   for (const auto i : *indices_)
     if (pcl::isFinite((*input_)[i]))
       finite->push_back(i);
-  typename PointCloud::Ptr coarse(new PointCloud);
   pcl::RandomSample<PointT> sample;
   sample.setInputCloud(input_);
   sample.setIndices(finite);
   sample.setSample(static_cast<unsigned>(std::min<std::size_t>(params_.plane_samples, finite->size())));
   sample.setSeed(1);
-  sample.filter(*coarse);
-  if (coarse->size() < 10)
+  pcl::Indices sampled;
+  sample.filter(sampled);
+  if (sampled.size() < 10)
     return false;
+  typename PointCloud::Ptr coarse(new PointCloud);
+  pcl::copyPointCloud(*input_, sampled, *coarse);
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   typename pcl::search::KdTree<PointT>::Ptr tree(new pcl::search::KdTree<PointT>);
   pcl::NormalEstimation<PointT, pcl::Normal> ne;
@@ -286,34 +235,352 @@ TabletopSegmentation<PointT>::findTableUnorganized(pcl::Indices& plane_points)
   sac.setMaxIterations(300);
   sac.setInputCloud(coarse);
   sac.setInputNormals(normals);
-  pcl::PointIndices inliers;
-  pcl::ModelCoefficients coefficients;
-  sac.segment(inliers, coefficients);
-  if (coefficients.values.size() != 4 || inliers.indices.size() < 3)
-    return false;
-  const auto& c = coefficients.values;
-  plane_ = orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]),
-                       input_->sensor_origin_.head(3));
-  // Every input point near that plane supports it.
-  plane_points.clear();
+  // Planes one after another, each on what the previous ones left.
+  const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
+  pcl::IndicesPtr remaining(new pcl::Indices(sampled.size()));
+  std::iota(remaining->begin(), remaining->end(), 0);
+  for (std::size_t k = 0; k < params_.max_planes && remaining->size() >= 10; ++k) {
+    sac.setIndices(remaining);
+    pcl::PointIndices inliers;
+    pcl::ModelCoefficients coefficients;
+    sac.segment(inliers, coefficients);
+    if (coefficients.values.size() != 4 ||
+        static_cast<double>(inliers.indices.size()) * scale < static_cast<double>(params_.min_plane_points))
+      break;
+    const auto& c = coefficients.values;
+    Candidate cand;
+    cand.plane = orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), input_->sensor_origin_.head(3));
+    for (const auto i : inliers.indices)
+      cand.points.push_back(sampled[static_cast<std::size_t>(i)]);
+    cand.support = static_cast<std::size_t>(static_cast<double>(inliers.indices.size()) * scale);
+    candidates.push_back(std::move(cand));
+    std::vector<std::uint8_t> taken(sampled.size(), 0);
+    for (const auto i : inliers.indices)
+      taken[static_cast<std::size_t>(i)] = 1;
+    pcl::IndicesPtr left(new pcl::Indices);
+    for (const auto i : *remaining)
+      if (!taken[static_cast<std::size_t>(i)])
+        left->push_back(i);
+    remaining = left;
+  }
+  return !candidates.empty();
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& candidates) const
+{
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  for (auto& c : candidates) {
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.points.size()));
+    for (std::size_t k = 0; k < c.points.size(); ++k)
+      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.points[k]].getVector3fMap();
+    Eigen::Vector4f refined;
+    if (fitPlane(pts, viewpoint, refined))
+      c.plane = refined;
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.support > b.support; });
+  if (!up_.isZero()) {
+    const Eigen::Vector3f up = up_.normalized();
+    const float cos_max = std::cos(params_.max_support_tilt);
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](const Candidate& c) {
+                                      return c.plane.template head<3>().dot(up) < cos_max;
+                                    }),
+                     candidates.end());
+  }
+  if (params_.support == TabletopSegmentationParameters::Support::LargestPlane) {
+    if (candidates.size() > 1)
+      candidates.resize(1);
+    return;
+  }
+  if (candidates.size() > params_.max_planes)
+    candidates.resize(params_.max_planes);
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candidates,
+                                             pcl::Indices& band)
+{
+  // One pass: each candidate's points, and the points above some candidate (in its object
+  // band) with the candidates they lie on and above.
+  const std::size_t n = candidates.size(); // <= 8
+  std::vector<SupportPlane> all(n);
+  struct Above {
+    pcl::index_t index;
+    std::uint8_t on, above;
+  };
+  std::vector<Above> above_band;
+  for (std::size_t s = 0; s < n; ++s)
+    all[s].inliers.indices.reserve(candidates[s].support + candidates[s].support / 2);
   for (const auto i : *indices_) {
     const auto& p = (*input_)[i];
-    if (pcl::isFinite(p) &&
-        std::abs(plane_.head<3>().dot(p.getVector3fMap()) + plane_[3]) < params_.plane_distance)
-      plane_points.push_back(i);
+    if (!pcl::isFinite(p))
+      continue;
+    std::uint8_t on = 0, above = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      const Eigen::Vector4f& q = candidates[s].plane;
+      const float h = q.template head<3>().dot(p.getVector3fMap()) + q[3];
+      if (std::abs(h) < params_.plane_distance) {
+        on |= static_cast<std::uint8_t>(1u << s);
+        all[s].inliers.indices.push_back(i);
+      }
+      else if (h >= params_.min_height && h <= params_.max_height)
+        above |= static_cast<std::uint8_t>(1u << s);
+    }
+    if (above)
+      above_band.push_back({i, on, above});
   }
-  return plane_points.size() >= params_.min_plane_points;
+  // Supports: the planes of one family of parallel planes (a table, the floor under it, a
+  // shelf) that are large (a smaller plane is an object's face: its points stay objects).
+  const bool largest = params_.support == TabletopSegmentationParameters::Support::LargestPlane;
+  const std::vector<std::size_t> family = largest ? std::vector<std::size_t>{0}
+                                                  : supportFamily(candidates, all);
+  std::uint8_t kept = 0;
+  for (const std::size_t s : family) {
+    SupportPlane& support = all[s];
+    support.plane = candidates[s].plane;
+    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+    for (const auto i : candidates[s].points)
+      centre += (*input_)[i].getVector3fMap();
+    support.frame =
+      planeFrame(candidates[s].plane, centre / static_cast<float>(candidates[s].points.size()));
+    support.inliers.header = input_->header;
+    support.polygon = supportHull(support);
+    // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
+    // by the region found on it: its infinite plane slices through the objects around it.
+    bool elevated = false;
+    for (const std::size_t t : family) {
+      const float height = candidates[t].plane[3] - candidates[s].plane[3];
+      elevated = elevated || (t != s && candidates[t].support > candidates[s].support &&
+                              height >= params_.min_height && height <= params_.max_height);
+    }
+    const float area = elevated ? regionArea(candidates[s], support.frame)
+                                : polygonArea(support.polygon);
+    if (support.polygon.size() >= 3 && (largest || area >= params_.min_support_area))
+      kept |= static_cast<std::uint8_t>(1u << s);
+  }
+  for (const std::size_t s : family)
+    if (kept & (1u << s))
+      supports_.push_back(std::move(all[s]));
+  for (const Above& a : above_band)
+    if ((a.above & kept) && !(a.on & kept))
+      band.push_back(a.index);
+}
+
+template <typename PointT>
+std::vector<std::size_t>
+TabletopSegmentation<PointT>::supportFamily(const std::vector<Candidate>& candidates,
+                                            const std::vector<SupportPlane>& all) const
+{
+  // Families of parallel candidates.
+  std::vector<Eigen::Vector4f> normals;
+  std::vector<std::size_t> order;
+  for (std::size_t s = 0; s < candidates.size(); ++s) {
+    normals.push_back(Eigen::Vector4f(candidates[s].plane[0], candidates[s].plane[1],
+                                      candidates[s].plane[2], 0.f));
+    order.push_back(s); // largest first
+  }
+  const auto families = groupCoplanar(normals, order, params_.max_support_tilt,
+                                      std::numeric_limits<float>::infinity());
+  // With an up direction every candidate is horizontal already. Without one, the camera is
+  // taken to be upright: supports face the top of the image (their normal points against the
+  // image's down direction, measured on organized clouds); walls and ceilings do not. When no
+  // family does (a camera looking straight down, or rolled; unorganized clouds), any may. Then
+  // the family with most points wins.
+  const auto faces_up = [&](const std::vector<std::size_t>& f) {
+    return !up_.isZero() ||
+           candidates[f.front()].plane.template head<3>().dot(image_down_) <= -0.1f;
+  };
+  const bool any_faces_up = std::any_of(families.begin(), families.end(), faces_up);
+  std::size_t best = 0, best_points = 0;
+  for (std::size_t f = 0; f < families.size(); ++f) {
+    if (any_faces_up && !faces_up(families[f]))
+      continue;
+    std::size_t points = 0;
+    for (const std::size_t s : families[f])
+      points += all[s].inliers.indices.size();
+    if (points > best_points)
+      best = f, best_points = points;
+  }
+  return families.empty() ? std::vector<std::size_t>{} : families[best];
+}
+
+template <typename PointT>
+float
+TabletopSegmentation<PointT>::regionArea(const Candidate& c, const Eigen::Affine3f& frame) const
+{
+  const Eigen::Affine3f to_plane = frame.inverse();
+  std::vector<Eigen::Vector2f> flat;
+  for (const auto i : c.points)
+    flat.push_back((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
+  return polygonArea(convexHull2D(std::move(flat)));
+}
+
+template <typename PointT>
+std::vector<Eigen::Vector2f>
+TabletopSegmentation<PointT>::supportHull(const SupportPlane& s) const
+{
+  // Hull of every point on the plane (the plane regions found may miss parts of a table, e.g.
+  // the near edge where a real sensor's depth bends). The image of a plane is a projective
+  // map of it, which keeps convex hulls: on organized clouds only the first and the last
+  // point of each image row can be a vertex.
+  const Eigen::Affine3f to_plane = s.frame.inverse();
+  const auto& idx = s.inliers.indices;
+  std::vector<Eigen::Vector2f> flat;
+  const auto add = [&](pcl::index_t i) {
+    flat.push_back((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
+  };
+  if (input_->isOrganized()) {
+    const auto w = static_cast<pcl::index_t>(input_->width);
+    pcl::index_t row_end = -1; // inliers are ascending
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      if (idx[k] >= row_end) {
+        if (k > 0)
+          add(idx[k - 1]); // last of the previous row
+        add(idx[k]);       // first of this row
+        row_end = (idx[k] / w + 1) * w;
+      }
+    }
+    if (!idx.empty())
+      add(idx.back());
+  }
+  else {
+    const std::size_t stride = std::max<std::size_t>(1, idx.size() / params_.plane_samples);
+    for (std::size_t k = 0; k < idx.size(); k += stride)
+      add(idx[k]);
+  }
+  return convexHull2D(std::move(flat));
+}
+
+template <typename PointT>
+typename TabletopSegmentation<PointT>::Placement
+TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts,
+                                    const std::vector<std::size_t>& family) const
+{
+  const auto& p = params_;
+  Placement out;
+  std::vector<HeightProfile> profiles(supports_.size());
+  std::vector<float> over(supports_.size(), 0.f);
+  for (const std::size_t s : family) {
+    profiles[s] = heightProfile(pts, supports_[s].plane, p.min_height, p.max_height);
+    const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
+    std::size_t in_hull = 0;
+    for (Eigen::Index k = 0; k < pts.cols(); ++k)
+      in_hull += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).template head<2>(),
+                                supports_[s].polygon);
+    over[s] = static_cast<float>(in_hull) / static_cast<float>(pts.cols());
+    // The nearest support under the cluster: most of it in its band and over its hull (the
+    // prism test of pcl::ExtractPolygonalPrismData, per cluster).
+    if (profiles[s].in_band < 0.5f || over[s] < p.min_hull_share)
+      continue;
+    if (out.support < 0 || profiles[s].base < profiles[static_cast<std::size_t>(out.support)].base)
+      out.support = static_cast<int>(s);
+  }
+  if (out.support < 0)
+    return out;
+  // Legs hold up another support: they reach up to just under it.
+  for (const std::size_t s : family)
+    if (static_cast<int>(s) != out.support && over[s] >= 0.5f && profiles[s].top < 0.f &&
+        profiles[s].top > -0.1f) {
+      out.support = -1;
+      return out;
+    }
+  out.standing =
+    standsOn(profiles[static_cast<std::size_t>(out.support)], p.contact_height, p.max_height, 0.02f);
+  return out;
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::chooseSupports(std::vector<pcl::Indices>& groups,
+                                             std::vector<TabletopCluster>& clusters)
+{
+  const auto& p = params_;
+  // The clusters' points (at most 400 of each, evenly: enough for the height and hull tests).
+  std::vector<std::size_t> kept;
+  std::vector<Eigen::Matrix3Xf> points;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (groups[g].size() < p.min_cluster_size || groups[g].size() > p.max_cluster_size)
+      continue;
+    const std::size_t stride = std::max<std::size_t>(1, groups[g].size() / 400);
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>((groups[g].size() + stride - 1) / stride));
+    for (std::size_t k = 0, c = 0; k < groups[g].size(); k += stride, ++c)
+      pts.col(static_cast<Eigen::Index>(c)) = (*input_)[groups[g][k]].getVector3fMap();
+    kept.push_back(g);
+    points.push_back(std::move(pts));
+  }
+  std::vector<std::size_t> family(supports_.size());
+  std::iota(family.begin(), family.end(), 0);
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const Placement pl = place(points[k], family);
+    if (pl.support < 0)
+      continue;
+    SupportPlane& support = supports_[static_cast<std::size_t>(pl.support)];
+    ++support.objects;
+    if (pl.standing)
+      support.standing_points += groups[kept[k]].size();
+    clusters.push_back(makeCluster(std::move(groups[kept[k]]), pl.support));
+  }
+  // The table: the most object points standing on it; else the largest support.
+  table_ = family.front();
+  for (const std::size_t s : family)
+    if (supports_[s].standing_points > supports_[table_].standing_points ||
+        (supports_[s].standing_points == supports_[table_].standing_points &&
+         supports_[s].inliers.indices.size() > supports_[table_].inliers.indices.size()))
+      table_ = s;
+  table_found_ = supports_[table_].standing_points > 0;
+  // Keep the supports that hold objects, and the table.
+  std::vector<int> new_index(supports_.size(), -1);
+  std::vector<SupportPlane> used;
+  for (std::size_t s = 0; s < supports_.size(); ++s)
+    if (supports_[s].objects > 0 || s == table_) {
+      new_index[s] = static_cast<int>(used.size());
+      used.push_back(std::move(supports_[s]));
+    }
+  table_ = static_cast<std::size_t>(new_index[table_]);
+  supports_ = std::move(used);
+  for (auto& c : clusters)
+    c.support = new_index[static_cast<std::size_t>(c.support)];
+  const SupportPlane& table = supports_[table_];
+  table_coefficients_.header = input_->header;
+  table_coefficients_.values = {table.plane[0], table.plane[1], table.plane[2], table.plane[3]};
+  hull_->clear();
+  for (const auto& v : table.polygon) {
+    PointT q;
+    q.getVector3fMap() = table.frame * Eigen::Vector3f(v.x(), v.y(), 0.f);
+    hull_->push_back(q);
+  }
+}
+
+template <typename PointT>
+TabletopCluster
+TabletopSegmentation<PointT>::makeCluster(pcl::Indices indices, int support) const
+{
+  std::sort(indices.begin(), indices.end());
+  TabletopCluster c;
+  c.indices.header = input_->header;
+  c.indices.indices = std::move(indices);
+  c.support = support;
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.indices.indices.size()));
+  for (std::size_t k = 0; k < c.indices.indices.size(); ++k)
+    pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.indices.indices[k]].getVector3fMap();
+  c.centroid = pts.rowwise().mean();
+  c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
+                                : projectedBox(pts, camera_);
+  return c;
 }
 
 template <typename PointT>
 void
 TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
-                                               std::vector<pcl::PointIndices>& out) const
+                                               std::vector<pcl::Indices>& out) const
 {
-  // A sparse copy with only the object points finite: the connected components then never
-  // visit the rest of the image.
-  // (Buffers kept between calls: fresh VGA-sized allocations cost more in page faults than the
-  // work done on them.)
+  // A sparse copy with only the object points finite: the components then never visit the
+  // rest of the image. (Buffers kept between calls: fresh VGA-sized allocations cost more in
+  // page faults than the work done on them.)
   if (!masked_)
     masked_.reset(new pcl::PointCloud<pcl::PointXYZ>);
   const auto& masked = masked_;
@@ -324,6 +591,15 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   masked->is_dense = false;
   for (const auto i : objects)
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
+  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware &&
+      focal_ > 0.f) {
+    has_depth_.resize(input_->size());
+    for (std::size_t i = 0; i < input_->size(); ++i)
+      has_depth_[i] = pcl::isFinite((*input_)[i]);
+    out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
+                                  params_.objects);
+    return;
+  }
   pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
     new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
   comparator->setInputCloud(masked);
@@ -331,14 +607,19 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
   components.setInputCloud(masked);
   labels_.clear(); // PCL's segment() resizes without resetting: start empty (capacity stays)
-  components.segment(labels_, out);
+  std::vector<pcl::PointIndices> groups;
+  components.segment(labels_, groups);
+  out.clear();
+  for (auto& g : groups)
+    out.push_back(std::move(g.indices));
 }
 
 template <typename PointT>
 void
 TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
-                                                 std::vector<pcl::PointIndices>& out) const
+                                                 std::vector<pcl::Indices>& out) const
 {
+  out.clear();
   if (objects.empty())
     return;
   // Euclidean clusters of one representative per voxel of a quarter of the tolerance (any two
@@ -375,9 +656,9 @@ TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
   for (std::size_t g = 0; g < groups.size(); ++g)
     for (const auto i : groups[g].indices)
       group_of[i] = g;
-  out.assign(groups.size(), pcl::PointIndices{});
+  out.assign(groups.size(), pcl::Indices{});
   for (std::size_t k = 0; k < objects.size(); ++k)
-    out[group_of.at((*representatives)[voxel[k]])].indices.push_back(objects[k]);
+    out[group_of.at((*representatives)[voxel[k]])].push_back(objects[k]);
 }
 
 } // namespace facyl

@@ -1,0 +1,144 @@
+/*
+ * facyl: the options of TabletopCylinderRecognizer shared by the tools that run it
+ * (facyl_detect, facyl_tabletop_eval): one parser, one help text.
+ */
+#pragma once
+
+#include "cli.h"
+
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace facyl_cli {
+
+/** Options with a value that applyRecognizerOptions reads. */
+inline std::set<std::string>
+recognizerValueOptions()
+{
+  return {"--min-score", "--score", "--max-curvature-ratio", "--min-coverage", "--max-taper",
+          "--prior", "--radius-limits", "--orientations", "--max-fit-points", "--neighbours",
+          "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
+          "--cluster-size", "--up", "--clustering", "--support", "--max-cylinders-per-cluster"};
+}
+
+/** Switches that applyRecognizerOptions reads. */
+inline std::set<std::string>
+recognizerSwitches()
+{
+  return {"--no-retry", "--retry-inside", "--any-normal-sign"};
+}
+
+/** The help lines of those options. */
+inline const char*
+recognizerOptionsHelp()
+{
+  return "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
+         "angular coverage >= V and taper <= T):\n"
+         "  --score S              surface (default: lateral inliers + points on the end caps\n"
+         "                         and inner wall, over all points) | inlier (paper eq. 4)\n"
+         "  --min-score R          score threshold (default 0.5)\n"
+         "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
+         "                         (default 0.35; 1 turns the check off)\n"
+         "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
+         "  --max-taper T          the radius changes by at most T per unit of length along\n"
+         "                         the axis (default 0.15; 1 turns the check off)\n"
+         "  --no-retry             no second fit with upright/lying priors when the first fails\n"
+         "  --retry-inside         a last retry also fits concave clusters (the inside of an\n"
+         "                         open container; bowls too)\n"
+         "  --any-normal-sign      inliers' normals may point at the axis (default: away)\n"
+         "Fit:\n"
+         "  --prior P              orientation prior in the table frame: uniform | vertical\n"
+         "                         (default) | vertical-strong | horizontal\n"
+         "  --radius-limits A,B    radius interval in m (default 0.01,0.25)\n"
+         "  --orientations N       accumulator cells (default 450)\n"
+         "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
+         "  --neighbours K         k of the normal/curvature estimation (default 16)\n"
+         "  --seed S               accumulator seed (default 0)\n"
+         "  --max-cylinders-per-cluster N  cylinders extracted from a cluster the best fit\n"
+         "                         does not explain (touching, stacked objects; default 3;\n"
+         "                         1: off)\n"
+         "Segmentation:\n"
+         "  --up x,y,z             gravity's opposite in the cloud's frame: supports are then\n"
+         "                         the planes within 20 degrees of horizontal (default: the\n"
+         "                         camera is taken to be upright, image y down)\n"
+         "  --support S            standing (default: the plane most objects stand on, each\n"
+         "                         object on the plane under it) | largest (the largest plane)\n"
+         "  --clustering C         edge-aware (default: cut at depth jumps and concave\n"
+         "                         creases, join parts seen around an occluder) | euclidean\n"
+         "  --plane-distance D     support inlier distance in m (default 0.015)\n"
+         "  --height-limits A,B    object points lie A..B m above the support (0.01,0.5)\n"
+         "  --cluster-tolerance D  Euclidean clustering tolerance in m (default 0.02)\n"
+         "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n";
+}
+
+/** Reads the recognizer options of \a args into \a p and \a up (zero when not given).
+ * \throws std::invalid_argument for a malformed or out-of-range value. */
+inline void
+applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameters& p,
+                       Eigen::Vector3f& up)
+{
+  auto& d = p.decision;
+  d.min_score = static_cast<float>(args.number("--min-score", d.min_score));
+  const std::string score = args.text("--score", "surface");
+  if (score != "surface" && score != "inlier")
+    throw std::invalid_argument("--score must be surface or inlier");
+  d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
+                               : facyl::CylinderDecision::Score::InlierRatio;
+  d.max_curvature_ratio =
+    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
+  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
+  d.max_taper = static_cast<float>(args.number("--max-taper", d.max_taper));
+  p.retry_upright_lying = !args.has("--no-retry");
+  p.retry_any_normal_sign = args.has("--retry-inside");
+  p.hough.outward_normals = !args.has("--any-normal-sign");
+  if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
+    throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
+  const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
+  p.hough.radius_min = static_cast<float>(radii.first);
+  p.hough.radius_max = static_cast<float>(radii.second);
+  p.orientations = static_cast<std::size_t>(
+    args.integer("--orientations", static_cast<long long>(p.orientations), 10));
+  p.max_fit_points = static_cast<std::size_t>(
+    args.integer("--max-fit-points", static_cast<long long>(p.max_fit_points), 50));
+  p.neighbours = static_cast<int>(args.integer("--neighbours", p.neighbours, 5));
+  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
+  p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(
+    "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1));
+  auto& g = p.segmentation;
+  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance));
+  const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
+  g.min_height = static_cast<float>(heights.first);
+  g.max_height = static_cast<float>(heights.second);
+  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance));
+  const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
+                                static_cast<double>(g.max_cluster_size));
+  if (!(sizes.first >= 1 && sizes.second >= sizes.first))
+    throw std::invalid_argument("--cluster-size: expected 1 <= A <= B");
+  g.min_cluster_size = static_cast<std::size_t>(sizes.first);
+  g.max_cluster_size = static_cast<std::size_t>(sizes.second);
+  const std::string clustering = args.text("--clustering", "edge-aware");
+  if (clustering != "edge-aware" && clustering != "euclidean")
+    throw std::invalid_argument("--clustering must be edge-aware or euclidean");
+  g.clustering = clustering == "euclidean"
+                   ? facyl::TabletopSegmentationParameters::Clustering::Euclidean
+                   : facyl::TabletopSegmentationParameters::Clustering::EdgeAware;
+  const std::string support = args.text("--support", "standing");
+  if (support != "standing" && support != "largest")
+    throw std::invalid_argument("--support must be standing or largest");
+  g.support = support == "largest" ? facyl::TabletopSegmentationParameters::Support::LargestPlane
+                                   : facyl::TabletopSegmentationParameters::Support::ObjectsStanding;
+  up = Eigen::Vector3f::Zero();
+  if (args.has("--up")) {
+    up = args.vector3("--up", up);
+    if (!(up.norm() > 0.f))
+      throw std::invalid_argument("--up must be a non-zero vector");
+  }
+  const std::string why = facyl::validate(p);
+  if (!why.empty())
+    throw std::invalid_argument(why);
+}
+
+} // namespace facyl_cli

@@ -1,0 +1,58 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Small 2-D polygon helpers shared by the segmentation and the simulators.
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace facyl {
+
+/** \brief Convex hull of 2-D points (Andrew's monotone chain), counter-clockwise, without
+ * collinear vertices. Fewer than 3 points are returned sorted. O(n log n). */
+inline std::vector<Eigen::Vector2f>
+convexHull2D(std::vector<Eigen::Vector2f> p)
+{
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3)
+    return p;
+  const auto cross = [](const Eigen::Vector2f& o, const Eigen::Vector2f& a,
+                        const Eigen::Vector2f& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2f> h(2 * p.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0.f)
+      --k;
+    h[k++] = p[i];
+  }
+  for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0.f)
+      --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+/** \brief Area of a simple polygon (shoelace formula), >= 0. */
+inline float
+polygonArea(const std::vector<Eigen::Vector2f>& polygon)
+{
+  double twice = 0.0;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2f& a = polygon[i];
+    const Eigen::Vector2f& b = polygon[(i + 1) % polygon.size()];
+    twice += static_cast<double>(a.x()) * b.y() - static_cast<double>(b.x()) * a.y();
+  }
+  return static_cast<float>(0.5 * std::abs(twice));
+}
+
+} // namespace facyl

@@ -1,0 +1,89 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Splitting the points above a table into objects that touch, stack or occlude each other:
+ * free functions on an organized cloud, so that tests reach every step.
+ */
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace facyl {
+
+/** \brief Settings of segmentObjectsOrganized (lengths in metres). */
+struct ObjectSegmentationParameters {
+  /** Depth discontinuity: 4-neighbours farther apart than jump_factor times the footprint of a
+   * pixel at their depth (z / focal) are not connected, clamped to [min_gap, max_gap]. At a
+   * surface seen under a grazing angle neighbours are 1 / cos(incidence) footprints apart, so
+   * 8 keeps surfaces up to about 83 degrees connected. */
+  float jump_factor{8.f};
+  float min_gap{0.006f};
+  float max_gap{0.02f};
+  /** Concave creases (where objects touch or stand on each other, seen from the sensor): over
+   * crease_span(z) = max(crease_span, crease_span_z2 * z^2) on each side of a pixel, the
+   * surface turns away from the sensor by more than crease_angle (rad). The span grows with
+   * z^2 like depth noise. crease_angle 0 turns creases off. */
+  float crease_span{0.012f};
+  float crease_span_z2{0.012f};
+  float crease_angle{0.45f};
+  /** Segments of fewer points join the neighbour they share most connected boundary with. */
+  std::size_t min_fragment{40};
+  /** A segment whose boundary lies at least this share along one larger segment, connected
+   * but cut by a crease, joins it (the bottom inside a cup, a lid's rim). In (0, 1]. */
+  float enclosed_share{0.6f};
+  /** Two segments on both sides of a nearer occluder that continue one surface (local planes
+   * within bridge_angle rad, each part within bridge_distance of the other's plane, at most
+   * bridge_max_gap apart) are one object seen through the gap. */
+  bool bridge_occlusions{true};
+  float bridge_max_gap{0.25f};
+  float bridge_angle{0.3f};
+  float bridge_distance{0.015f};
+};
+
+/** \brief Checks \a params. \return an empty string, or what is wrong. */
+std::string
+validate(const ObjectSegmentationParameters& params);
+
+/** \brief Focal length in pixels of an organized cloud taken by a pinhole camera: the median
+ * of x / (u - cx) over finite pixels, with cx = (width - 1) / 2. 0 when it cannot tell. */
+float
+estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud);
+
+/** \brief The direction in which the image rows of an organized cloud go down (the camera's
+ * y axis), in the cloud's frame, from the data alone: the mean over columns of the unit ray
+ * (from \a viewpoint) of the lowest point minus that of the highest. Zero when it cannot tell.
+ * Needs no sensor orientation, so clouds stored in any frame give the camera's. */
+Eigen::Vector3f
+imageDownDirection(const pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Vector3f& viewpoint);
+
+/** \brief Per pixel of \a cloud (organized, non-object pixels NaN): 1 on a concave crease
+ * seen from \a viewpoint, in either image direction (see ObjectSegmentationParameters). Each
+ * test compares three points, each the mean of 5 pixels across the test direction, which
+ * averages depth noise along the crease without blurring it. */
+std::vector<std::uint8_t>
+concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
+               const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& params);
+
+/** \brief Splits the finite points of \a cloud (organized; only the candidate object points
+ * finite) into objects:
+ * 1. connected components over 4-neighbours without a depth discontinuity, crease pixels
+ *    left out; crease pixels then join the component that reaches them first (breadth first);
+ * 2. fragments and enclosed segments join their neighbour;
+ * 3. (bridge_occlusions) parts of one surface on both sides of a nearer occluder are joined.
+ * \param has_depth per pixel of the full frame: 1 where the sensor measured depth (table and
+ *        background included), to tell an occluder's shadow from visible table.
+ * \param focal focal length in pixels (> 0).
+ * \return the segments' point indices, ascending, in no particular order of segments. */
+std::vector<pcl::Indices>
+segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                        const std::vector<std::uint8_t>& has_depth, float focal,
+                        const Eigen::Vector3f& viewpoint,
+                        const ObjectSegmentationParameters& params);
+
+} // namespace facyl

@@ -1,0 +1,653 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#include <facyl/segmentation/object_segmentation.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+#include <cstdlib>
+
+namespace facyl {
+
+std::string
+validate(const ObjectSegmentationParameters& p)
+{
+  std::ostringstream s;
+  if (!(p.jump_factor > 0.f) || !std::isfinite(p.jump_factor))
+    s << "jump_factor must be > 0";
+  else if (!(p.min_gap > 0.f && p.max_gap >= p.min_gap && std::isfinite(p.max_gap)))
+    s << "gaps must satisfy 0 < min_gap <= max_gap";
+  else if (!(p.crease_span > 0.f && p.crease_span <= 0.2f) ||
+           !(p.crease_span_z2 >= 0.f && p.crease_span_z2 <= 0.2f))
+    s << "crease spans must be in (0, 0.2] m (crease_span_z2 in [0, 0.2])";
+  else if (!(p.crease_angle >= 0.f && p.crease_angle < 3.1f))
+    s << "crease_angle must be in [0, pi)";
+  else if (!(p.enclosed_share > 0.f && p.enclosed_share <= 1.f))
+    s << "enclosed_share must be in (0, 1]";
+  else if (!(p.bridge_max_gap > 0.f && p.bridge_max_gap <= 2.f) ||
+           !(p.bridge_angle > 0.f && p.bridge_angle < 1.57f) || !(p.bridge_distance > 0.f))
+    s << "bridge settings must be positive (gap <= 2 m, angle < pi/2)";
+  return s.str();
+}
+
+namespace {
+
+bool
+finite(const pcl::PointXYZ& p)
+{
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+class UnionFind {
+public:
+  explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  int
+  find(int a)
+  {
+    while (parent_[static_cast<std::size_t>(a)] != a) {
+      auto& p = parent_[static_cast<std::size_t>(a)];
+      p = parent_[static_cast<std::size_t>(p)];
+      a = p;
+    }
+    return a;
+  }
+  void
+  unite(int a, int b)
+  {
+    a = find(a), b = find(b);
+    if (a != b)
+      parent_[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+  }
+
+private:
+  std::vector<int> parent_;
+};
+
+/** The valid pixels of an organized cloud, numbered compactly (in image order), with their
+ * ranges and the connection test between neighbours. */
+class Grid {
+public:
+  Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
+       const ObjectSegmentationParameters& p)
+  : cloud_(cloud), w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
+    slot_(cloud.size(), -1)
+  {
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      if (finite(cloud[i])) {
+        slot_[i] = static_cast<int>(pixel_.size());
+        pixel_.push_back(i);
+        u_.push_back(static_cast<int>(i % static_cast<std::size_t>(w_)));
+        v_.push_back(static_cast<int>(i / static_cast<std::size_t>(w_)));
+        const float r = (cloud[i].getVector3fMap() - viewpoint).norm();
+        range_.push_back(r);
+        const float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
+        gap2_.push_back(gap * gap);
+      }
+  }
+  int
+  width() const
+  {
+    return w_;
+  }
+  int
+  height() const
+  {
+    return h_;
+  }
+  /** Valid pixels. */
+  std::size_t
+  size() const
+  {
+    return pixel_.size();
+  }
+  std::size_t
+  pixel(int c) const
+  {
+    return pixel_[static_cast<std::size_t>(c)];
+  }
+  /** Compact number of pixel (u, v), or -1 (outside the image, or not valid). */
+  int
+  at(int u, int v) const
+  {
+    if (u < 0 || v < 0 || u >= w_ || v >= h_)
+      return -1;
+    return slot_[static_cast<std::size_t>(v) * w_ + u];
+  }
+  Eigen::Vector3f
+  point(int c) const
+  {
+    return cloud_[pixel(c)].getVector3fMap();
+  }
+  float
+  range(int c) const
+  {
+    return range_[static_cast<std::size_t>(c)];
+  }
+  /** Neighbours a and b are on one surface: no depth discontinuity. */
+  bool
+  linked(int a, int b) const
+  {
+    const float g2 = std::min(gap2_[static_cast<std::size_t>(a)], gap2_[static_cast<std::size_t>(b)]);
+    return (point(a) - point(b)).squaredNorm() < g2;
+  }
+  /** Calls f(b) for each valid 4-neighbour b of a, and g() for each other neighbour. */
+  template <typename F, typename G>
+  void
+  forNeighbours(int a, F f, G g) const
+  {
+    const int u = u_[static_cast<std::size_t>(a)], v = v_[static_cast<std::size_t>(a)];
+    for (const int b : {at(u + 1, v), at(u - 1, v), at(u, v + 1), at(u, v - 1)}) {
+      if (b >= 0)
+        f(b);
+      else
+        g();
+    }
+  }
+  /** Image position of valid pixel c. */
+  void
+  position(int c, int& u, int& v) const
+  {
+    u = u_[static_cast<std::size_t>(c)];
+    v = v_[static_cast<std::size_t>(c)];
+  }
+
+private:
+  const pcl::PointCloud<pcl::PointXYZ>& cloud_;
+  int w_, h_;
+  std::vector<int> slot_;
+  std::vector<std::size_t> pixel_;
+  std::vector<int> u_, v_;
+  std::vector<float> range_, gap2_;
+};
+
+/** Per valid pixel: the mean of the valid points among the 5 pixels centred on it across a
+ * test direction (vertical for horizontal tests), when at least 3 are valid. */
+struct AcrossMeans {
+  std::vector<Eigen::Vector3f> mean;
+  std::vector<std::uint8_t> ok;
+};
+
+AcrossMeans
+acrossMeans(const Grid& grid, bool horizontal)
+{
+  AcrossMeans m;
+  m.mean.resize(grid.size());
+  m.ok.assign(grid.size(), 0);
+  for (std::size_t c = 0; c < grid.size(); ++c) {
+    int u, v;
+    grid.position(static_cast<int>(c), u, v);
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    int n = 0;
+    for (int d = -2; d <= 2; ++d) {
+      const int b = horizontal ? grid.at(u, v + d) : grid.at(u + d, v);
+      if (b >= 0) {
+        sum += grid.point(b);
+        ++n;
+      }
+    }
+    if (n >= 3) {
+      m.mean[c] = sum / static_cast<float>(n);
+      m.ok[c] = 1;
+    }
+  }
+  return m;
+}
+
+/** Per valid pixel: 1 on a concave crease (see concaveCreases). */
+std::vector<std::uint8_t>
+creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
+        const ObjectSegmentationParameters& p)
+{
+  std::vector<std::uint8_t> crease(grid.size(), 0);
+  if (!(p.crease_angle > 0.f) || !(focal > 0.f))
+    return crease;
+  const float cos_max = std::cos(p.crease_angle);
+  const AcrossMeans across[2] = {acrossMeans(grid, true), acrossMeans(grid, false)};
+  for (std::size_t c = 0; c < grid.size(); ++c) {
+    const float range = grid.range(static_cast<int>(c));
+    const float span = std::max(p.crease_span, p.crease_span_z2 * range * range);
+    const int k = std::clamp(static_cast<int>(std::lround(span * focal / range)), 2, 24);
+    int u, v;
+    grid.position(static_cast<int>(c), u, v);
+    for (int dir = 0; dir < 2 && !crease[c]; ++dir) {
+      const AcrossMeans& m = across[dir];
+      const int a = dir == 0 ? grid.at(u - k, v) : grid.at(u, v - k);
+      const int z = dir == 0 ? grid.at(u + k, v) : grid.at(u, v + k);
+      if (a < 0 || z < 0 || !m.ok[c] || !m.ok[static_cast<std::size_t>(a)] ||
+          !m.ok[static_cast<std::size_t>(z)])
+        continue;
+      const Eigen::Vector3f& pa = m.mean[static_cast<std::size_t>(a)];
+      const Eigen::Vector3f& pb = m.mean[c];
+      const Eigen::Vector3f& pc = m.mean[static_cast<std::size_t>(z)];
+      const Eigen::Vector3f e1 = pb - pa, e2 = pc - pb;
+      const float l1 = e1.norm(), l2 = e2.norm();
+      // Much longer than the span: a depth jump, which the connection test handles.
+      if (!(l1 > 0.f && l2 > 0.f) || l1 > 8.f * span || l2 > 8.f * span)
+        continue;
+      if (e1.dot(e2) > cos_max * l1 * l2)
+        continue;
+      // Concave seen from the sensor: the middle lies behind the chord.
+      crease[c] = (pb - 0.5f * (pa + pc)).dot(pb - viewpoint) > 0.f;
+    }
+  }
+  return crease;
+}
+
+/** Connected components of the valid pixels accepted by \a use (and unlabelled), over linked
+ * neighbours; numbers them from \a next on in \a label. \return the next free number. */
+template <typename Use>
+int
+components(const Grid& grid, Use use, std::vector<int>& label, int next)
+{
+  UnionFind uf(grid.size());
+  for (int a = 0; a < static_cast<int>(grid.size()); ++a) {
+    if (label[static_cast<std::size_t>(a)] >= 0 || !use(a))
+      continue;
+    int u, v;
+    grid.position(a, u, v);
+    for (const int b : {grid.at(u + 1, v), grid.at(u, v + 1)})
+      if (b >= 0 && label[static_cast<std::size_t>(b)] < 0 && use(b) && grid.linked(a, b))
+        uf.unite(a, b);
+  }
+  std::vector<int> number(grid.size(), -1);
+  for (int a = 0; a < static_cast<int>(grid.size()); ++a) {
+    if (label[static_cast<std::size_t>(a)] >= 0 || !use(a))
+      continue;
+    int& n = number[static_cast<std::size_t>(uf.find(a))];
+    if (n < 0)
+      n = next++;
+    label[static_cast<std::size_t>(a)] = n;
+  }
+  return next;
+}
+
+/** Segments as groups of labels, with the statistics the merges need. */
+class Segments {
+public:
+  Segments(const Grid& grid, std::vector<int> label, int count)
+  : grid_(grid), label_(std::move(label)), group_(static_cast<std::size_t>(count)),
+    size_(static_cast<std::size_t>(count), 0), boundary_(static_cast<std::size_t>(count), 0)
+  {
+    std::iota(group_.begin(), group_.end(), 0);
+    for (int i = 0; i < static_cast<int>(grid_.size()); ++i) {
+      const int a = label_[static_cast<std::size_t>(i)];
+      ++size_[static_cast<std::size_t>(a)];
+      grid_.forNeighbours(
+        i,
+        [&](int j) {
+          const int b = label_[static_cast<std::size_t>(j)];
+          if (b == a)
+            return;
+          ++boundary_[static_cast<std::size_t>(a)];
+          auto& link = links_[key(a, b)];
+          ++link.all;
+          link.connected += grid_.linked(i, j);
+        },
+        [&] { ++boundary_[static_cast<std::size_t>(a)]; });
+    }
+  }
+
+  /** Fragments, then enclosed segments, join a neighbour, until nothing changes. */
+  void
+  mergeNeighbours(std::size_t min_fragment, float enclosed_share)
+  {
+    for (bool changed = true; changed;) {
+      changed = false;
+      const auto stats = groupStats();
+      for (const auto& [g, s] : stats) {
+        if (find(g) != g)
+          continue; // merged in this pass already
+        int best = -1;
+        std::size_t best_links = 0;
+        for (const auto& [h, link] : s.links)
+          if (find(h) != g && link.connected > best_links && stats.at(h).size >= s.size)
+            best = h, best_links = link.connected;
+        if (best < 0)
+          continue;
+        const bool fragment = s.size < min_fragment;
+        const bool enclosed =
+          static_cast<float>(best_links) >= enclosed_share * static_cast<float>(s.boundary);
+        if (fragment || enclosed) {
+          group_[static_cast<std::size_t>(g)] = find(best);
+          changed = true;
+        }
+      }
+    }
+  }
+
+  /** Joins the parts of one surface on both sides of a nearer occluder. */
+  void
+  bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size_t min_part,
+                   const ObjectSegmentationParameters& p)
+  {
+    std::map<int, std::vector<int>> pixels; // group -> its pixels
+    for (int i = 0; i < static_cast<int>(grid_.size()); ++i)
+      pixels[find(label_[static_cast<std::size_t>(i)])].push_back(i);
+    std::vector<int> groups;
+    for (const auto& [g, px] : pixels)
+      if (px.size() >= min_part)
+        groups.push_back(g);
+    std::map<int, std::vector<int>> borders;
+    std::map<int, Eigen::AlignedBox3f> boxes;
+    for (const int g : groups) {
+      borders[g] = border(pixels[g], g);
+      for (const int i : pixels[g])
+        boxes[g].extend(grid_.point(i));
+    }
+    for (std::size_t a = 0; a < groups.size(); ++a)
+      for (std::size_t b = a + 1; b < groups.size(); ++b) {
+        const int g = find(groups[a]), h = find(groups[b]);
+        if (g == h || boxes[groups[a]].exteriorDistance(boxes[groups[b]]) > p.bridge_max_gap)
+          continue;
+        if (sameSurfaceBehind(pixels[groups[a]], pixels[groups[b]], borders[groups[a]],
+                              borders[groups[b]], g, h, has_depth, p))
+          group_[static_cast<std::size_t>(std::max(g, h))] = std::min(g, h);
+      }
+  }
+
+  /** Point indices of every group, ascending. */
+  std::vector<pcl::Indices>
+  indices() const
+  {
+    std::vector<int> slot(group_.size(), -1);
+    std::vector<pcl::Indices> out;
+    for (int i = 0; i < static_cast<int>(grid_.size()); ++i) {
+      const int g = findConst(label_[static_cast<std::size_t>(i)]);
+      int& k = slot[static_cast<std::size_t>(g)];
+      if (k < 0) {
+        k = static_cast<int>(out.size());
+        out.emplace_back();
+      }
+      out[static_cast<std::size_t>(k)].push_back(static_cast<pcl::index_t>(grid_.pixel(i)));
+    }
+    return out;
+  }
+
+private:
+  struct Link {
+    std::size_t all{0};       ///< 4-neighbour pairs across the border
+    std::size_t connected{0}; ///< of which without a depth discontinuity
+  };
+  struct GroupStats {
+    std::size_t size{0}, boundary{0};
+    std::map<int, Link> links; ///< to other groups
+  };
+
+  static std::uint64_t
+  key(int a, int b)
+  {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+           static_cast<std::uint32_t>(b);
+  }
+  int
+  find(int a)
+  {
+    while (group_[static_cast<std::size_t>(a)] != a)
+      a = group_[static_cast<std::size_t>(a)] =
+        group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(a)])];
+    return a;
+  }
+  int
+  findConst(int a) const
+  {
+    while (group_[static_cast<std::size_t>(a)] != a)
+      a = group_[static_cast<std::size_t>(a)];
+    return a;
+  }
+
+  std::map<int, GroupStats>
+  groupStats()
+  {
+    std::map<int, GroupStats> stats;
+    for (std::size_t s = 0; s < size_.size(); ++s) {
+      auto& g = stats[find(static_cast<int>(s))];
+      g.size += size_[s];
+      g.boundary += boundary_[s];
+    }
+    for (const auto& [k, link] : links_) {
+      const int g = find(static_cast<int>(k >> 32)), h = find(static_cast<int>(k & 0xffffffffu));
+      if (g == h) { // inside one group now: not boundary
+        stats[g].boundary -= link.all;
+        continue;
+      }
+      auto& l = stats[g].links[h];
+      l.all += link.all;
+      l.connected += link.connected;
+    }
+    return stats;
+  }
+
+  /** Boundary pixels of a part (a 4-neighbour in another group or none), at most 100. */
+  std::vector<int>
+  border(const std::vector<int>& px, int g) const
+  {
+    std::vector<int> out;
+    for (const int i : px) {
+      bool edge = false;
+      grid_.forNeighbours(
+        i, [&](int j) { edge = edge || findConst(label_[static_cast<std::size_t>(j)]) != g; },
+        [&] { edge = true; });
+      if (edge)
+        out.push_back(i);
+    }
+    if (out.size() > 100) {
+      std::vector<int> thin;
+      for (std::size_t k = 0; k < 100; ++k)
+        thin.push_back(out[k * out.size() / 100]);
+      out.swap(thin);
+    }
+    return out;
+  }
+
+  /** Plane (centroid, unit normal) of the points of \a px within \a radius of \a centre. */
+  bool
+  localPlane(const std::vector<int>& px, const Eigen::Vector3f& centre, float radius,
+             Eigen::Vector3f& centroid, Eigen::Vector3f& normal) const
+  {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    std::size_t n = 0;
+    const std::size_t step = std::max<std::size_t>(1, px.size() / 3000);
+    for (std::size_t k = 0; k < px.size(); k += step) {
+      const Eigen::Vector3f q = grid_.point(px[k]);
+      if ((q - centre).squaredNorm() > radius * radius)
+        continue;
+      const Eigen::Vector3d d = q.cast<double>();
+      sum += d;
+      outer += d * d.transpose();
+      ++n;
+    }
+    if (n < 10)
+      return false;
+    const Eigen::Vector3d mean = sum / static_cast<double>(n);
+    const Eigen::Matrix3d cov = outer / static_cast<double>(n) - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    centroid = mean.cast<float>();
+    normal = eig.eigenvectors().col(0).cast<float>();
+    return true;
+  }
+
+  bool
+  sameSurfaceBehind(const std::vector<int>& pa, const std::vector<int>& pb,
+                    const std::vector<int>& ba, const std::vector<int>& bb, int g, int h,
+                    const std::vector<std::uint8_t>& has_depth,
+                    const ObjectSegmentationParameters& p) const
+  {
+    // The closest border pixels of the two parts, in the image.
+    int ia = -1, ib = -1;
+    long best = std::numeric_limits<long>::max();
+    for (const int i : ba) {
+      int ui, vi;
+      grid_.position(i, ui, vi);
+      for (const int j : bb) {
+        int uj, vj;
+        grid_.position(j, uj, vj);
+        const long du = ui - uj, dv = vi - vj;
+        if (du * du + dv * dv < best)
+          best = du * du + dv * dv, ia = i, ib = j;
+      }
+    }
+    if (ia < 0 || best <= 4)
+      return false; // adjacent: split on purpose (a crease or a jump), not seen through a gap
+    const Eigen::Vector3f xa = grid_.point(ia), xb = grid_.point(ib);
+    if ((xa - xb).norm() > p.bridge_max_gap)
+      return false;
+    // Everything between them is nearer (an occluder) or without depth (its shadow).
+    const float ra = grid_.range(ia), rb = grid_.range(ib);
+    int ua, va, ub, vb;
+    grid_.position(ia, ua, va);
+    grid_.position(ib, ub, vb);
+    const int steps = std::max(std::abs(ub - ua), std::abs(vb - va));
+    std::size_t occluder = 0;
+    for (int s = 1; s < steps; ++s) {
+      const float t = static_cast<float>(s) / static_cast<float>(steps);
+      const int u = static_cast<int>(std::lround(static_cast<float>(ua) + t * static_cast<float>(ub - ua)));
+      const int v = static_cast<int>(std::lround(static_cast<float>(va) + t * static_cast<float>(vb - va)));
+      const int c = grid_.at(u, v);
+      if (c >= 0) {
+        const int k = findConst(label_[static_cast<std::size_t>(c)]);
+        if (k == g || k == h)
+          continue;
+        if (grid_.range(c) > (1.f - t) * ra + t * rb - 0.01f)
+          return false; // an object behind, or level with them: not an occluder
+        ++occluder;
+      }
+      else if (has_depth[static_cast<std::size_t>(v) * static_cast<std::size_t>(grid_.width()) +
+                         static_cast<std::size_t>(u)]) {
+        return false; // the table or the background shows between them
+      }
+    }
+    if (occluder == 0)
+      return false;
+    // One surface: local planes at both ends agree.
+    const float radius = 0.04f;
+    Eigen::Vector3f ca, na, cb, nb;
+    if (!localPlane(pa, xa, radius, ca, na) || !localPlane(pb, xb, radius, cb, nb))
+      return false;
+    return std::abs(na.dot(nb)) >= std::cos(p.bridge_angle) &&
+           std::abs(na.dot(cb - ca)) <= p.bridge_distance &&
+           std::abs(nb.dot(ca - cb)) <= p.bridge_distance;
+  }
+
+  const Grid& grid_;
+  std::vector<int> label_; ///< per valid pixel
+  std::vector<int> group_;
+  std::vector<std::size_t> size_, boundary_;
+  std::unordered_map<std::uint64_t, Link> links_;
+};
+
+} // namespace
+
+float
+estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud)
+{
+  if (!cloud.isOrganized() || cloud.width < 8)
+    return 0.f;
+  const float cx = 0.5f * static_cast<float>(cloud.width - 1);
+  std::vector<float> f;
+  const std::size_t step = std::max<std::size_t>(1, cloud.size() / 4000);
+  for (std::size_t i = 0; i < cloud.size(); i += step) {
+    const auto& p = cloud[i];
+    const float du = static_cast<float>(i % cloud.width) - cx;
+    if (finite(p) && std::abs(du) > 0.1f * cloud.width && p.z > 0.f)
+      f.push_back(du * p.z / p.x);
+  }
+  if (f.size() < 20)
+    return 0.f;
+  std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
+  const float focal = f[f.size() / 2];
+  return std::isfinite(focal) && focal > 0.f ? focal : 0.f;
+}
+
+Eigen::Vector3f
+imageDownDirection(const pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Vector3f& viewpoint)
+{
+  if (!cloud.isOrganized() || cloud.height < 2)
+    return Eigen::Vector3f::Zero();
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  for (std::uint32_t u = 0; u < cloud.width; ++u) {
+    int top = -1, bottom = -1;
+    for (std::uint32_t v = 0; v < cloud.height; ++v)
+      if (finite(cloud.at(u, v))) {
+        if (top < 0)
+          top = static_cast<int>(v);
+        bottom = static_cast<int>(v);
+      }
+    if (top < 0 || bottom <= top)
+      continue;
+    const auto ray = [&](int v) {
+      return Eigen::Vector3f((cloud.at(u, static_cast<std::uint32_t>(v)).getVector3fMap() -
+                              viewpoint).normalized());
+    };
+    sum += ray(bottom) - ray(top);
+  }
+  const float n = sum.norm();
+  return n > 0.f && std::isfinite(n) ? Eigen::Vector3f(sum / n) : Eigen::Vector3f::Zero();
+}
+
+std::vector<std::uint8_t>
+concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
+               const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p)
+{
+  std::vector<std::uint8_t> out(cloud.size(), 0);
+  if (!cloud.isOrganized() || !(focal > 0.f))
+    return out;
+  const Grid grid(cloud, focal, viewpoint, p);
+  const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);
+  for (std::size_t c = 0; c < grid.size(); ++c)
+    out[grid.pixel(static_cast<int>(c))] = crease[c];
+  return out;
+}
+
+std::vector<pcl::Indices>
+segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                        const std::vector<std::uint8_t>& has_depth, float focal,
+                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p)
+{
+  if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
+    return {};
+  const Grid grid(cloud, focal, viewpoint, p);
+  if (grid.size() == 0)
+    return {};
+  const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);
+  // 1. Components without the crease pixels.
+  std::vector<int> label(grid.size(), -1);
+  int count = components(grid, [&](int a) { return !crease[static_cast<std::size_t>(a)]; },
+                         label, 0);
+  // Crease pixels join the component that reaches them first (breadth first from all).
+  std::vector<int> queue;
+  queue.reserve(grid.size());
+  for (int a = 0; a < static_cast<int>(grid.size()); ++a)
+    if (label[static_cast<std::size_t>(a)] >= 0)
+      queue.push_back(a);
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int a = queue[head];
+    grid.forNeighbours(
+      a,
+      [&](int b) {
+        if (label[static_cast<std::size_t>(b)] < 0 && grid.linked(a, b)) {
+          label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
+          queue.push_back(b);
+        }
+      },
+      [] {});
+  }
+  // Crease pixels no component reached (thin parts) are components of their own.
+  count = components(grid, [](int) { return true; }, label, count);
+  // 2. Fragments and enclosed segments join their neighbour; 3. occluded parts are joined.
+  Segments segments(grid, std::move(label), count);
+  segments.mergeNeighbours(p.min_fragment, p.enclosed_share);
+  if (p.bridge_occlusions)
+    segments.bridgeOcclusions(has_depth, p.min_fragment, p);
+  return segments.indices();
+}
+
+} // namespace facyl
