@@ -9,9 +9,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 namespace facyl_test {
+
+/** A file of the real data folder (FACYL_REAL_DATA_DIR), or "" when it is absent. */
+inline std::string
+realFile(const std::string& name)
+{
+  const std::filesystem::path p = std::filesystem::path(FACYL_REAL_DATA_DIR) / name;
+  return std::filesystem::exists(p) ? p.string() : std::string();
+}
 
 inline pcl::PointCloud<facyl::NormalCurvature>::Ptr
 estimateCues(const pcl::PointCloud<pcl::PointNormal>::ConstPtr& cloud, int k = 16)

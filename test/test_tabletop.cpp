@@ -512,12 +512,7 @@ TEST(TabletopCylinderRecognizer, ReportsBadInput)
 // ---------------------------------------------------------------- real data
 
 namespace {
-std::string
-realFile(const std::string& name)
-{
-  const std::filesystem::path p = std::filesystem::path(FACYL_REAL_DATA_DIR) / name;
-  return std::filesystem::exists(p) ? p.string() : std::string();
-}
+using facyl_test::realFile;
 } // namespace
 
 TEST(RealData, TheTutorialMug)

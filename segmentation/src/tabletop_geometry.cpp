@@ -178,11 +178,16 @@ heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, floa
     return h;
   std::vector<float> heights(static_cast<std::size_t>(points.cols()));
   std::size_t in_band = 0;
+  const Eigen::Vector3f n = plane.head<3>();
+  const Eigen::Vector3f e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+  Eigen::AlignedBox2f box;
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    const float z = plane.head<3>().dot(points.col(i)) + plane[3];
+    const float z = n.dot(points.col(i)) + plane[3];
     heights[static_cast<std::size_t>(i)] = z;
     in_band += z >= min_height && z <= max_height;
+    box.extend(Eigen::Vector2f(e1.dot(points.col(i)), e2.dot(points.col(i))));
   }
+  h.extent = box.diagonal().norm();
   const auto at = [&heights](double q) {
     const auto k = static_cast<std::size_t>(q * static_cast<double>(heights.size() - 1));
     std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k), heights.end());

@@ -25,6 +25,7 @@ struct HeightProfile {
   float base{0.f};          ///< 2nd percentile of the heights
   float top{0.f};           ///< 98th percentile
   float in_band{0.f};       ///< share of the points with height in [min, max]
+  float extent{0.f};        ///< diagonal of the points' bounding box along the plane
 };
 
 /** \brief HeightProfile of \a points (3 x n) over \a plane (unit normal), band [min, max]. */
@@ -33,12 +34,13 @@ heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, floa
               float max_height);
 
 /** \brief A cluster stands on a plane when it reaches down to it (base <= contact) and is
- * whole inside the object band (top below max_height - margin): a table's objects do, the
- * legs of the table over a floor do not (they reach up to the table top). */
+ * whole inside the object band, a box max_height high and wide (top below max_height -
+ * margin, extent below max_height): a table's objects do; the legs of a table over a floor
+ * (they reach up to the table top) and the foot of a wall (wide) do not. */
 inline bool
 standsOn(const HeightProfile& h, float contact, float max_height, float margin)
 {
-  return h.base <= contact && h.top <= max_height - margin;
+  return h.base <= contact && h.top <= max_height - margin && h.extent <= max_height;
 }
 
 } // namespace facyl

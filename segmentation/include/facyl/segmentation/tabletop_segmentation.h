@@ -268,9 +268,10 @@ private:
   /** Area of the convex hull of the points that found \a c, in \a frame's plane. */
   float
   regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;
-  /** Convex hull of a support's inliers, in its plane's coordinates. */
+  /** Convex hull of a support's points, in its plane's coordinates: on organized clouds
+   * those near the region found as candidate \a c (every point when nullptr). */
   std::vector<Eigen::Vector2f>
-  supportHull(const SupportPlane& support) const;
+  supportHull(const SupportPlane& support, const Candidate* c) const;
   void
   clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   void
@@ -290,6 +291,7 @@ private:
   PinholeCamera camera_;
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   std::vector<SupportPlane> supports_;
+  std::vector<std::vector<Eigen::Vector2f>> extents_; ///< hulls of all the supports' points
   std::size_t table_{0};
   bool table_found_{false};
   float focal_{0.f}; ///< pixels (organized input)

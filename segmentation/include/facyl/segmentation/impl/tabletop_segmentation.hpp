@@ -34,6 +34,7 @@ void
 TabletopSegmentation<PointT>::reset()
 {
   supports_.clear();
+  extents_.clear();
   table_ = 0;
   table_found_ = false;
   focal_ = 0.f;
@@ -124,8 +125,10 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
     for (const auto i : *indices_)
       allowed[i] = 1;
   }
-  // A grid of every step-th pixel; each cell takes a pixel of its block with depth, so that
-  // missing pixels (real sensors lose several percent) do not spread NaN normals.
+  // A grid of every step-th pixel; each cell is the mean of the pixels of its block that have
+  // depth near the first one's: real sensors lose several percent of their pixels (a single
+  // pixel per cell would spread NaN normals) and active stereo is noisy (the mean of up to
+  // step^2 pixels is less so); the depth test keeps objects' edges sharp.
   pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
   small->width = static_cast<std::uint32_t>((w + step - 1) / step);
   small->height = static_cast<std::uint32_t>((h + step - 1) / step);
@@ -135,26 +138,35 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
                        pcl::PointXYZ(nan, nan, nan));
   std::vector<pcl::index_t> source(small->size(), -1);
   for (int v0 = 0, k = 0; v0 < h; v0 += step)
-    for (int u0 = 0; u0 < w; u0 += step, ++k)
-      for (int dv = 0; dv < step && v0 + dv < h && source[k] < 0; ++dv)
+    for (int u0 = 0; u0 < w; u0 += step, ++k) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      float first = 0.f;
+      int n = 0;
+      for (int dv = 0; dv < step && v0 + dv < h; ++dv)
         for (int du = 0; du < step && u0 + du < w; ++du) {
           const std::size_t idx = static_cast<std::size_t>(v0 + dv) * w + u0 + du;
           const auto& p = (*input_)[idx];
-          if ((fake_indices_ || allowed[idx]) && pcl::isFinite(p)) {
-            (*small)[k].getVector3fMap() = p.getVector3fMap();
+          if (!(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
+            continue;
+          if (n == 0) {
+            first = p.z;
             source[k] = static_cast<pcl::index_t>(idx);
-            break;
           }
+          else if (std::abs(p.z - first) > 0.02f * std::abs(first))
+            continue;
+          sum += p.getVector3fMap();
+          ++n;
         }
+      if (n > 0)
+        (*small)[k].getVector3fMap() = sum / static_cast<float>(n);
+    }
   focal_ = camera_.valid() ? camera_.fx : estimateFocalLength(*small) * static_cast<float>(step);
   image_down_ = imageDownDirection(*small, input_->sensor_origin_.head(3));
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
   ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
   ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step));
-  // Smoothing over about 32 pixels of the frame: depth noise of active stereo sensors
-  // breaks smaller windows' normals into many small regions.
-  ne.setNormalSmoothingSize(std::max(4.f, 32.f / static_cast<float>(step)));
+  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
   ne.setInputCloud(small);
   ne.compute(*normals);
 
@@ -271,16 +283,41 @@ void
 TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& candidates) const
 {
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  // A support spans a plane (collinear points, e.g. one image row of a far surface, do not)
+  // that does not pass by the sensor (it would be seen edge-on).
+  std::vector<Candidate> planar;
   for (auto& c : candidates) {
     Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.points.size()));
     for (std::size_t k = 0; k < c.points.size(); ++k)
       pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.points[k]].getVector3fMap();
     Eigen::Vector4f refined;
-    if (fitPlane(pts, viewpoint, refined))
-      c.plane = refined;
+    if (!fitPlane(pts, viewpoint, refined) ||
+        refined.template head<3>().dot(viewpoint) + refined[3] < 0.05f)
+      continue;
+    c.plane = refined;
+    planar.push_back(std::move(c));
   }
+  candidates.swap(planar);
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.support > b.support; });
+  // A region lying on a larger candidate (a part of the same table seen through a sensor's
+  // slight bend) is a part of it, not another support.
+  std::vector<Candidate> distinct;
+  for (auto& c : candidates) {
+    const bool part = std::any_of(distinct.begin(), distinct.end(), [&](const Candidate& big) {
+      if (big.plane.template head<3>().dot(c.plane.template head<3>()) < std::cos(0.2f))
+        return false;
+      std::vector<float> h;
+      for (const auto i : c.points)
+        h.push_back(std::abs(big.plane.template head<3>().dot((*input_)[i].getVector3fMap()) +
+                             big.plane[3]));
+      std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
+      return h[h.size() / 2] < 2.f * params_.plane_distance;
+    });
+    if (!part)
+      distinct.push_back(std::move(c));
+  }
+  candidates.swap(distinct);
   if (!up_.isZero()) {
     const Eigen::Vector3f up = up_.normalized();
     const float cos_max = std::cos(params_.max_support_tilt);
@@ -348,7 +385,7 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
     support.frame =
       planeFrame(candidates[s].plane, centre / static_cast<float>(candidates[s].points.size()));
     support.inliers.header = input_->header;
-    support.polygon = supportHull(support);
+    support.polygon = supportHull(support, &candidates[s]);
     // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
     // by the region found on it: its infinite plane slices through the objects around it.
     bool elevated = false;
@@ -363,8 +400,10 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
       kept |= static_cast<std::uint8_t>(1u << s);
   }
   for (const std::size_t s : family)
-    if (kept & (1u << s))
+    if (kept & (1u << s)) {
+      extents_.push_back(supportHull(all[s], nullptr));
       supports_.push_back(std::move(all[s]));
+    }
   for (const Above& a : above_band)
     if ((a.above & kept) && !(a.on & kept))
       band.push_back(a.index);
@@ -421,38 +460,67 @@ TabletopSegmentation<PointT>::regionArea(const Candidate& c, const Eigen::Affine
 
 template <typename PointT>
 std::vector<Eigen::Vector2f>
-TabletopSegmentation<PointT>::supportHull(const SupportPlane& s) const
+TabletopSegmentation<PointT>::supportHull(const SupportPlane& s, const Candidate* c) const
 {
-  // Hull of every point on the plane (the plane regions found may miss parts of a table, e.g.
-  // the near edge where a real sensor's depth bends). The image of a plane is a projective
-  // map of it, which keeps convex hulls: on organized clouds only the first and the last
-  // point of each image row can be a vertex.
   const Eigen::Affine3f to_plane = s.frame.inverse();
   const auto& idx = s.inliers.indices;
-  std::vector<Eigen::Vector2f> flat;
-  const auto add = [&](pcl::index_t i) {
-    flat.push_back((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
+  const auto flat = [&](pcl::index_t i) {
+    return Eigen::Vector2f((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
   };
-  if (input_->isOrganized()) {
-    const auto w = static_cast<pcl::index_t>(input_->width);
-    pcl::index_t row_end = -1; // inliers are ascending
-    for (std::size_t k = 0; k < idx.size(); ++k) {
-      if (idx[k] >= row_end) {
-        if (k > 0)
-          add(idx[k - 1]); // last of the previous row
-        add(idx[k]);       // first of this row
-        row_end = (idx[k] / w + 1) * w;
-      }
-    }
-    if (!idx.empty())
-      add(idx.back());
-  }
-  else {
+  std::vector<Eigen::Vector2f> points;
+  if (!input_->isOrganized()) {
     const std::size_t stride = std::max<std::size_t>(1, idx.size() / params_.plane_samples);
     for (std::size_t k = 0; k < idx.size(); k += stride)
-      add(idx[k]);
+      points.push_back(flat(idx[k]));
+    return convexHull2D(std::move(points));
   }
-  return convexHull2D(std::move(flat));
+  if (c)
+    for (const auto i : c->points)
+      points.push_back(flat(i));
+  // The region found on the plane, grown by the plane's points within 5 cm of it: the region
+  // may miss a table's near edge, where a real sensor's depth bends, but the infinite plane's
+  // points also hold the lines where it cuts walls and other objects. The image of a plane is
+  // a projective map of it, which keeps convex hulls: only the first and the last point of each
+  // image row can be a vertex.
+  const std::vector<Eigen::Vector2f> region = convexHull2D(points); // none: every point
+  constexpr float grow = 0.05f;
+  const auto near_region = [&](const Eigen::Vector2f& p) {
+    if (!c || region.size() < 3 || pointInPolygon(p, region))
+      return true;
+    for (std::size_t e = 0; e < region.size(); ++e) {
+      const Eigen::Vector2f a = region[e], b = region[(e + 1) % region.size()];
+      const float t = std::clamp((p - a).dot(b - a) / std::max((b - a).squaredNorm(), 1e-12f), 0.f, 1.f);
+      if ((a + t * (b - a) - p).squaredNorm() <= grow * grow)
+        return true;
+    }
+    return false;
+  };
+  const auto w = static_cast<pcl::index_t>(input_->width);
+  const auto add = [&](pcl::index_t i) {
+    const Eigen::Vector2f p = flat(i);
+    if (near_region(p))
+      points.push_back(p);
+  };
+  // Each image row: its first and last point near the region.
+  std::size_t k = 0;
+  while (k < idx.size()) {
+    const pcl::index_t row_end = (idx[k] / w + 1) * w;
+    std::size_t end = k;
+    while (end < idx.size() && idx[end] < row_end)
+      ++end;
+    for (std::size_t j = k; j < end; ++j)
+      if (near_region(flat(idx[j]))) {
+        add(idx[j]);
+        break;
+      }
+    for (std::size_t j = end; j-- > k;)
+      if (near_region(flat(idx[j]))) {
+        add(idx[j]);
+        break;
+      }
+    k = end;
+  }
+  return convexHull2D(std::move(points));
 }
 
 template <typename PointT>
@@ -481,13 +549,22 @@ TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts,
   }
   if (out.support < 0)
     return out;
-  // Legs hold up another support: they reach up to just under it.
-  for (const std::size_t s : family)
-    if (static_cast<int>(s) != out.support && over[s] >= 0.5f && profiles[s].top < 0.f &&
-        profiles[s].top > -0.1f) {
+  // Under a higher support (its legs, or what stands under it) is furniture, not an object
+  // on the lower one. "Under" takes every point of the higher plane: seen at a grazing angle, a
+  // table's region may miss its edges.
+  for (const std::size_t s : family) {
+    if (static_cast<int>(s) == out.support || !(profiles[s].top < 0.f))
+      continue;
+    const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
+    std::size_t under = 0;
+    for (Eigen::Index k = 0; k < pts.cols(); ++k)
+      under += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).template head<2>(),
+                              extents_[s]);
+    if (2 * under >= static_cast<std::size_t>(pts.cols())) {
       out.support = -1;
       return out;
     }
+  }
   out.standing =
     standsOn(profiles[static_cast<std::size_t>(out.support)], p.contact_height, p.max_height, 0.02f);
   return out;
@@ -542,6 +619,7 @@ TabletopSegmentation<PointT>::chooseSupports(std::vector<pcl::Indices>& groups,
     }
   table_ = static_cast<std::size_t>(new_index[table_]);
   supports_ = std::move(used);
+  extents_.clear();
   for (auto& c : clusters)
     c.support = new_index[static_cast<std::size_t>(c.support)];
   const SupportPlane& table = supports_[table_];

@@ -1,0 +1,639 @@
+/*
+ * facyl: cluttered tabletops. The simulator's clutter and sensors, the edge-aware object
+ * segmentation, the choice of supports, the evidence of cylinders found in larger clusters,
+ * and the recognizer end to end on touching, stacked and occluded objects.
+ */
+#include "test_helpers.h"
+
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/object_segmentation.h>
+#include <facyl/segmentation/segmentation_score.h>
+#include <facyl/segmentation/support_planes.h>
+#include <facyl/segmentation/tabletop_segmentation.h>
+#include <facyl/simulation/random.h>
+#include <facyl/simulation/scene_rendering.h>
+#include <facyl/simulation/tabletop_scene.h>
+
+#include <pcl/common/io.h>
+#include <pcl/common/point_tests.h>
+#include <pcl/common/transforms.h>
+#include <pcl/io/pcd_io.h>
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+/** Camera at \a eye looking at \a target (world z up), as the simulator's cameras. */
+Eigen::Isometry3f
+lookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target)
+{
+  const Eigen::Vector3f forward = (target - eye).normalized();
+  const Eigen::Vector3f right = forward.cross(Eigen::Vector3f::UnitZ()).normalized();
+  Eigen::Isometry3f pose = Eigen::Isometry3f::Identity();
+  pose.linear().col(0) = right;
+  pose.linear().col(1) = forward.cross(right);
+  pose.linear().col(2) = forward;
+  pose.translation() = eye;
+  return pose;
+}
+
+/** A table (and its legs, floor) without objects, from the generator; the test adds them. */
+facyl::TabletopScene
+emptyTable(const facyl::TabletopSceneParameters& base = {})
+{
+  facyl::TabletopSceneParameters p = base;
+  p.min_objects = p.max_objects = 0;
+  return facyl::generateTabletopScene(p);
+}
+
+facyl::SceneObject
+box(const Eigen::Vector3f& size, const Eigen::Vector3f& base, float yaw = 0.f)
+{
+  facyl::SceneObject o;
+  o.cls = facyl::SceneClass::Box;
+  o.kind = "box";
+  o.size = size;
+  o.pose.linear() = Eigen::AngleAxisf(yaw, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  o.pose.translation() = base;
+  o.colour[0] = Eigen::Vector3f(0.8f, 0.3f, 0.2f);
+  return o;
+}
+
+facyl::SceneObject
+can(float radius, float height, const Eigen::Vector3f& base, const std::string& kind = "can")
+{
+  facyl::SceneObject o;
+  o.cls = facyl::SceneClass::Cylinder;
+  o.kind = kind;
+  o.radius = radius;
+  o.height = height;
+  o.pose.translation() = base;
+  o.colour[0] = Eigen::Vector3f(0.2f, 0.5f, 0.8f);
+  return o;
+}
+
+facyl::RenderedScene
+render(facyl::TabletopScene scene, const Eigen::Vector3f& eye, const Eigen::Vector3f& target,
+       const std::string& sensor = "kinect", std::uint64_t seed = 7)
+{
+  scene.camera_to_world = lookAt(eye, target);
+  facyl::TabletopSceneParameters p;
+  facyl::parseSensorPreset(sensor, p.sensor, p.camera);
+  return facyl::renderTabletopScene(scene, p.camera, p.sensor, seed);
+}
+
+/** Per point: the object id (>= 2) or 0 (table, background), -1 without depth. */
+std::vector<int>
+truthOf(const facyl::RenderedScene& s)
+{
+  std::vector<int> t(s.cloud.size());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    t[i] = !pcl::isFinite(s.cloud[i]) ? -1 : (s.object_id[i] >= 2 ? s.object_id[i] : 0);
+  return t;
+}
+
+std::vector<facyl::SegmentOutcome>
+segmentAndScore(const facyl::RenderedScene& s, facyl::TabletopSegmentationParameters params = {})
+{
+  Cloud::Ptr cloud(new Cloud(s.cloud));
+  facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+  seg.setParameters(params);
+  seg.setInputCloud(cloud);
+  std::vector<facyl::TabletopCluster> clusters;
+  EXPECT_TRUE(seg.segment(clusters));
+  std::vector<pcl::PointIndices> segments;
+  for (const auto& c : clusters)
+    segments.push_back(c.indices);
+  return facyl::scoreSegments(truthOf(s), segments, 300);
+}
+
+std::vector<facyl::RecognizedObject>
+recognize(const facyl::RenderedScene& s, facyl::TabletopRecognizerParameters params = {})
+{
+  Cloud::Ptr cloud(new Cloud(s.cloud));
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setParameters(params);
+  rec.setInputCloud(cloud);
+  std::vector<facyl::RecognizedObject> objects;
+  EXPECT_TRUE(rec.recognize(objects));
+  return objects;
+}
+
+/** The output object most of whose points are ground-truth object \a id, or nullptr. */
+const facyl::RecognizedObject*
+objectOf(const std::vector<facyl::RecognizedObject>& objects, const facyl::RenderedScene& s, int id)
+{
+  const facyl::RecognizedObject* best = nullptr;
+  std::size_t best_count = 0;
+  for (const auto& o : objects) {
+    std::size_t count = 0;
+    for (const auto i : o.cluster.indices.indices)
+      count += s.object_id[static_cast<std::size_t>(i)] == id;
+    if (2 * count > o.cluster.indices.indices.size() && count > best_count)
+      best = &o, best_count = count;
+  }
+  return best;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------- simulator
+
+TEST(Random, IsTheSameOnEveryStandardLibrary)
+{
+  // Golden values: mt19937_64's output is fixed by the standard and the conversions are ours.
+  facyl::Random a(42);
+  EXPECT_EQ(a.bits(), 13930160852258120406ULL);
+  facyl::Random b(42);
+  b.bits();
+  EXPECT_DOUBLE_EQ(b.unit(), static_cast<double>(11788048577503494824ULL >> 11) * 0x1.0p-53);
+  facyl::Random c(7), d(7);
+  for (int k = 0; k < 100; ++k) {
+    const float x = c.normal();
+    EXPECT_EQ(x, d.normal());
+    EXPECT_TRUE(std::isfinite(x));
+    const int i = c.integer(-3, 5);
+    EXPECT_EQ(i, d.integer(-3, 5));
+    EXPECT_GE(i, -3);
+    EXPECT_LE(i, 5);
+  }
+}
+
+TEST(ClutteredScenes, ObjectsTouchStackAndLeanWithoutPassingThroughEachOther)
+{
+  std::size_t objects = 0, touching = 0, stacked = 0, leaning = 0;
+  for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+    p.seed = seed;
+    const facyl::TabletopScene scene = facyl::generateTabletopScene(p);
+    const facyl::TabletopScene again = facyl::generateTabletopScene(p);
+    ASSERT_EQ(scene.objects.size(), again.objects.size());
+    EXPECT_TRUE(scene.camera_to_world.isApprox(again.camera_to_world));
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const auto& o = scene.objects[i];
+      ++objects;
+      touching += !o.touches.empty();
+      leaning += o.leaning;
+      for (const int j : o.touches) { // contacts are mutual
+        const auto& other = scene.objects[static_cast<std::size_t>(j)].touches;
+        EXPECT_NE(std::find(other.begin(), other.end(), static_cast<int>(i)), other.end());
+      }
+      if (o.support < 0) {
+        continue;
+      }
+      // A stacked object stands on its support's flat top.
+      ++stacked;
+      const auto& s = scene.objects[static_cast<std::size_t>(o.support)];
+      const float top = s.pose.translation().z() +
+                        (s.cls == facyl::SceneClass::Box ? s.size.z() : s.height);
+      const float bottom = o.lying ? o.pose.translation().z() - o.radius : o.pose.translation().z();
+      EXPECT_NEAR(bottom, top, 1e-4f) << "seed " << seed << " object " << i;
+    }
+  }
+  std::printf("[ figures ] 30 cluttered scenes: %zu objects, %zu touching, %zu stacked, %zu "
+              "leaning\n",
+              objects, touching, stacked, leaning);
+  EXPECT_GT(touching, objects / 2);
+  EXPECT_GT(stacked, objects / 20);
+}
+
+TEST(ClutteredScenes, SensorPresetsDiffer)
+{
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 3;
+  const facyl::RenderedScene kinect = facyl::simulateTabletopScene(p);
+  ASSERT_TRUE(facyl::parseSensorPreset("stereo", p.sensor, p.camera));
+  EXPECT_FALSE(facyl::parseSensorPreset("lidar", p.sensor, p.camera));
+  const facyl::RenderedScene stereo = facyl::simulateTabletopScene(p);
+  const auto missing = [](const facyl::RenderedScene& s) {
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < s.cloud.size(); ++i)
+      m += s.object_id[i] != 0 && !pcl::isFinite(s.cloud[i]);
+    return m;
+  };
+  // Speckled holes: active stereo loses a few percent more of the surfaces it sees.
+  EXPECT_GT(missing(stereo), missing(kinect) + stereo.cloud.size() / 100);
+  // The table of the ground truth holds in both.
+  EXPECT_TRUE(stereo.table_plane.isApprox(kinect.table_plane, 1e-4f));
+}
+
+TEST(ClutteredScenes, InvalidSharesAreRejected)
+{
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.touch_share = 0.8f; // with stack 0.2 and lean 0.08: more than 1
+  EXPECT_NE(facyl::validate(p).find("sum <= 1"), std::string::npos);
+  p = facyl::clutteredSceneParameters();
+  p.table_radius = {0.6f, 0.3f};
+  EXPECT_FALSE(facyl::validate(p).empty());
+  p = facyl::TabletopSceneParameters{};
+  p.sensor.hole_rate = 0.5f;
+  EXPECT_THROW(facyl::simulateTabletopScene(p), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------- small numerics
+
+TEST(ObjectSegmentation, FocalLengthAndImageDownFromTheData)
+{
+  facyl::TabletopSceneParameters p;
+  p.seed = 5;
+  const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+  pcl::PointCloud<pcl::PointXYZ> xyz;
+  pcl::copyPointCloud(s.cloud, xyz);
+  EXPECT_NEAR(facyl::estimateFocalLength(xyz), 525.f, 5.f);
+  const Eigen::Vector3f down = facyl::imageDownDirection(xyz, Eigen::Vector3f::Zero());
+  EXPECT_GT(down.dot(Eigen::Vector3f::UnitY()), 0.99f);
+  // In another frame the data still tell the camera's down.
+  const Eigen::Affine3f world(Eigen::AngleAxisf(1.2f, Eigen::Vector3f(1.f, 2.f, 3.f).normalized()));
+  pcl::PointCloud<pcl::PointXYZ> moved;
+  pcl::transformPointCloud(xyz, moved, world);
+  EXPECT_GT(facyl::imageDownDirection(moved, world.translation()).dot(world.linear() * Eigen::Vector3f::UnitY()),
+            0.99f);
+}
+
+TEST(ObjectSegmentation, CreasesAreTheValleysNotTheRidges)
+{
+  // Two surfaces seen from the sensor at the origin, 1 m away: a valley (concave, where two
+  // objects meet) at u = 80 and a ridge (convex, a box edge) at u = 160.
+  pcl::PointCloud<pcl::PointXYZ> cloud(240, 60);
+  const float f = 525.f;
+  for (int v = 0; v < 60; ++v)
+    for (int u = 0; u < 240; ++u) {
+      // Depth falls towards u = 80 (the ridge comes nearest) and rises towards u = 160 (the
+      // valley lies farthest): faces 39 degrees off fronto-parallel, turning by 78 degrees.
+      const float g = static_cast<float>(std::abs(u - 80) - (u >= 160 ? 2 * (u - 160) : 0));
+      const float depth = 1.f + 0.8f * g / f;
+      cloud.at(u, v) = pcl::PointXYZ(static_cast<float>(u - 120) / f * depth,
+                                     static_cast<float>(v - 30) / f * depth, depth);
+    }
+  facyl::ObjectSegmentationParameters p;
+  const auto crease = facyl::concaveCreases(cloud, f, Eigen::Vector3f::Zero(), p);
+  std::size_t at_valley = 0, at_ridge = 0, elsewhere = 0;
+  for (int v = 5; v < 55; ++v)
+    for (int u = 0; u < 240; ++u) {
+      if (!crease[static_cast<std::size_t>(v) * 240 + u])
+        continue;
+      if (std::abs(u - 160) <= 12)
+        ++at_valley;
+      else if (std::abs(u - 80) <= 12)
+        ++at_ridge;
+      else
+        ++elsewhere;
+    }
+  EXPECT_GT(at_valley, 50u * 5u);
+  EXPECT_EQ(at_ridge, 0u);
+  EXPECT_EQ(elsewhere, 0u);
+}
+
+TEST(SegmentationScore, RecoveredMergedAndSplit)
+{
+  // Points 0-9 object 1, 10-19 object 2, 20-29 object 3, 30-34 table.
+  std::vector<int> truth(35, 0);
+  for (int i = 0; i < 30; ++i)
+    truth[static_cast<std::size_t>(i)] = 1 + i / 10;
+  pcl::PointIndices a, b, c, d;
+  for (int i = 0; i < 10; ++i)
+    a.indices.push_back(i); // object 1 exactly
+  for (int i = 10; i < 25; ++i)
+    b.indices.push_back(i); // object 2 and half of 3: merged
+  for (int i = 25; i < 30; ++i)
+    c.indices.push_back(i); // the other half of 3
+  for (int i = 30; i < 35; ++i)
+    d.indices.push_back(i); // table
+  const auto out = facyl::scoreSegments(truth, {a, b, c, d}, 1);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_TRUE(out[0].recovered);
+  EXPECT_FLOAT_EQ(out[0].best_iou, 1.f);
+  EXPECT_TRUE(out[1].recovered); // IoU 10/15
+  EXPECT_TRUE(out[1].merged);    // a third of its segment is object 3
+  EXPECT_FALSE(out[2].recovered);
+  EXPECT_TRUE(out[2].split);
+  facyl::SegmentTotals t;
+  for (const auto& o : out)
+    t.add(o);
+  EXPECT_NEAR(t.recoveredShare(), 2.0 / 3.0, 1e-9);
+  EXPECT_TRUE(facyl::scoreSegments(truth, {a}, 11).empty()); // objects too small to count
+}
+
+TEST(SupportPlanes, CoplanarGroupsAndHeights)
+{
+  const std::vector<Eigen::Vector4f> planes{{0.f, 0.f, 1.f, -0.7f},
+                                            {0.f, 0.01f, 1.f, -0.705f},
+                                            {0.f, 0.f, 1.f, 0.f},
+                                            {1.f, 0.f, 0.f, 0.f}};
+  const auto groups = facyl::groupCoplanar(planes, {0, 1, 2, 3}, 0.05f, 0.015f);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups[0], (std::vector<std::size_t>{0, 1}));
+  // Parallel families, whatever the offset.
+  EXPECT_EQ(facyl::groupCoplanar(planes, {0, 1, 2, 3}, 0.05f, 1e9f).size(), 2u);
+  Eigen::Matrix3Xf pts(3, 100);
+  for (int i = 0; i < 100; ++i)
+    pts.col(i) = Eigen::Vector3f(0.f, 0.f, 0.02f + 0.001f * static_cast<float>(i));
+  const facyl::HeightProfile h = facyl::heightProfile(pts, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.1f);
+  EXPECT_NEAR(h.base, 0.021f, 1e-3f);
+  EXPECT_NEAR(h.top, 0.117f, 1e-3f);
+  EXPECT_NEAR(h.in_band, 0.805f, 0.01f);
+  EXPECT_TRUE(facyl::standsOn(h, 0.03f, 0.5f, 0.02f));
+  EXPECT_FALSE(facyl::standsOn(h, 0.01f, 0.5f, 0.02f)); // does not reach down
+  EXPECT_FALSE(facyl::standsOn(h, 0.03f, 0.12f, 0.02f)); // reaches the band's top: a leg
+  Eigen::Matrix3Xf wide = pts;
+  wide.row(0).setLinSpaced(0.f, 0.8f); // 80 cm wide: the foot of a wall, not an object
+  EXPECT_FALSE(facyl::standsOn(facyl::heightProfile(wide, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.5f),
+                               0.03f, 0.5f, 0.02f));
+}
+
+TEST(CylinderEvidence, ArcGapTaperAndJunctions)
+{
+  facyl::CylinderModel m;
+  m.radius = 0.05f;
+  m.axis = Eigen::Vector3f::UnitZ();
+  m.top = Eigen::Vector3f(0.f, 0.f, 0.1f);
+  // A contiguous half circle, and two separate quarter arcs.
+  Eigen::Matrix3Xf half(3, 180), two(3, 180), normals(3, 180);
+  for (int k = 0; k < 180; ++k) {
+    const float a = static_cast<float>(k) * kPi / 180.f;
+    const float b = k < 90 ? a * 0.5f : kPi + a * 0.5f;
+    half.col(k) = Eigen::Vector3f(0.05f * std::cos(a), 0.05f * std::sin(a), 0.0005f * static_cast<float>(k));
+    two.col(k) = Eigen::Vector3f(0.05f * std::cos(b), 0.05f * std::sin(b), 0.05f);
+    normals.col(k) = Eigen::Vector3f(std::cos(a), std::sin(a), 0.f);
+  }
+  EXPECT_LE(facyl::arcGap(m, half), 1.f / 36.f);
+  EXPECT_GT(facyl::arcGap(m, two), 0.2f);
+  // The side of a cylinder keeps its radius; a cone's shrinks.
+  EXPECT_LT(facyl::taperAlongAxis(m, half, normals, {}), 0.01f);
+  Eigen::Matrix3Xf cone = half;
+  for (int k = 0; k < 180; ++k) {
+    const float z = 0.0005f * static_cast<float>(k), r = 0.05f - 0.3f * z;
+    cone.col(k).head<2>() *= r / 0.05f;
+  }
+  EXPECT_NEAR(facyl::taperAlongAxis(m, cone, normals, {}), 0.3f, 0.02f);
+  // Junctions: a ridge (convex) and a valley (concave) between two planes.
+  Eigen::Matrix3Xf pts(3, 40), nrm(3, 40);
+  std::vector<Eigen::Index> left, right;
+  for (int k = 0; k < 40; ++k) {
+    const float x = -0.02f + 0.001f * static_cast<float>(k);
+    pts.col(k) = Eigen::Vector3f(x, 0.f, -std::abs(x)); // ridge at x = 0, seen from +z
+    nrm.col(k) = Eigen::Vector3f(x < 0.f ? -1.f : 1.f, 0.f, 1.f).normalized();
+    (x < 0.f ? left : right).push_back(k);
+  }
+  EXPECT_GT(facyl::convexJunctionShare(pts, nrm, left, right, 0.005f, 0.1f), 0.9f);
+  for (int k = 0; k < 40; ++k) { // the valley: mirror
+    pts(2, k) = -pts(2, k);
+    nrm(0, k) = -nrm(0, k);
+  }
+  EXPECT_LT(facyl::convexJunctionShare(pts, nrm, left, right, 0.005f, 0.1f), 0.1f);
+  EXPECT_TRUE(std::isnan(facyl::convexJunctionShare(pts, nrm, left, right, 1e-6f, 0.1f)));
+}
+
+TEST(CylinderEvidence, TheDecisionUsesEveryCheck)
+{
+  facyl::CylinderEvidence e;
+  e.fitted = true;
+  e.surface_ratio = e.inlier_ratio = 0.8f;
+  e.angular_coverage = 0.4f;
+  e.curvature_ratio = 0.1f;
+  const facyl::CylinderDecision d;
+  EXPECT_TRUE(facyl::acceptCylinder(e, d));
+  auto worse = e;
+  worse.surface_ratio = 0.4f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.curvature_ratio = 0.5f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.angular_coverage = 0.1f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.arc_gap = 0.2f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.taper = 0.3f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.p_cylinder = 0.2f;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  worse = e;
+  worse.fitted = false;
+  EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  facyl::CylinderDecision bad;
+  bad.min_score = 2.f;
+  EXPECT_FALSE(facyl::validate(bad).empty());
+}
+
+// ---------------------------------------------------------------- segmentation
+
+TEST(ObjectSegmentation, SplitsStackedTouchingAndJoinsOccludedParts)
+{
+  facyl::TabletopScene scene = emptyTable();
+  // 2: a box with 3: a can standing on it; 4: a can touching the side of 5: a box;
+  // 6: a long box behind 7: a thin tube standing in front of its middle.
+  scene.objects.push_back(box({0.16f, 0.12f, 0.08f}, {-0.25f, 0.f, 0.f}));
+  scene.objects.push_back(can(0.035f, 0.11f, {-0.25f, 0.f, 0.08f}));
+  scene.objects.push_back(can(0.04f, 0.13f, {0.05f, -0.0595f + 0.0005f, 0.f}));
+  scene.objects.push_back(box({0.14f, 0.04f, 0.16f}, {0.05f, 0.f, 0.f}));
+  scene.objects.push_back(box({0.3f, 0.06f, 0.12f}, {0.3f, 0.2f, 0.f}));
+  scene.objects.push_back(can(0.012f, 0.2f, {0.3f, 0.08f, 0.f}, "tube"));
+  const facyl::RenderedScene s = render(scene, {0.02f, -0.85f, 0.55f}, {0.02f, 0.05f, 0.05f});
+  for (const bool edge_aware : {false, true}) {
+    facyl::TabletopSegmentationParameters p;
+    p.clustering = edge_aware ? facyl::TabletopSegmentationParameters::Clustering::EdgeAware
+                              : facyl::TabletopSegmentationParameters::Clustering::Euclidean;
+    const auto out = segmentAndScore(s, p);
+    std::map<int, bool> recovered;
+    for (const auto& o : out)
+      recovered[o.object] = o.recovered;
+    std::printf("[ figures ] hand-made clutter, %s: stacked %d/%d, touching %d/%d, occluded "
+                "box %d\n",
+                edge_aware ? "edge-aware" : "Euclidean", recovered[2], recovered[3], recovered[4],
+                recovered[5], recovered[6]);
+    if (edge_aware) {
+      for (const int id : {2, 3, 4, 5, 6}) {
+        EXPECT_TRUE(recovered[id]) << "object " << id;
+      }
+    }
+    else {
+      EXPECT_FALSE(recovered[2] && recovered[3]); // stacked objects merge
+    }
+  }
+}
+
+TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
+{
+  // A small table (0.55 x 0.45 m, 0.5 m high, legs) seen from 1.6 m: the floor fills most of
+  // the frame. Then a low camera with a wall behind the table: the wall is the largest plane.
+  facyl::TabletopSceneParameters small;
+  small.table_width = {0.55f, 0.55f};
+  small.table_depth = {0.45f, 0.45f};
+  small.table_height = {0.5f, 0.5f};
+  small.table_legs = true;
+  small.wall_share = 1.f;
+  facyl::TabletopScene scene = emptyTable(small);
+  scene.objects.push_back(can(0.035f, 0.12f, {-0.1f, 0.f, 0.f}));
+  scene.objects.push_back(box({0.1f, 0.08f, 0.1f}, {0.1f, 0.05f, 0.f}, 0.4f));
+  scene.objects.push_back(can(0.03f, 0.1f, {0.05f, -0.12f, 0.f}));
+  const std::vector<std::pair<Eigen::Vector3f, const char*>> views{
+    {{0.1f, -1.1f, 1.35f}, "floor bigger than the table"},
+    {{0.f, -1.1f, 0.25f}, "a wall behind the table"}};
+  for (const auto& [eye, what] : views) {
+    const facyl::RenderedScene s = render(scene, eye, {0.f, 0.f, 0.04f});
+    if (std::getenv("FACYL_TEST_DUMP"))
+      pcl::io::savePCDFileBinary(std::string("/tmp/support_") + (eye.z() > 1.f ? "floor" : "wall") + ".pcd", s.cloud);
+    Cloud::Ptr cloud(new Cloud(s.cloud));
+    for (const bool given_up : {false, true}) {
+      facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+      seg.setInputCloud(cloud);
+      if (given_up)
+        seg.setUpDirection(s.table_plane.head<3>());
+      std::vector<facyl::TabletopCluster> clusters;
+      ASSERT_TRUE(seg.segment(clusters)) << what;
+      const auto& c = seg.getTableCoefficients().values;
+      EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), 0.995f) << what;
+      EXPECT_NEAR(c[3], s.table_plane[3], 0.02f) << what;
+      EXPECT_TRUE(seg.tableFound()) << what;
+      const auto on_table = std::count_if(clusters.begin(), clusters.end(), [&](const auto& k) {
+        return k.support == static_cast<int>(seg.getTableIndex());
+      });
+      EXPECT_EQ(on_table, 3) << what; // (legs may stand on the floor)
+    }
+    if (eye.z() < 1.f)
+      continue;
+    // The paper's choice, the largest plane, is the floor here.
+    facyl::TabletopSegmentationParameters largest;
+    largest.support = facyl::TabletopSegmentationParameters::Support::LargestPlane;
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setParameters(largest);
+    seg.setInputCloud(cloud);
+    std::vector<facyl::TabletopCluster> clusters;
+    if (seg.segment(clusters)) {
+      EXPECT_GT(std::abs(seg.getTableCoefficients().values[3] - s.table_plane[3]), 0.05f) << what;
+    }
+  }
+  // An up direction that no plane matches: no support.
+  const facyl::RenderedScene s = render(scene, views[0].first, {0.f, 0.f, 0.04f});
+  Cloud::Ptr cloud(new Cloud(s.cloud));
+  facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+  seg.setInputCloud(cloud);
+  seg.setUpDirection(Eigen::Vector3f(1.f, 0.f, 0.f));
+  std::vector<facyl::TabletopCluster> clusters;
+  EXPECT_FALSE(seg.segment(clusters));
+}
+
+// ---------------------------------------------------------------- recognition
+
+TEST(ClutterRecognition, StackedCoaxialCylindersAndACanAgainstABox)
+{
+  facyl::TabletopScene scene = emptyTable();
+  // 2: a tin (r 8 cm) with 3: a can (r 3.5 cm) standing on it, coaxial; 4: a can touching
+  // the face of 5: a box.
+  scene.objects.push_back(can(0.08f, 0.07f, {-0.15f, 0.f, 0.f}, "tin"));
+  scene.objects.push_back(can(0.035f, 0.11f, {-0.15f, 0.f, 0.07f}));
+  scene.objects.push_back(can(0.04f, 0.13f, {0.15f, -0.0795f, 0.f}));
+  scene.objects.push_back(box({0.16f, 0.08f, 0.18f}, {0.15f, 0.f, 0.f}));
+  for (const std::string sensor : {"kinect", "stereo"}) {
+    const facyl::RenderedScene s =
+      render(scene, {0.f, -0.8f, 0.45f}, {0.f, 0.f, 0.06f}, sensor);
+    const auto objects = recognize(s);
+    for (const auto& [id, radius] : std::vector<std::pair<int, float>>{{2, 0.08f}, {3, 0.035f}, {4, 0.04f}}) {
+      const facyl::RecognizedObject* o = objectOf(objects, s, id);
+      ASSERT_NE(o, nullptr) << sensor << " object " << id;
+      EXPECT_TRUE(o->is_cylinder) << sensor << " object " << id;
+      EXPECT_NEAR(o->cylinder.radius, radius, 0.06f * radius) << sensor << " object " << id;
+      const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, s.scene.objects[static_cast<std::size_t>(id - 2)]);
+      EXPECT_LT(facyl::axisAngle(o->cylinder.axis, t.axis), 0.05f) << sensor << " object " << id;
+    }
+    const facyl::RecognizedObject* b = objectOf(objects, s, 5);
+    ASSERT_NE(b, nullptr) << sensor;
+    EXPECT_FALSE(b->is_cylinder) << sensor;
+  }
+}
+
+TEST(ClutterRecognition, SimulatedClutterAgainstGroundTruth)
+{
+  // Seeded cluttered scenes (touching, stacked, leaning objects; both sensors): objects seen
+  // well (>= 1500 pixels) are one segment, and cylinders are found, against the ground truth.
+  std::size_t objects = 0, recovered = 0, touching = 0, touching_recovered = 0;
+  std::size_t cylinders = 0, found = 0, called = 0, wrong = 0;
+  for (const std::string sensor : {"kinect", "stereo"})
+    for (std::uint64_t seed = 2000; seed < 2010; ++seed) {
+      facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+      facyl::parseSensorPreset(sensor, p.sensor, p.camera);
+      p.seed = seed;
+      const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+      const auto out = recognize(s);
+      std::vector<pcl::PointIndices> segments;
+      for (const auto& o : out)
+        segments.push_back(o.cluster.indices);
+      for (const auto& r : facyl::scoreSegments(truthOf(s), segments, 1500)) {
+        const auto& o = s.scene.objects[static_cast<std::size_t>(r.object - 2)];
+        ++objects;
+        recovered += r.recovered;
+        touching += !o.touches.empty();
+        touching_recovered += !o.touches.empty() && r.recovered;
+        if (o.cls != facyl::SceneClass::Cylinder)
+          continue;
+        ++cylinders;
+        const facyl::RecognizedObject* mine = objectOf(out, s, r.object);
+        if (mine && mine->is_cylinder) {
+          ++found;
+          const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, o);
+          const bool good = std::abs(mine->cylinder.radius - t.radius) < 0.1f * t.radius &&
+                            facyl::axisAngle(mine->cylinder.axis, t.axis) < 0.1f;
+          wrong += !good;
+        }
+      }
+      for (const auto& o : out)
+        called += o.is_cylinder;
+    }
+  std::printf("[ figures ] 20 cluttered scenes: %zu of %zu objects recovered (%zu of %zu "
+              "touching); %zu of %zu cylinders found (%zu off by > 10%% radius or > 5.7 deg); %zu "
+              "objects called cylinders\n",
+              recovered, objects, touching_recovered, touching, found, cylinders, wrong, called);
+  EXPECT_GE(static_cast<double>(recovered), 0.8 * static_cast<double>(objects));
+  EXPECT_GE(static_cast<double>(touching_recovered), 0.75 * static_cast<double>(touching));
+  EXPECT_GE(static_cast<double>(found), 0.7 * static_cast<double>(cylinders));
+  EXPECT_LE(static_cast<double>(wrong), 0.1 * static_cast<double>(found));
+}
+
+// ---------------------------------------------------------------- real scenes
+
+TEST(RealData, MosdSegmentationByGroup)
+{
+  const std::string dir = facyl_test::realFile("mosd");
+  if (dir.empty() || !std::filesystem::exists(dir + "/learn0.pcd"))
+    GTEST_SKIP() << "no " << FACYL_REAL_DATA_DIR << "/mosd learn scenes";
+  // All 45 learn scenes against the dataset's per-object labels: boxes, stacked boxes,
+  // occluded objects, cylindric objects. An object counts as recovered when one segment has
+  // IoU >= 0.5 with it.
+  const std::pair<int, int> groups[] = {{0, 16}, {17, 24}, {25, 32}, {33, 44}};
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  for (const auto& [first, last] : groups) {
+    facyl::SegmentTotals totals;
+    for (int k = first; k <= last; ++k) {
+      pcl::PointCloud<pcl::PointXYZRGBL> labelled;
+      ASSERT_EQ(pcl::io::loadPCDFile(dir + "/learn" + std::to_string(k) + ".pcd", labelled), 0);
+      Cloud::Ptr cloud(new Cloud);
+      pcl::copyPointCloud(labelled, *cloud);
+      std::vector<int> truth(labelled.size());
+      for (std::size_t i = 0; i < labelled.size(); ++i)
+        truth[i] = !pcl::isFinite(labelled[i]) ? -1
+                                              : (labelled[i].label >= 20 ? static_cast<int>(labelled[i].label / 10) : 0);
+      rec.setInputCloud(cloud);
+      std::vector<facyl::RecognizedObject> objects;
+      ASSERT_TRUE(rec.recognize(objects)) << "learn" << k;
+      std::vector<pcl::PointIndices> segments;
+      for (const auto& o : objects)
+        segments.push_back(o.cluster.indices);
+      for (const auto& o : facyl::scoreSegments(truth, segments, 300))
+        totals.add(o);
+    }
+    std::printf("[ figures ] mOSD learn%d-%d: %zu of %zu objects recovered, %zu merged, %zu "
+                "split\n",
+                first, last, totals.recovered, totals.objects, totals.merged, totals.split);
+    EXPECT_GE(totals.recoveredShare(), 0.9) << "learn" << first << "-" << last;
+  }
+}
