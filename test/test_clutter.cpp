@@ -462,6 +462,42 @@ TEST(ObjectSegmentation, SplitsStackedTouchingAndJoinsOccludedParts)
   }
 }
 
+TEST(ObjectSegmentation, UnorganizedCloudsAreSplitToo)
+{
+  // The same clutter without its pixel grid (NaN removed): projected into a depth image, with
+  // the camera given or a virtual one at the sensor origin.
+  facyl::TabletopScene scene = emptyTable();
+  scene.objects.push_back(box({0.16f, 0.12f, 0.08f}, {-0.25f, 0.f, 0.f}));
+  scene.objects.push_back(can(0.035f, 0.11f, {-0.25f, 0.f, 0.08f}));
+  scene.objects.push_back(can(0.04f, 0.13f, {0.05f, -0.0595f + 0.0005f, 0.f}));
+  scene.objects.push_back(box({0.14f, 0.04f, 0.16f}, {0.05f, 0.f, 0.f}));
+  const facyl::RenderedScene s = render(scene, {0.02f, -0.85f, 0.55f}, {0.02f, 0.05f, 0.05f});
+  Cloud::Ptr cloud(new Cloud);
+  std::vector<int> truth;
+  for (std::size_t i = 0; i < s.cloud.size(); ++i)
+    if (pcl::isFinite(s.cloud[i])) {
+      cloud->push_back(s.cloud[i]);
+      truth.push_back(s.object_id[i] >= 2 ? s.object_id[i] : 0);
+    }
+  for (const bool with_camera : {true, false}) {
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setInputCloud(cloud);
+    if (with_camera)
+      seg.setCamera(facyl::PinholeCamera{525.f, 525.f, 319.5f, 239.5f, 640, 480});
+    std::vector<facyl::TabletopCluster> clusters;
+    ASSERT_TRUE(seg.segment(clusters));
+    std::vector<pcl::PointIndices> segments;
+    for (const auto& c : clusters)
+      segments.push_back(c.indices);
+    const auto out = facyl::scoreSegments(truth, segments, 300);
+    ASSERT_EQ(out.size(), 4u);
+    for (const auto& o : out) {
+      EXPECT_TRUE(o.recovered) << (with_camera ? "camera" : "virtual camera") << ", object "
+                               << o.object << " IoU " << o.best_iou;
+    }
+  }
+}
+
 TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
 {
   // A small table (0.55 x 0.45 m, 0.5 m high, legs) seen from 1.6 m: the floor fills most of

@@ -30,8 +30,9 @@ struct TabletopSegmentationParameters {
   /** How the object points are split into objects:
    * - EdgeAware (default): organized clouds are cut at depth discontinuities and concave
    *   creases, then fragments, enclosed parts and parts seen on both sides of an occluder are
-   *   joined (segmentObjectsOrganized); unorganized clouds are clustered with
-   *   pcl::EuclideanClusterExtraction;
+   *   joined (segmentObjectsOrganized); unorganized clouds are first projected into a depth
+   *   image from the sensor origin (the camera given with setCamera, else a pinhole looking at
+   *   the objects), each point then taking its pixel's segment;
    * - Euclidean: connected components within cluster_tolerance (the paper's clustering). */
   enum class Clustering { Euclidean, EdgeAware } clustering{Clustering::EdgeAware};
   ObjectSegmentationParameters objects; ///< settings of the EdgeAware clustering
@@ -276,6 +277,11 @@ private:
   clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   void
   clusterUnorganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  /** EdgeAware on unorganized clouds: the points projected into a depth image (the camera
+   * given, else a pinhole at the sensor origin looking at the objects), segmented as an
+   * organized frame; each point takes its pixel's segment. */
+  void
+  segmentProjected(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** The support of a cluster (points \a pts) among the supports of \a family. */
   Placement
   place(const Eigen::Matrix3Xf& pts, const std::vector<std::size_t>& family) const;

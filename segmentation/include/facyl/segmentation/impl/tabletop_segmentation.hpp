@@ -238,17 +238,17 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   ne.setSearchMethod(tree);
   ne.setKSearch(12);
   ne.compute(*normals);
-  pcl::SACSegmentationFromNormals<PointT, pcl::Normal> sac;
+  // Planes one after another, each on what the previous ones left: RANSAC on positions
+  // (cheap), then the inliers whose normal agrees with the plane's.
+  pcl::SACSegmentation<PointT> sac;
   sac.setOptimizeCoefficients(true);
-  sac.setModelType(pcl::SACMODEL_NORMAL_PLANE);
+  sac.setModelType(pcl::SACMODEL_PLANE);
   sac.setMethodType(pcl::SAC_RANSAC);
-  sac.setNormalDistanceWeight(0.1);
   sac.setDistanceThreshold(params_.plane_distance);
-  sac.setMaxIterations(300);
+  sac.setMaxIterations(200);
   sac.setInputCloud(coarse);
-  sac.setInputNormals(normals);
-  // Planes one after another, each on what the previous ones left.
   const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
+  const float cos_normal = std::cos(0.3f);
   pcl::IndicesPtr remaining(new pcl::Indices(sampled.size()));
   std::iota(remaining->begin(), remaining->end(), 0);
   for (std::size_t k = 0; k < params_.max_planes && remaining->size() >= 10; ++k) {
@@ -256,19 +256,22 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
     pcl::PointIndices inliers;
     pcl::ModelCoefficients coefficients;
     sac.segment(inliers, coefficients);
-    if (coefficients.values.size() != 4 ||
-        static_cast<double>(inliers.indices.size()) * scale < static_cast<double>(params_.min_plane_points))
+    if (coefficients.values.size() != 4)
       break;
     const auto& c = coefficients.values;
     Candidate cand;
     cand.plane = orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), input_->sensor_origin_.head(3));
-    for (const auto i : inliers.indices)
-      cand.points.push_back(sampled[static_cast<std::size_t>(i)]);
-    cand.support = static_cast<std::size_t>(static_cast<double>(inliers.indices.size()) * scale);
-    candidates.push_back(std::move(cand));
     std::vector<std::uint8_t> taken(sampled.size(), 0);
-    for (const auto i : inliers.indices)
+    for (const auto i : inliers.indices) {
       taken[static_cast<std::size_t>(i)] = 1;
+      const auto& n = (*normals)[static_cast<std::size_t>(i)];
+      if (std::abs(Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).dot(cand.plane.template head<3>())) >= cos_normal)
+        cand.points.push_back(sampled[static_cast<std::size_t>(i)]);
+    }
+    cand.support = static_cast<std::size_t>(static_cast<double>(cand.points.size()) * scale);
+    if (cand.support < params_.min_plane_points)
+      break;
+    candidates.push_back(std::move(cand));
     pcl::IndicesPtr left(new pcl::Indices);
     for (const auto i : *remaining)
       if (!taken[static_cast<std::size_t>(i)])
@@ -700,6 +703,10 @@ TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
   out.clear();
   if (objects.empty())
     return;
+  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware) {
+    segmentProjected(objects, out);
+    return;
+  }
   // Euclidean clusters of one representative per voxel of a quarter of the tolerance (any two
   // points of neighbouring voxels are closer than the tolerance), then every point joins its
   // voxel's cluster: on dense sensor clouds the radius searches then return few neighbours.
@@ -737,6 +744,96 @@ TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
   out.assign(groups.size(), pcl::Indices{});
   for (std::size_t k = 0; k < objects.size(); ++k)
     out[group_of.at((*representatives)[voxel[k]])].push_back(objects[k]);
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
+                                               std::vector<pcl::Indices>& out) const
+{
+  // The camera: the one given, else a pinhole at the sensor origin looking at the objects
+  // with a VGA sensor's angular resolution.
+  const Eigen::Vector3f origin = input_->sensor_origin_.head(3);
+  Eigen::Matrix3f to_camera = Eigen::Matrix3f::Identity(); // cloud to camera rotation
+  PinholeCamera camera = camera_;
+  if (!camera.valid()) {
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (const auto i : objects)
+      mean += (*input_)[i].getVector3fMap() - origin;
+    const Eigen::Vector3f z = mean.normalized();
+    const Eigen::Vector3f x = z.unitOrthogonal(), y = z.cross(x);
+    to_camera.row(0) = x;
+    to_camera.row(1) = y;
+    to_camera.row(2) = z;
+    camera = PinholeCamera{525.f, 525.f, 0.f, 0.f, 0, 0};
+    Eigen::AlignedBox2f box;
+    for (const auto i : objects) {
+      const Eigen::Vector3f c = to_camera * ((*input_)[i].getVector3fMap() - origin);
+      if (c.z() > 0.f)
+        box.extend(Eigen::Vector2f(c.x() / c.z(), c.y() / c.z()));
+    }
+    if (box.isEmpty())
+      return;
+    // At most 1280 x 960 pixels: a wider view gets a coarser grid.
+    const float f = std::min({525.f, 1279.f / std::max(box.sizes().x(), 1e-6f),
+                              959.f / std::max(box.sizes().y(), 1e-6f)});
+    camera.fx = camera.fy = f;
+    camera.cx = -f * box.min().x();
+    camera.cy = -f * box.min().y();
+    camera.width = static_cast<int>(std::ceil(f * box.sizes().x())) + 1;
+    camera.height = static_cast<int>(std::ceil(f * box.sizes().y())) + 1;
+  }
+  const auto pixel_of = [&](const Eigen::Vector3f& p) -> long {
+    const Eigen::Vector3f c = to_camera * (p - origin);
+    if (!(c.z() > 0.f))
+      return -1;
+    const long u = std::lround(camera.fx * c.x() / c.z() + camera.cx);
+    const long v = std::lround(camera.fy * c.y() / c.z() + camera.cy);
+    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height)
+      return -1;
+    return v * camera.width + u;
+  };
+  // A depth image of the nearest object point per pixel, and which pixels see any surface.
+  const std::size_t n = static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  pcl::PointCloud<pcl::PointXYZ> image;
+  image.width = static_cast<std::uint32_t>(camera.width);
+  image.height = static_cast<std::uint32_t>(camera.height);
+  image.points.assign(n, pcl::PointXYZ(nan, nan, nan));
+  std::vector<float> range(n, std::numeric_limits<float>::infinity());
+  std::vector<std::uint8_t> has_depth(n, 0);
+  for (const auto i : *indices_) {
+    const auto& p = (*input_)[i];
+    if (!pcl::isFinite(p))
+      continue;
+    const long k = pixel_of(p.getVector3fMap());
+    if (k >= 0)
+      has_depth[static_cast<std::size_t>(k)] = 1;
+  }
+  std::vector<long> pixel(objects.size(), -1);
+  for (std::size_t j = 0; j < objects.size(); ++j) {
+    const Eigen::Vector3f p = (*input_)[objects[j]].getVector3fMap();
+    const long k = pixel_of(p);
+    pixel[j] = k;
+    if (k < 0)
+      continue;
+    const float r = (p - origin).norm();
+    if (r < range[static_cast<std::size_t>(k)]) {
+      range[static_cast<std::size_t>(k)] = r;
+      image[static_cast<std::size_t>(k)].getVector3fMap() = p;
+    }
+  }
+  const std::vector<pcl::Indices> segments =
+    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects);
+  // Every object point takes the segment of its pixel.
+  std::vector<int> segment_of(n, -1);
+  for (std::size_t s = 0; s < segments.size(); ++s)
+    for (const auto k : segments[s])
+      segment_of[static_cast<std::size_t>(k)] = static_cast<int>(s);
+  out.assign(segments.size(), pcl::Indices{});
+  for (std::size_t j = 0; j < objects.size(); ++j)
+    if (pixel[j] >= 0 && segment_of[static_cast<std::size_t>(pixel[j])] >= 0)
+      out[static_cast<std::size_t>(segment_of[static_cast<std::size_t>(pixel[j])])].push_back(objects[j]);
 }
 
 } // namespace facyl
