@@ -397,9 +397,13 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
       elevated = elevated || (t != s && candidates[t].support > candidates[s].support &&
                               height >= params_.min_height && height <= params_.max_height);
     }
-    const float area = elevated ? regionArea(candidates[s], support.frame)
-                                : polygonArea(support.polygon);
-    if (support.polygon.size() >= 3 && (largest || area >= params_.min_support_area))
+    // Its own region must be sizeable too: a small region's infinite plane can cross a
+    // table.
+    const float region = regionArea(candidates[s], support.frame);
+    const float area = elevated ? region : polygonArea(support.polygon);
+    if (support.polygon.size() >= 3 &&
+        (largest || (area >= params_.min_support_area &&
+                     region >= 0.25f * params_.min_support_area)))
       kept |= static_cast<std::uint8_t>(1u << s);
   }
   for (const std::size_t s : family)
@@ -425,8 +429,9 @@ TabletopSegmentation<PointT>::supportFamily(const std::vector<Candidate>& candid
                                       candidates[s].plane[2], 0.f));
     order.push_back(s); // largest first
   }
-  const auto families = groupCoplanar(normals, order, params_.max_support_tilt,
-                                      std::numeric_limits<float>::infinity());
+  // Supports are level: a table, the floor under it and a shelf are parallel within degrees.
+  const auto families =
+    groupCoplanar(normals, order, 0.1f, std::numeric_limits<float>::infinity());
   // With an up direction every candidate is horizontal already. Without one, the camera is
   // taken to be upright: supports face the top of the image (their normal points against the
   // image's down direction, measured on organized clouds); walls and ceilings do not. When no
