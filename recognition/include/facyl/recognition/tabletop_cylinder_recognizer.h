@@ -217,6 +217,9 @@ private:
    * its best fit. */
   std::vector<Fit>
   extractCylinders(const FitInput& input, Fit first);
+  /** Least squares of \a model on the cluster's points (\a indices) near its surface. */
+  void
+  refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
   ExplainSettings
   explainSettings(const CylinderModel& model) const;

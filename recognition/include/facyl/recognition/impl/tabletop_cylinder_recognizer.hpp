@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <unordered_set>
 
 namespace facyl {
 
@@ -143,6 +144,8 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster,
     for (auto& i : object.cylinder.inliers)
       i = input.subset[static_cast<std::size_t>(i)];
     object.is_cylinder = acceptCylinder(object.evidence, params_.decision);
+    if (object.is_cylinder)
+      refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
   }
   // Cylinder-first recovery: a cluster the best fit does not explain may hold several objects.
   if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
@@ -217,6 +220,60 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit 
 }
 
 template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluster,
+                                                      CylinderModel& model) const
+{
+  // The fit saw a pixel grid; the surface is located better with every pixel of the grid
+  // cells of its inliers (whose normals were checked: a cup's inner wall, near the surface by
+  // position alone, is left out) within the inlier distance of the surface.
+  const int stride =
+    static_cast<int>(std::lround(params_.fit_point_angle * segmentation_.getFocalLength()));
+  if (!input_->isOrganized() || stride <= 1 || model.inliers.size() < 20)
+    return;
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float d = model.distance_threshold;
+  const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
+  std::vector<std::uint8_t> in_cluster; // membership of the cluster's pixels near the inliers
+  std::vector<Eigen::Vector3f> near;
+  const std::unordered_set<pcl::index_t> members(cluster.begin(), cluster.end());
+  for (const auto i : model.inliers) {
+    const int u0 = static_cast<int>(i % w), v0 = static_cast<int>(i / w);
+    for (int v = v0; v < std::min(h, v0 + stride); ++v)
+      for (int u = u0; u < std::min(w, u0 + stride); ++u) {
+        const auto j = static_cast<pcl::index_t>(v * w + u);
+        if (!members.count(j))
+          continue;
+        const Eigen::Vector3f p = (*input_)[j].getVector3fMap();
+        const float rho = distanceToLine(p, model.base, a);
+        if (std::abs(rho - model.radius) <= d)
+          near.push_back(p);
+      }
+  }
+  if (near.size() < 20)
+    return;
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(near.size()));
+  for (std::size_t k = 0; k < near.size(); ++k)
+    pts.col(static_cast<Eigen::Index>(k)) = near[k];
+  Eigen::Vector3f point = model.base, axis = a;
+  float radius = model.radius;
+  if (!refineCylinder(pts, point, axis, radius) ||
+      !(std::abs(radius - model.radius) < 0.1f * model.radius) || axisAngle(axis, a) > 0.05f)
+    return; // a refinement that moves far is not trusted
+  CylinderModel refined = model;
+  refined.point_on_axis = point;
+  refined.axis = axis.normalized();
+  refined.radius = radius;
+  describeInliers(pts, refined);
+  refined.inliers = model.inliers;
+  refined.inlier_ratio = model.inlier_ratio;
+  refined.confidence = model.confidence;
+  refined.angular_coverage = model.angular_coverage;
+  refined.distance_threshold = model.distance_threshold;
+  model = std::move(refined);
+}
+
+template <typename PointT>
 ExplainSettings
 TabletopCylinderRecognizer<PointT>::explainSettings(const CylinderModel& model) const
 {
@@ -282,6 +339,7 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     o.cylinder = parts[p].model;
     for (auto& i : o.cylinder.inliers)
       i = input.subset[static_cast<std::size_t>(i)];
+    refineOnAllPoints(o.cluster.indices.indices, o.cylinder);
     o.is_cylinder = true;
     objects.push_back(std::move(o));
   }
