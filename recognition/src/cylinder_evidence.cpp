@@ -302,6 +302,9 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   const float beyond = std::max(axial_margin * model.radius, margin), h = length(model);
   std::size_t region = 0, lateral = 0, any = 0;
   std::vector<Eigen::Index> on_surface;
+  const bool with_normals = normals.cols() == points.cols();
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float cos_max = std::cos(settings.max_angle);
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (!alive.empty() && !alive[k])
@@ -309,6 +312,10 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     const AxialPosition x = axial(model, points.col(i));
     const bool inside = x.radial.norm() <= reach && x.t >= -beyond && x.t <= h + beyond;
     if (!inside && why[k] == Explained::No)
+      continue;
+    // A plane across the axis (the box a can stands on, a lid wider than the can) says nothing
+    // against a cylinder; a sphere's or a cone's surface beyond the band does.
+    if (why[k] == Explained::No && with_normals && std::abs(normals.col(i).dot(a)) >= cos_max)
       continue;
     ++region;
     if (why[k] == Explained::Lateral) {

@@ -176,7 +176,8 @@ arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points);
  * share on its lateral surface; angular_coverage is the model's, curvature_ratio is left NaN
  * (the caller knows the curvatures). A sphere's band or a cone's, fitted by a cylinder, leaves
  * the rest of the sphere or cone inside the region unexplained; so does a thin cylinder fitted
- * to the edge of a box, with the faces beyond the edge (hence the absolute margin).
+ * to the edge of a box, with the faces beyond the edge (hence the absolute margin). Points
+ * whose normal lies along the axis (the box a can stands on) are left out of the region.
  * \param[out] explained when given, the explanation of every column (alive or not). */
 CylinderEvidence
 localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
