@@ -5,9 +5,11 @@
 
 #include <Eigen/Core>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -16,6 +18,9 @@
 #include <vector>
 
 namespace facyl_cli {
+
+/** The largest seed an option accepts (seeds are read as signed 64-bit integers). */
+constexpr long long kMaxSeed = std::numeric_limits<long long>::max();
 
 /** Options "--name value" and switches "--name"; everything else is a positional argument.
  * Unknown options and malformed values are errors (std::invalid_argument), never ignored. */
@@ -57,31 +62,44 @@ public:
     const auto it = values_.find(name);
     return it == values_.end() ? fallback : it->second;
   }
+  /** The value of \a name as a finite number in [\a min_value, \a max_value]. */
   double
-  number(const std::string& name, double fallback) const
+  number(const std::string& name, double fallback,
+         double min_value = -std::numeric_limits<double>::max(),
+         double max_value = std::numeric_limits<double>::max()) const
   {
     const auto it = values_.find(name);
     if (it == values_.end())
       return fallback;
     char* end = nullptr;
+    errno = 0;
     const double v = std::strtod(it->second.c_str(), &end);
-    if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
+    if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v) || errno == ERANGE)
       throw std::invalid_argument("option " + name + ": '" + it->second + "' is not a number");
+    if (v < min_value || v > max_value)
+      throw std::invalid_argument("option " + name + ": " + it->second + " is not in [" +
+                                  shortNumber(min_value) + ", " + shortNumber(max_value) + "]");
     return v;
   }
+  /** The value of \a name as an integer in [\a min_value, \a max_value]: digits only (an
+   * optional minus sign), no wrap-around, no saturation. */
   long long
-  integer(const std::string& name, long long fallback, long long min_value) const
+  integer(const std::string& name, long long fallback, long long min_value,
+          long long max_value) const
   {
     const auto it = values_.find(name);
     if (it == values_.end())
       return fallback;
-    char* end = nullptr;
-    const long long v = std::strtoll(it->second.c_str(), &end, 10);
-    if (end == it->second.c_str() || *end != '\0')
-      throw std::invalid_argument("option " + name + ": '" + it->second + "' is not an integer");
-    if (v < min_value)
-      throw std::invalid_argument("option " + name + " must be at least " +
-                                  std::to_string(min_value));
+    const std::string& t = it->second;
+    const std::size_t first = !t.empty() && t[0] == '-' ? 1 : 0;
+    if (t.size() == first || t.find_first_not_of("0123456789", first) != std::string::npos)
+      throw std::invalid_argument("option " + name + ": '" + t + "' is not an integer");
+    errno = 0;
+    const long long v = std::strtoll(t.c_str(), nullptr, 10);
+    if (errno == ERANGE || v < min_value || v > max_value)
+      throw std::invalid_argument("option " + name + ": " + t + " is not in [" +
+                                  std::to_string(min_value) + ", " + std::to_string(max_value) +
+                                  "]");
     return v;
   }
   Eigen::Vector3f
@@ -100,6 +118,13 @@ public:
   }
 
 private:
+  static std::string
+  shortNumber(double v)
+  {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
   std::map<std::string, std::string> values_;
   std::set<std::string> switches_;
   std::vector<std::string> positional_;
@@ -138,10 +163,37 @@ wantsHelp(int argc, char** argv)
   return false;
 }
 
-/** JSON string literal. */
-inline std::string
-quote(const std::string& s)
+/** Length of the valid UTF-8 sequence at \a s[i], or 0 when the bytes there are not one. */
+inline std::size_t
+utf8Length(const std::string& s, std::size_t i)
 {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = byte(i);
+  const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+  if (n == 0 || i + n > s.size() || (n == 2 && c < 0xc2))
+    return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((byte(i + k) >> 6) != 0x2)
+      return 0;
+  return n;
+}
+
+/** JSON string literal (bytes that are not UTF-8, e.g. from a corrupt file, become U+FFFD). */
+inline std::string
+quote(const std::string& text)
+{
+  std::string s;
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8Length(text, i);
+    if (n == 0) {
+      s += "\xef\xbf\xbd";
+      ++i;
+    }
+    else {
+      s.append(text, i, n);
+      i += n;
+    }
+  }
   std::string out = "\"";
   for (const char c : s) {
     switch (c) {

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "pcl_baseline.h"
 
+#include <facyl/features/parallel.h>
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/simulation/cylinder_simulation.h>
@@ -26,12 +27,10 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <random>
 #include <sstream>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace {
 
@@ -278,9 +277,9 @@ main(int argc, char** argv)
     dump = args.text("--dump", "");
     if (!args.positional().empty())
       throw std::invalid_argument("unexpected argument " + args.positional()[0]);
-    scenes = static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1));
-    seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0));
-    threads = static_cast<int>(args.integer("--threads", 0, 0));
+    scenes = static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1, 1000000));
+    seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0, facyl_cli::kMaxSeed));
+    threads = static_cast<int>(args.integer("--threads", 0, 0, 256));
     out = args.text("--out", out);
     const std::string list = args.text("--settings", "paper,practical");
     settings.clear();
@@ -336,35 +335,27 @@ main(int argc, char** argv)
     method_sets[s] = methods(s);
   std::vector<std::vector<Fit>> results(tasks.size());
 
-#ifdef _OPENMP
-  const int workers = threads > 0 ? threads : omp_get_max_threads();
-#else
-  const int workers = 1;
-#endif
+  const int workers = facyl::parallelWorkers(tasks.size(), threads, 1);
   std::fprintf(stderr, "facyl_bench: %zu scene-levels (%d scenes x %zu levels x %zu settings) on "
                        "%d threads\n",
                tasks.size(), scenes, lv.size(), settings.size(), workers);
   std::atomic<std::size_t> done{0};
   const auto start = std::chrono::steady_clock::now();
+  std::mutex progress;
   auto last = start;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(workers)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(tasks.size()); ++i) {
-    const auto& t = tasks[static_cast<std::size_t>(i)];
-    results[static_cast<std::size_t>(i)] = runTask(t, lv[t.level], method_sets[t.setting], seed);
+  facyl::parallelFor(tasks.size(), threads, 1, [&](std::size_t i, std::size_t) {
+    const auto& t = tasks[i];
+    results[i] = runTask(t, lv[t.level], method_sets[t.setting], seed);
     const std::size_t d = ++done;
-#ifdef _OPENMP
-    if (omp_get_thread_num() == 0)
-#endif
-    {
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last > std::chrono::seconds(5) || d == tasks.size()) {
-        last = now;
-        const double el = std::chrono::duration<double>(now - start).count();
-        std::fprintf(stderr, "facyl_bench: %zu/%zu, %.0f s, about %.0f s left\n", d,
-                     tasks.size(), el, el / static_cast<double>(d) * (tasks.size() - d));
-      }
+    const std::lock_guard<std::mutex> lock(progress);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last > std::chrono::seconds(5) || d == tasks.size()) {
+      last = now;
+      const double el = std::chrono::duration<double>(now - start).count();
+      std::fprintf(stderr, "facyl_bench: %zu/%zu, %.0f s, about %.0f s left\n", d, tasks.size(),
+                   el, el / static_cast<double>(d) * (tasks.size() - d));
     }
-  }
+  });
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

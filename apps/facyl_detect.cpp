@@ -9,6 +9,7 @@
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
 #include <pcl/common/io.h>
+#include <pcl/console/print.h>
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/png_io.h>
@@ -18,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 namespace {
@@ -35,7 +37,8 @@ printHelp(const char* self)
     "Output:\n"
     "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
     "  --overlay PATH         RGB image with boxes (green: cylinder, red: not) and fitted\n"
-    "                         outlines; with several scenes PATH is a folder (<stem>.png)\n"
+    "                         outlines; with several scenes PATH is a folder (<stem>.png;\n"
+    "                         <stem>-<k>.png when scenes share a name, k from 1)\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
     "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad "
@@ -98,10 +101,20 @@ drawCylinder(Canvas& canvas, const facyl::PinholeCamera& cam, const facyl::Cylin
     canvas.line(project(m.base + s * side), project(m.top + s * side), colour, 2);
 }
 
-std::string
-stemOf(const std::string& file)
+/** The name of each scene's outputs (overlay, clusters): its file name's stem, or, when
+ * several scenes share a stem, "<stem>-<k>" with k its position among the scenes (from 1). */
+std::vector<std::string>
+outputNames(const std::vector<std::string>& files)
 {
-  return std::filesystem::path(file).stem().string();
+  std::map<std::string, int> uses;
+  for (const auto& f : files)
+    ++uses[std::filesystem::path(f).stem().string()];
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    const std::string stem = std::filesystem::path(files[k]).stem().string();
+    names.push_back(uses[stem] > 1 ? stem + "-" + std::to_string(k + 1) : stem);
+  }
+  return names;
 }
 
 struct Settings {
@@ -248,13 +261,13 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
 /** Each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png) in \a dir.
  * \return an empty string, or what could not be written. */
 std::string
-saveClusters(const std::string& dir, const std::string& file, const Cloud& cloud,
+saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud,
              bool has_colour, const std::vector<facyl::RecognizedObject>& objects)
 {
   for (std::size_t k = 0; k < objects.size(); ++k) {
     const auto& o = objects[k];
     const std::string base =
-      (std::filesystem::path(dir) / (stemOf(file) + "_obj" + std::to_string(k))).string();
+      (std::filesystem::path(dir) / (name + "_obj" + std::to_string(k))).string();
     Cloud part;
     pcl::copyPointCloud(cloud, o.cluster.indices, part);
     if (pcl::io::savePCDFileBinaryCompressed(base + ".pcd", part) < 0)
@@ -276,7 +289,8 @@ saveClusters(const std::string& dir, const std::string& file, const Cloud& cloud
 }
 
 bool
-processScene(const std::string& file, const Settings& s, std::ostream& out)
+processScene(const std::string& file, const std::string& name, const Settings& s,
+             std::ostream& out)
 {
   auto fail = [&](const std::string& why) {
     out << "{\"file\":" << facyl_cli::quote(file) << ",\"error\":" << facyl_cli::quote(why) << "}"
@@ -284,11 +298,14 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
     return false;
   };
   pcl::PCLPointCloud2 blob;
-  const std::string why = facyl_cli::readPcd(file, blob);
+  facyl_cli::Viewpoint viewpoint;
+  const std::string why = facyl_cli::readPcd(file, blob, &viewpoint);
   if (!why.empty())
     return fail(why);
   Cloud::Ptr cloud(new Cloud);
   pcl::fromPCLPointCloud2(blob, *cloud);
+  cloud->sensor_origin_ = viewpoint.origin;
+  cloud->sensor_orientation_ = viewpoint.orientation;
   const bool has_colour = facyl_cli::hasField(blob, "rgb") || facyl_cli::hasField(blob, "rgba");
   if (cloud->empty())
     return fail("the cloud is empty");
@@ -315,11 +332,11 @@ processScene(const std::string& file, const Settings& s, std::ostream& out)
   std::string warning;
   if (!s.overlay.empty()) {
     const std::string path =
-      s.many ? (std::filesystem::path(s.overlay) / (stemOf(file) + ".png")).string() : s.overlay;
+      s.many ? (std::filesystem::path(s.overlay) / (name + ".png")).string() : s.overlay;
     warning = drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects);
   }
   if (!s.clusters_dir.empty()) {
-    const std::string w = saveClusters(s.clusters_dir, file, *cloud, has_colour, objects);
+    const std::string w = saveClusters(s.clusters_dir, name, *cloud, has_colour, objects);
     warning = warning.empty() ? w : warning;
   }
   if (!warning.empty())
@@ -347,14 +364,17 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
     char c1 = 0, c2 = 0, c3 = 0;
     facyl::PinholeCamera& cam = s.camera;
     if (!(in >> cam.fx >> c1 >> cam.fy >> c2 >> cam.cx >> c3 >> cam.cy) || c1 != ',' ||
-        c2 != ',' || c3 != ',' || !(cam.fx > 0.f) || !(cam.fy > 0.f))
-      throw std::invalid_argument("--camera: expected fx,fy,cx,cy with fx, fy > 0");
+        c2 != ',' || c3 != ',' || !in.eof() || !(cam.fx > 0.f && cam.fx <= 1e5f) ||
+        !(cam.fy > 0.f && cam.fy <= 1e5f) || !(cam.cx >= 0.f && cam.cx <= 4000.f) ||
+        !(cam.cy >= 0.f && cam.cy <= 4000.f))
+      throw std::invalid_argument("--camera: expected fx,fy,cx,cy with 0 < fx, fy <= 1e5 and "
+                                  "0 <= cx, cy <= 4000 (images up to 8001 x 8001 pixels)");
     cam.width = static_cast<int>(std::ceil(2.f * cam.cx + 1.f));
     cam.height = static_cast<int>(std::ceil(2.f * cam.cy + 1.f));
   }
   s.overlay = args.text("--overlay", "");
   s.clusters_dir = args.text("--save-clusters", "");
-  s.repeat = static_cast<int>(args.integer("--repeat", 1, 1));
+  s.repeat = static_cast<int>(args.integer("--repeat", 1, 1, 1000));
   s.many = files.size() > 1;
   if (!s.many && !s.overlay.empty()) {
     const auto parent = std::filesystem::path(s.overlay).parent_path();
@@ -385,8 +405,22 @@ main(int argc, char** argv)
     std::fprintf(stderr, "facyl_detect: %s\n", e.what());
     return 2;
   }
+  // PCL's warnings about a file (e.g. a cloud without colour) would drown the output; the
+  // errors that explain a failed scene stay.
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  const std::vector<std::string> names = outputNames(files);
   bool all_ok = true;
-  for (const auto& f : files)
-    all_ok = processScene(f, s, std::cout) && all_ok;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    bool ok = false;
+    try {
+      ok = processScene(files[k], names[k], s, std::cout);
+    }
+    catch (const std::exception& e) { // e.g. std::bad_alloc: this scene fails, the batch goes on
+      std::cout << "{\"file\":" << facyl_cli::quote(files[k]) << ",\"error\":"
+                << facyl_cli::quote(std::string("unexpected failure: ") + e.what()) << "}"
+                << std::endl;
+    }
+    all_ok = ok && all_ok;
+  }
   return all_ok ? 0 : 1;
 }

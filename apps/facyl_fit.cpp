@@ -106,11 +106,14 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   ok = false;
   pcl::StopWatch total_watch;
   pcl::PCLPointCloud2 blob;
-  const std::string unreadable = facyl_cli::readPcd(file, blob);
+  facyl_cli::Viewpoint viewpoint;
+  const std::string unreadable = facyl_cli::readPcd(file, blob, &viewpoint);
   if (!unreadable.empty())
     return errorObject(file, unreadable);
   Cloud::Ptr cloud(new Cloud);
   pcl::fromPCLPointCloud2(blob, *cloud);
+  cloud->sensor_origin_ = viewpoint.origin; // normals are oriented towards it
+  cloud->sensor_orientation_ = viewpoint.orientation;
   if (cloud->empty())
     return errorObject(file, "the cloud is empty");
   const auto finite = std::count_if(cloud->begin(), cloud->end(),
@@ -214,17 +217,17 @@ main(int argc, char** argv)
     s.up = args.vector3("--up", s.up);
     if (!(s.up.norm() > 0.f))
       throw std::invalid_argument("--up must not be zero");
-    s.orientations = static_cast<std::size_t>(args.integer("--orientations", default_orientations, 1));
-    s.accumulators = static_cast<std::size_t>(args.integer("--accumulators", default_accumulators, 1));
-    s.params.radius_min = static_cast<float>(args.number("--radius-min", 0.0));
+    s.orientations = static_cast<std::size_t>(args.integer("--orientations", default_orientations, 1, 200000));
+    s.accumulators = static_cast<std::size_t>(args.integer("--accumulators", default_accumulators, 1, 64));
+    s.params.radius_min = static_cast<float>(args.number("--radius-min", 0.0, 0.0, 1e4));
     s.params.radius_max = static_cast<float>(
-        args.number("--radius-max", std::numeric_limits<double>::infinity()));
-    s.params.distance_threshold = static_cast<float>(args.number("--distance-threshold", 0.0));
+        args.number("--radius-max", std::numeric_limits<double>::infinity(), 0.0, 1e4));
+    s.params.distance_threshold = static_cast<float>(args.number("--distance-threshold", 0.0, 0.0, 1e4));
     s.params.max_cylinders =
-        static_cast<std::size_t>(args.integer("--max-cylinders", default_max_cylinders, 1));
-    s.k = static_cast<int>(args.integer("--k", default_k, 3));
-    s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
-    s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0));
+        static_cast<std::size_t>(args.integer("--max-cylinders", default_max_cylinders, 1, 100));
+    s.k = static_cast<int>(args.integer("--k", default_k, 3, 1000));
+    s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
+    s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0, 256));
     s.params.outward_normals = args.has("--outward-normals");
     const std::string why = facyl::validate(s.params);
     if (!why.empty())

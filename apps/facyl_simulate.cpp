@@ -48,16 +48,16 @@ main(int argc, char** argv)
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output file (see -h)");
     out = args.positional()[0];
-    p.radius = static_cast<float>(args.number("--radius", 0.05));
-    p.height = static_cast<float>(args.number("--height", 0.2));
+    p.radius = static_cast<float>(args.number("--radius", 0.05, 1e-4, 100.0));
+    p.height = static_cast<float>(args.number("--height", 0.2, 1e-4, 1000.0));
     p.axis = args.vector3("--axis", Eigen::Vector3f::UnitZ());
     p.base = args.vector3("--base", Eigen::Vector3f(0.f, 0.f, 0.8f));
     p.random_axis = args.has("--random-axis");
-    p.lateral_points = static_cast<std::size_t>(args.integer("--points", 900, 1));
-    p.lid_ratio = static_cast<float>(args.number("--lids", 0.0));
-    p.noise = static_cast<float>(args.number("--noise", 0.0));
-    p.occlusion = static_cast<float>(args.number("--occlusion", 0.0));
-    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
+    p.lateral_points = static_cast<std::size_t>(args.integer("--points", 900, 1, 10000000));
+    p.lid_ratio = static_cast<float>(args.number("--lids", 0.0, 0.0, 10.0));
+    p.noise = static_cast<float>(args.number("--noise", 0.0, 0.0, 10.0));
+    p.occlusion = static_cast<float>(args.number("--occlusion", 0.0, 0.0, 1.0));
+    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
     normals = args.has("--with-normals");
     const std::string why = facyl::validate(p);
     if (!why.empty())

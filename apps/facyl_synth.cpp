@@ -7,6 +7,7 @@
  * PREFIX.json (ground truth), and prints one JSON line per scene.
  */
 #include "cli.h"
+#include "scene_options.h"
 
 #include <facyl/simulation/tabletop_scene.h>
 
@@ -39,9 +40,10 @@ printHelp(const char* self)
     "  --lying-share P    probability that a can or tube lies (default 0.25)\n"
     "  --noise K          axial depth noise sigma = K z^2 (default: the sensor's)\n"
     "  --no-quantisation  no disparity quantisation\n"
+    "%s"
     "Class codes in PREFIX_class.png: 0 background, 1 table, 2 cylinder, 3 box, 4 sphere,\n"
     "5 cone, 6 bowl.\n",
-    self);
+    self, facyl_cli::sceneImageOptionsHelp());
 }
 } // namespace
 
@@ -56,10 +58,12 @@ main(int argc, char** argv)
   std::string prefix;
   std::size_t count = 1;
   try {
-    const facyl_cli::Arguments args(argc, argv,
-                                    {"--seed", "--count", "--objects", "--cylinder-share",
-                                     "--lying-share", "--noise", "--layout", "--sensor"},
-                                    {"--no-quantisation"});
+    const facyl_cli::Arguments args(
+      argc, argv,
+      facyl_cli::joined(facyl_cli::sceneImageOptions(),
+                        {"--seed", "--count", "--objects", "--cylinder-share", "--lying-share",
+                         "--noise", "--layout", "--sensor"}),
+      {"--no-quantisation"});
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
     prefix = args.positional()[0];
@@ -70,8 +74,8 @@ main(int argc, char** argv)
       throw std::invalid_argument("--layout must be spread or cluttered");
     if (!facyl::parseSensorPreset(args.text("--sensor", "kinect"), p.sensor, p.camera))
       throw std::invalid_argument("--sensor must be kinect or stereo");
-    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
-    count = static_cast<std::size_t>(args.integer("--count", 1, 1));
+    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
+    count = static_cast<std::size_t>(args.integer("--count", 1, 1, 100000));
     const std::string objects = args.text(
       "--objects", std::to_string(p.min_objects) + "," + std::to_string(p.max_objects));
     unsigned lo = 0, hi = 0;
@@ -80,11 +84,12 @@ main(int argc, char** argv)
       throw std::invalid_argument("--objects: expected MIN,MAX, got '" + objects + "'");
     p.min_objects = lo;
     p.max_objects = hi;
-    p.cylinder_share = static_cast<float>(args.number("--cylinder-share", p.cylinder_share));
-    p.lying_share = static_cast<float>(args.number("--lying-share", p.lying_share));
-    p.sensor.noise_coefficient = static_cast<float>(args.number("--noise", p.sensor.noise_coefficient));
+    p.cylinder_share = static_cast<float>(args.number("--cylinder-share", p.cylinder_share, 0.0, 1.0));
+    p.lying_share = static_cast<float>(args.number("--lying-share", p.lying_share, 0.0, 1.0));
+    p.sensor.noise_coefficient = static_cast<float>(args.number("--noise", p.sensor.noise_coefficient, 0.0, 0.1));
     if (args.has("--no-quantisation"))
       p.sensor.disparity_step = 0.f;
+    facyl_cli::applySceneImageOptions(args, p);
     const std::string why = facyl::validate(p);
     if (!why.empty())
       throw std::invalid_argument(why);

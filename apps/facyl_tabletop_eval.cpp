@@ -7,6 +7,7 @@
  */
 #include "cli.h"
 #include "recognizer_options.h"
+#include "scene_options.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/segmentation_score.h>
@@ -203,6 +204,7 @@ struct Options {
   std::uint64_t seed{1000};
   bool cluttered{false};
   std::string sensor{"kinect"};
+  facyl::TabletopSceneParameters scene; ///< layout, sensor and image options; seed per scene
   std::string mosd, csv;
   facyl::TabletopRecognizerParameters params;
 };
@@ -270,10 +272,11 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
   std::size_t cylinders = 0, touching = 0;
   for (const Row& r : all)
     cylinders += r.positive, touching += r.touching;
-  std::printf("## Simulated scenes: %zu (%s layout, %s sensor, seeds %llu..%llu), %zu objects "
-              "with >= %zu visible pixels (%zu cylinders, %zu touching another object); "
-              "%zu scenes failed (no table), %zu with a wrong support plane\n",
+  std::printf("## Simulated scenes: %zu (%s layout, %s sensor, %dx%d, %.1f%% dropout, seeds "
+              "%llu..%llu), %zu objects with >= %zu visible pixels (%zu cylinders, %zu touching "
+              "another object); %zu scenes failed (no table), %zu with a wrong support plane\n",
               opt.sim, opt.cluttered ? "cluttered" : "spread", opt.sensor.c_str(),
+              opt.scene.camera.width, opt.scene.camera.height, 100.0 * opt.scene.sensor.dropout,
               static_cast<unsigned long long>(opt.seed),
               static_cast<unsigned long long>(opt.seed + opt.sim - 1), all.size(),
               opt.params.segmentation.min_cluster_size, cylinders, touching, failures,
@@ -327,9 +330,7 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<facyl::RecognitionTiming> timing;
   std::size_t failures = 0, wrong_plane = 0;
   for (std::size_t k = 0; k < opt.sim; ++k) {
-    facyl::TabletopSceneParameters sp =
-      opt.cluttered ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
-    facyl::parseSensorPreset(opt.sensor, sp.sensor, sp.camera);
+    facyl::TabletopSceneParameters sp = opt.scene;
     sp.seed = opt.seed + k;
     const facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
     Cloud::Ptr cloud(new Cloud(scene.cloud));
@@ -576,7 +577,7 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [--sim N] [--first-seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
-    "          [--mosd DIR] [--csv FILE] [recognizer options]\n"
+    "          [--resolution WxH] [--dropout P] [--mosd DIR] [--csv FILE] [recognizer options]\n"
     "Runs TabletopCylinderRecognizer on N simulated scenes (seeds S.., default 1000) and/or\n"
     "the mOSD learn scenes and prints: segmentation (objects recovered as one segment with\n"
     "IoU >= 0.5, merged, split; in simulation also for the objects touching another), cylinder\n"
@@ -592,20 +593,23 @@ parseOptions(int argc, char** argv)
   const facyl_cli::Arguments args(
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      {"--sim", "--first-seed", "--layout", "--sensor", "--mosd", "--csv"}),
+                      facyl_cli::joined(facyl_cli::sceneImageOptions(),
+                                        {"--sim", "--first-seed", "--layout", "--sensor",
+                                         "--mosd", "--csv"})),
     facyl_cli::recognizerSwitches());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
-  opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0));
-  opt.seed = static_cast<std::uint64_t>(args.integer("--first-seed", 1000, 0));
+  opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0, 100000));
+  opt.seed = static_cast<std::uint64_t>(args.integer("--first-seed", 1000, 0, facyl_cli::kMaxSeed));
   const std::string layout = args.text("--layout", "spread");
   if (layout != "spread" && layout != "cluttered")
     throw std::invalid_argument("--layout must be spread or cluttered");
   opt.cluttered = layout == "cluttered";
   opt.sensor = args.text("--sensor", "kinect");
-  facyl::TabletopSceneParameters probe;
-  if (!facyl::parseSensorPreset(opt.sensor, probe.sensor, probe.camera))
+  opt.scene = opt.cluttered ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
+  if (!facyl::parseSensorPreset(opt.sensor, opt.scene.sensor, opt.scene.camera))
     throw std::invalid_argument("--sensor must be kinect or stereo");
+  facyl_cli::applySceneImageOptions(args, opt.scene);
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");
   facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);

@@ -81,42 +81,46 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
                        Eigen::Vector3f& up)
 {
   auto& d = p.decision;
-  d.min_score = static_cast<float>(args.number("--min-score", d.min_score));
+  d.min_score = static_cast<float>(args.number("--min-score", d.min_score, 0.0, 1.0));
   const std::string score = args.text("--score", "surface");
   if (score != "surface" && score != "inlier")
     throw std::invalid_argument("--score must be surface or inlier");
   d.score = score == "surface" ? facyl::CylinderDecision::Score::SurfaceRatio
                                : facyl::CylinderDecision::Score::InlierRatio;
   d.max_curvature_ratio =
-    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio));
-  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage));
-  d.max_taper = static_cast<float>(args.number("--max-taper", d.max_taper));
+    static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio, 1e-6, 1.0));
+  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage, 0.0, 1.0));
+  d.max_taper = static_cast<float>(args.number("--max-taper", d.max_taper, 1e-6, 1.0));
   p.retry_upright_lying = !args.has("--no-retry");
   p.retry_any_normal_sign = args.has("--retry-inside");
   p.hough.outward_normals = !args.has("--any-normal-sign");
   if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
     throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
   const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
+  if (!(radii.first >= 0 && radii.second <= 10))
+    throw std::invalid_argument("--radius-limits: expected 0 <= A < B <= 10 (m)");
   p.hough.radius_min = static_cast<float>(radii.first);
   p.hough.radius_max = static_cast<float>(radii.second);
   p.orientations = static_cast<std::size_t>(
-    args.integer("--orientations", static_cast<long long>(p.orientations), 10));
+    args.integer("--orientations", static_cast<long long>(p.orientations), 10, 100000));
   p.max_fit_points = static_cast<std::size_t>(
-    args.integer("--max-fit-points", static_cast<long long>(p.max_fit_points), 50));
-  p.neighbours = static_cast<int>(args.integer("--neighbours", p.neighbours, 5));
-  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0));
+    args.integer("--max-fit-points", static_cast<long long>(p.max_fit_points), 50, 1000000));
+  p.neighbours = static_cast<int>(args.integer("--neighbours", p.neighbours, 5, 200));
+  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, kMaxSeed));
   p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(
-    "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1));
+    "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1, 20));
   auto& g = p.segmentation;
-  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance));
+  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance, 1e-4, 1.0));
   const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
+  if (!(heights.first >= -10 && heights.second <= 10))
+    throw std::invalid_argument("--height-limits: expected -10 <= A < B <= 10 (m)");
   g.min_height = static_cast<float>(heights.first);
   g.max_height = static_cast<float>(heights.second);
-  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance));
+  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance, 1e-4, 1.0));
   const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
                                 static_cast<double>(g.max_cluster_size));
-  if (!(sizes.first >= 1 && sizes.second >= sizes.first))
-    throw std::invalid_argument("--cluster-size: expected 1 <= A <= B");
+  if (!(sizes.first >= 1 && sizes.second >= sizes.first && sizes.second <= 1e9))
+    throw std::invalid_argument("--cluster-size: expected 1 <= A <= B <= 1e9");
   g.min_cluster_size = static_cast<std::size_t>(sizes.first);
   g.max_cluster_size = static_cast<std::size_t>(sizes.second);
   const std::string clustering = args.text("--clustering", "edge-aware");

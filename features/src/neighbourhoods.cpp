@@ -2,6 +2,7 @@
  * facyl: fast cylinder detection for PCL.
  */
 #include <facyl/features/neighbourhoods.h>
+#include <facyl/features/parallel.h>
 
 #include <nanoflann.hpp>
 
@@ -11,10 +12,6 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace facyl {
 
@@ -56,16 +53,9 @@ struct FiniteColumns {
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FiniteColumns>,
                                                  FiniteColumns, 3, std::uint32_t>;
 
-int
-threadCount(int threads)
-{
-#ifdef _OPENMP
-  return threads > 0 ? threads : omp_get_max_threads();
-#else
-  (void)threads;
-  return 1;
-#endif
-}
+/** Queries per block of a parallel search. */
+constexpr std::size_t kQueryGrain = 512;
+
 } // namespace
 
 struct NeighbourSearch::Impl {
@@ -100,19 +90,16 @@ NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) co
     return out;
   std::vector<std::uint32_t> found(n * kk);
   std::vector<std::uint32_t> counts(n, 0);
-#pragma omp parallel num_threads(threadCount(threads))
-  {
+  parallelFor(n, threads, kQueryGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<float> distances(kk);
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      const Eigen::Vector3f q = queries.col(i);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
       if (!q.allFinite())
         continue;
-      std::uint32_t* out = found.data() + static_cast<std::size_t>(i) * kk;
-      counts[static_cast<std::size_t>(i)] =
-          static_cast<std::uint32_t>(tree.knnSearch(q.data(), kk, out, distances.data()));
+      std::uint32_t* out = found.data() + i * kk;
+      counts[i] = static_cast<std::uint32_t>(tree.knnSearch(q.data(), kk, out, distances.data()));
     }
-  }
+  });
   for (std::size_t i = 0; i < n; ++i)
     out.offsets[i + 1] = out.offsets[i] + counts[i];
   out.indices.resize(out.offsets[n]);
@@ -134,22 +121,20 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
   std::vector<std::vector<int>> lists(n);
   if (data.columns.empty())
     return Neighbourhoods::fromLists(lists);
-#pragma omp parallel num_threads(threadCount(threads))
-  {
+  parallelFor(n, threads, kQueryGrain / 2, [&](std::size_t begin, std::size_t end) {
     std::vector<std::pair<std::uint32_t, float>> matches;
-#pragma omp for schedule(dynamic, 256)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      const Eigen::Vector3f q = queries.col(i);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
       if (!q.allFinite())
         continue;
       tree.radiusSearch(q.data(), radius * radius, matches,
                         nanoflann::SearchParams(32, 0.f, true));
-      auto& list = lists[static_cast<std::size_t>(i)];
+      auto& list = lists[i];
       list.reserve(matches.size());
       for (const auto& m : matches)
         list.push_back(data.columns[m.first]);
     }
-  }
+  });
   return Neighbourhoods::fromLists(lists);
 }
 

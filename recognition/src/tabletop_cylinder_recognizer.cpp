@@ -21,14 +21,14 @@ validate(const TabletopRecognizerParameters& p)
   if (!why.empty())
     return "decision: " + why;
   std::ostringstream s;
-  if (p.orientations < 10)
-    s << "orientations " << p.orientations << " must be >= 10";
+  if (p.orientations < 10 || p.orientations > 100000)
+    s << "orientations " << p.orientations << " must be in [10, 100000]";
   else if (!(p.fit_point_angle >= 0.f && p.fit_point_angle <= 0.1f))
     s << "fit_point_angle " << p.fit_point_angle << " must be in [0, 0.1] rad";
-  else if (p.max_fit_points < 50)
-    s << "max_fit_points " << p.max_fit_points << " must be >= 50";
-  else if (p.neighbours < 5)
-    s << "neighbours " << p.neighbours << " must be >= 5";
+  else if (p.max_fit_points < 50 || p.max_fit_points > 1000000)
+    s << "max_fit_points " << p.max_fit_points << " must be in [50, 1000000]";
+  else if (p.neighbours < 5 || p.neighbours > 200)
+    s << "neighbours " << p.neighbours << " must be in [5, 200]";
   else if (p.max_cylinders_per_cluster < 1 || p.max_cylinders_per_cluster > 20)
     s << "max_cylinders_per_cluster " << p.max_cylinders_per_cluster << " must be in [1, 20]";
   else if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))

@@ -199,4 +199,52 @@ heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, floa
   return h;
 }
 
+Eigen::Affine3f
+sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation)
+{
+  Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+  const float norm = orientation.norm();
+  if (std::isfinite(norm) && norm > 1e-6f)
+    pose.linear() = orientation.normalized().toRotationMatrix();
+  if (origin.head<3>().allFinite())
+    pose.translation() = origin.head<3>();
+  return pose;
+}
+
+Eigen::Affine3f
+plausibleSensorPose(const Eigen::Matrix3Xf& sample, const Eigen::Vector4f& origin,
+                    const Eigen::Quaternionf& orientation)
+{
+  const Eigen::Affine3f stored = sensorPose(origin, orientation);
+  Eigen::Affine3f unrotated = Eigen::Affine3f::Identity();
+  unrotated.translation() = stored.translation();
+  if (stored.linear().isApprox(Eigen::Matrix3f::Identity(), 1e-6f))
+    return stored;
+  const Eigen::Affine3f to_stored = stored.inverse(), to_unrotated = unrotated.inverse();
+  std::size_t ahead_stored = 0, ahead_unrotated = 0;
+  for (Eigen::Index i = 0; i < sample.cols(); ++i) {
+    const Eigen::Vector3f p = sample.col(i);
+    if (!p.allFinite())
+      continue;
+    ahead_stored += (to_stored * p).z() > 0.f;
+    ahead_unrotated += (to_unrotated * p).z() > 0.f;
+  }
+  return ahead_stored >= ahead_unrotated ? stored : unrotated;
+}
+
+bool
+isIdentityPose(const Eigen::Affine3f& pose)
+{
+  return pose.matrix().isApprox(Eigen::Matrix4f::Identity(), 1e-6f) ||
+         (pose.matrix() - Eigen::Matrix4f::Identity()).cwiseAbs().maxCoeff() < 1e-6f;
+}
+
+Eigen::Vector4f
+transformPlane(const Eigen::Vector4f& plane, const Eigen::Affine3f& t)
+{
+  const Eigen::Vector3f n = t.linear() * plane.head<3>();
+  const Eigen::Vector3f on_plane = -plane[3] * plane.head<3>() / plane.head<3>().squaredNorm();
+  return Eigen::Vector4f(n.x(), n.y(), n.z(), -n.dot(t * on_plane));
+}
+
 } // namespace facyl

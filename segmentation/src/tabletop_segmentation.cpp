@@ -27,8 +27,8 @@ validate(const TabletopSegmentationParameters& p)
     why << "cluster sizes must satisfy 1 <= min <= max";
   else if (!(p.min_hull_share > 0.f && p.min_hull_share <= 1.f))
     why << "min_hull_share " << p.min_hull_share << " must be in (0, 1]";
-  else if (p.plane_step < 1 || p.plane_step > 16)
-    why << "plane step " << p.plane_step << " must be in [1, 16]";
+  else if (p.plane_step < 0 || p.plane_step > 16)
+    why << "plane step " << p.plane_step << " must be in [0, 16] (0: automatic)";
   else if (p.plane_samples < 100)
     why << "plane_samples " << p.plane_samples << " must be >= 100";
   else if (p.max_planes < 1 || p.max_planes > 8)

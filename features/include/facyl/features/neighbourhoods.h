@@ -53,7 +53,8 @@ struct Neighbourhoods {
 
 /** \brief Exact neighbour search among the finite columns of a 3 x N matrix (a nanoflann
  * kd-tree, built once in the constructor). Queries are const, run in parallel on \a threads
- * threads (0: OpenMP's default), and may be issued concurrently. Indices refer to columns of
+ * threads (0: the hardware's concurrency; one per 512 queries at most; see parallelFor: waiting
+ * threads sleep, never spin), and may be issued concurrently. Indices refer to columns of
  * the surface; a query that is not finite gets no neighbour; a query that is a surface point
  * finds itself first.
  */

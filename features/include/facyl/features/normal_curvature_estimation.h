@@ -26,8 +26,9 @@ namespace facyl {
  * search method is given with setSearchMethod, neighbours come from an internal nanoflann
  * kd-tree (exact, and several times faster than pcl::search::KdTree on small clouds). Points that
  * are not finite or have fewer than 3 finite neighbours get NaN output and make
- * output.is_dense false. Runs in parallel with OpenMP; the result does not depend on the
- * number of threads.
+ * output.is_dense false. Runs in parallel on std::threads (see setNumberOfThreads and
+ * facyl::parallelFor: blocks of 256 points, waiting threads sleep rather than spin); the result
+ * does not depend on the number of threads.
  *
  * If the normals are known already, give them with setInputNormals (one per point of the
  * search surface): only the curvatures are then computed.
@@ -45,17 +46,26 @@ public:
 
   NormalCurvatureEstimation() { this->feature_name_ = "NormalCurvatureEstimation"; }
 
-  /** \brief Point towards which the normals are flipped (default: the origin, a sensor). */
+  /** \brief Point towards which the normals are flipped (default: the input cloud's
+   * sensor_origin_, as in pcl::NormalEstimation; the origin for a cloud without a pose). */
   void
   setViewPoint(float vpx, float vpy, float vpz)
   {
     view_point_ = Eigen::Vector3f(vpx, vpy, vpz);
+    use_sensor_origin_ = false;
   }
-  /** \brief The view point (see setViewPoint). */
+  /** \brief The view point set with setViewPoint, or the input's sensor origin. */
   Eigen::Vector3f
   getViewPoint() const
   {
-    return view_point_;
+    return use_sensor_origin_ && this->input_ ? Eigen::Vector3f(this->input_->sensor_origin_.template head<3>())
+                                              : view_point_;
+  }
+  /** \brief Flip the normals towards the input's sensor_origin_ again (the default). */
+  void
+  useSensorOriginAsViewPoint()
+  {
+    use_sensor_origin_ = true;
   }
 
   /** \brief Known normals, one per point of the search surface (the input when no surface was
@@ -72,13 +82,14 @@ public:
     return input_normals_;
   }
 
-  /** \brief Number of OpenMP threads; 0 (default) lets OpenMP choose. */
+  /** \brief Number of threads; 0 (default): the hardware's concurrency. Inputs of at most 256
+   * points (one block) run on the calling thread alone. */
   void
   setNumberOfThreads(unsigned int threads)
   {
     threads_ = threads;
   }
-  /** \brief Number of OpenMP threads (0: OpenMP's choice). */
+  /** \brief Number of threads (0: the hardware's concurrency). */
   unsigned int
   getNumberOfThreads() const
   {
@@ -100,10 +111,13 @@ private:
                  int threads) const;
 
   Eigen::Vector3f view_point_{Eigen::Vector3f::Zero()};
+  bool use_sensor_origin_{true};
   bool use_pcl_search_{false};
   std::unique_ptr<NeighbourSearch> search_;
   NormalCloudConstPtr input_normals_;
   unsigned int threads_{0};
+  /** Points per block of the parallel loops. */
+  static constexpr std::size_t kGrain = 256;
 };
 
 } // namespace facyl

@@ -16,6 +16,7 @@
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -43,7 +44,7 @@ struct TabletopRecognizerParameters {
   CylinderDecision decision;      ///< what makes a fitted object a cylinder
   /** Orientation prior, expressed in the table frame (up = table normal). */
   OrientationPrior prior{OrientationPrior::Vertical};
-  std::size_t orientations{450};  ///< accumulator cells N_d, >= 10
+  std::size_t orientations{450};  ///< accumulator cells N_d, in [10, 100000]
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
    * a lying (Horizontal) prior in the table frame and keep the best. */
   bool retry_upright_lying{true};
@@ -65,8 +66,8 @@ struct TabletopRecognizerParameters {
    * pixels at a 525 px focal length), so normals and curvatures are estimated at the same
    * angular scale near and far; 0: every pixel. In [0, 0.1]. */
   float fit_point_angle{0.006f};
-  std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, >= 50
-  int neighbours{16};             ///< k of the normal/curvature estimation, >= 5
+  std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
+  int neighbours{16};             ///< k of the normal/curvature estimation, in [5, 200]
   std::uint64_t seed{0};
 };
 
@@ -116,6 +117,7 @@ public:
   using PointCloud = pcl::PointCloud<PointT>;
   using pcl::PCLBase<PointT>::input_;
   using pcl::PCLBase<PointT>::indices_;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
 
   /** \brief All settings. */
   void
@@ -196,6 +198,10 @@ private:
   /** One fit of a FitInput and its evidence. */
   struct Fit;
 
+  /** recognize() on a cloud in the sensor's frame (identity sensor pose); \a t0: its start. */
+  bool
+  recognizeInSensorFrame(std::vector<RecognizedObject>& objects,
+                         std::chrono::steady_clock::time_point t0);
   /** Builds the cue estimation and the estimators (one per prior of the retries). */
   void
   configure();

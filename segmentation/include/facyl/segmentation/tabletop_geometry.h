@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +32,16 @@ struct PinholeCamera {
     return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   }
 };
+
+/** \brief True when \a camera's intrinsics are finite and positive and its image is at most
+ * 8192 x 8192 pixels (the images facyl builds from it stay below half a gigabyte). */
+inline bool
+cameraUsable(const PinholeCamera& camera)
+{
+  return camera.valid() && std::isfinite(camera.fx) && std::isfinite(camera.fy) &&
+         std::isfinite(camera.cx) && std::isfinite(camera.cy) && camera.width <= 8192 &&
+         camera.height <= 8192;
+}
 
 /** \brief Pixel box, inclusive: {u0, v0, u1, v1}; all -1 when unknown. */
 using PixelBox = std::array<int, 4>;
@@ -62,6 +73,29 @@ pixelBox(const pcl::Indices& indices, std::uint32_t width);
  * skipped), clipped to the image. All -1 when nothing projects inside. */
 PixelBox
 projectedBox(const Eigen::Matrix3Xf& points, const PinholeCamera& camera);
+
+/** \brief The sensor's pose in a cloud's frame (PCL's sensor_origin_ and sensor_orientation_,
+ * the PCD file's VIEWPOINT): maps sensor coordinates to the cloud's. */
+Eigen::Affine3f
+sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation);
+
+/** \brief The sensor pose to use for a cloud whose points include \a sample (3 x n): the stored
+ * one (sensorPose), unless its rotation puts fewer of the sample in front of the sensor (z > 0
+ * in the sensor's frame) than the origin alone does. Some files store the pose of a viewer
+ * rather than the sensor's (PCL's grabber frames: a 180-degree turn about x, with the points in
+ * the camera's frame); an RGB-D frame's points lie in front of its sensor. The origin is always
+ * kept. */
+Eigen::Affine3f
+plausibleSensorPose(const Eigen::Matrix3Xf& sample, const Eigen::Vector4f& origin,
+                    const Eigen::Quaternionf& orientation);
+
+/** \brief True when \a pose is the identity within 1e-6 (the cloud is in the sensor's frame). */
+bool
+isIdentityPose(const Eigen::Affine3f& pose);
+
+/** \brief Plane (a, b, c, d) with unit normal moved by the rigid transform \a t. */
+Eigen::Vector4f
+transformPlane(const Eigen::Vector4f& plane, const Eigen::Affine3f& t);
 
 /** \brief Pinhole intrinsics from points and the pixels they were measured at (least squares
  * on u = fx x/z + cx and v = fy y/z + cy). \return false with fewer than 10 usable points or a

@@ -56,7 +56,10 @@ struct TabletopSegmentationParameters {
   float min_support_area{0.1f};
   /** A cluster stands on a support when it reaches down to within this height of it. */
   float contact_height{0.03f};
-  int plane_step{4};              ///< organized: the plane search sees every step-th pixel, >= 1
+  /** Organized: the plane search works on blocks of step x step pixels, in [0, 16]; 0
+   * (default): the image width / 160 (4 at VGA), so that the search sees the same angular
+   * grid at every resolution. */
+  int plane_step{0};
   std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
   std::size_t max_planes{6};      ///< support candidates examined, in [1, 8]
 };
@@ -64,6 +67,20 @@ struct TabletopSegmentationParameters {
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
 std::string
 validate(const TabletopSegmentationParameters& params);
+
+/** \brief The sensor pose of \a cloud (sensor_origin_, sensor_orientation_), checked against an
+ * even sample of its points (see plausibleSensorPose). */
+template <typename PointT>
+Eigen::Affine3f
+plausibleSensorPose(const pcl::PointCloud<PointT>& cloud)
+{
+  const std::size_t step = std::max<std::size_t>(1, cloud.size() / 2000);
+  Eigen::Matrix3Xf sample(3, static_cast<Eigen::Index>((cloud.size() + step - 1) / step));
+  Eigen::Index n = 0;
+  for (std::size_t i = 0; i < cloud.size(); i += step)
+    sample.col(n++) = cloud[i].getVector3fMap();
+  return plausibleSensorPose(sample.leftCols(n), cloud.sensor_origin_, cloud.sensor_orientation_);
+}
 
 /** \brief One object above a support. */
 struct TabletopCluster {
@@ -87,10 +104,11 @@ struct SupportPlane {
 
 /** \brief Supports (tables), objects above them, and object clusters (paper III-A).
  *
- * Candidate planes: organized clouds (width x height > 1) use pcl::IntegralImageNormalEstimation
- * and pcl::OrganizedMultiPlaneSegmentation on a grid of every plane_step-th pixel (each grid
- * cell takes a pixel with depth, so missing pixels do not break the normals), coplanar regions
- * are joined; unorganized clouds use pcl::RandomSample, pcl::NormalEstimation and repeated
+ * Candidate planes: organized clouds (at least 16 blocks wide and high) use
+ * pcl::IntegralImageNormalEstimation and pcl::OrganizedMultiPlaneSegmentation on a grid of
+ * blocks of plane_step pixels (each cell the mean of its pixels with depth, so missing pixels
+ * do not break the normals), coplanar regions are joined; unorganized clouds (and narrower
+ * organized ones: a LiDAR's few rings) use pcl::RandomSample, pcl::NormalEstimation and repeated
  * pcl::SACSegmentationFromNormals (SACMODEL_NORMAL_PLANE). Each candidate is refitted on its
  * points. Objects are the points within [min_height, max_height] above a candidate and on no
  * candidate, clustered (see Clustering). A cluster belongs to the nearest candidate under it
@@ -119,6 +137,7 @@ public:
   using pcl::PCLBase<PointT>::input_;
   using pcl::PCLBase<PointT>::indices_;
   using pcl::PCLBase<PointT>::fake_indices_;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
 
   /** \brief All settings. */
   void
@@ -187,6 +206,12 @@ public:
   bool
   segment(std::vector<TabletopCluster>& clusters);
 
+  /** \brief Moves the results of the last run (supports, table, hull, and \a clusters'
+   * centroids) by the rigid transform \a t: for a caller that ran segment() on a copy of its
+   * cloud in another frame. segment() itself does this for a cloud with a sensor pose. */
+  void
+  transformResults(const Eigen::Affine3f& t, std::vector<TabletopCluster>& clusters);
+
   /** \brief Supports of the last run that hold objects, and the table (always there). */
   const std::vector<SupportPlane>&
   getSupports() const
@@ -251,6 +276,16 @@ private:
     bool standing{false}; ///< reaches down to it and is whole in its object band
   };
 
+  /** The block size of the plane search on organized input (see plane_step). */
+  int
+  planeStep() const;
+  /** True when the input is searched as an image (organized and at least 16 plane-grid cells
+   * wide and high), else as a point set. */
+  bool
+  searchedAsImage() const;
+  /** segment() on a cloud in the sensor's frame (identity sensor pose). */
+  bool
+  segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
   bool
   findPlanesOrganized(std::vector<Candidate>& candidates);
   bool

@@ -5,17 +5,15 @@
 
 #include <facyl/features/neighbourhoods.h>
 #include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/features/parallel.h>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/console/print.h>
 
+#include <atomic>
 #include <limits>
 #include <stdexcept>
 #include <vector>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace facyl {
 
@@ -89,12 +87,9 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
   };
   if (use_pcl_search_) {
     std::vector<pcl::Indices> lists(n);
-#pragma omp parallel num_threads(threads)
-    {
+    parallelFor(n, threads, kGrain, [&](std::size_t begin, std::size_t end) {
       std::vector<float> distances;
-#pragma omp for schedule(dynamic, 128)
-      for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-        const auto s = static_cast<std::size_t>(i);
+      for (std::size_t s = begin; s < end; ++s) {
         if (!pcl::isFinite(query_point(s)))
           continue;
         if (queries_are_input)
@@ -104,7 +99,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
           this->searchForNeighbors(surface, surface_queries[s], this->search_parameter_,
                                    lists[s], distances);
       }
-    }
+    });
     return Neighbourhoods::fromLists(lists);
   }
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
@@ -125,11 +120,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   const std::size_t n = indices.size();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(nan);
-#ifdef _OPENMP
-  const int threads = threads_ > 0 ? static_cast<int>(threads_) : omp_get_max_threads();
-#else
-  const int threads = 1;
-#endif
+  const int threads = static_cast<int>(threads_); // 0: the hardware's concurrency
 
   Eigen::Matrix3Xf surface_points;
   if (!use_pcl_search_) {
@@ -140,6 +131,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   }
 
   // Normals oriented towards the view point, so that neighbouring normals agree in sign.
+  const Eigen::Vector3f view_point = getViewPoint();
   const auto pcaNormal = [&](const Neighbourhoods& nb, std::size_t i, const Eigen::Vector3f& at,
                              Eigen::Vector3f& normal, float& variation) {
     const int* list = nb.begin(i);
@@ -148,7 +140,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
             nb.count(i), [&](std::size_t j) { return surface[list[j]].getVector3fMap(); },
             normal, variation))
       return false;
-    if ((view_point_ - at).dot(normal) < 0.f)
+    if ((view_point - at).dot(normal) < 0.f)
       normal = -normal;
     return true;
   };
@@ -172,12 +164,11 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
     }
   }
   else {
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      const auto s = static_cast<std::size_t>(i);
-      if (pcl::isFinite(input[indices[s]]))
-        pcaNormal(nb, s, input[indices[s]].getVector3fMap(), normals[s], variation[s]);
-    }
+    parallelFor(n, threads, kGrain, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s)
+        if (pcl::isFinite(input[indices[s]]))
+          pcaNormal(nb, s, input[indices[s]].getVector3fMap(), normals[s], variation[s]);
+    });
   }
 
   // 2. A normal at every neighbour. In the common case (no search surface, no indices) the
@@ -204,46 +195,46 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
       }
     if (!missing.empty()) {
       const Neighbourhoods extra = neighbourhoods(missing, false, threads);
-#pragma omp parallel for num_threads(threads) schedule(static)
-      for (std::ptrdiff_t m = 0; m < static_cast<std::ptrdiff_t>(missing.size()); ++m) {
-        const auto s = static_cast<std::size_t>(m);
-        float sv;
-        pcaNormal(extra, s, surface[missing[s]].getVector3fMap(), surface_normals[missing[s]],
-                  sv);
-      }
+      parallelFor(missing.size(), threads, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t s = begin; s < end; ++s) {
+          float sv;
+          pcaNormal(extra, s, surface[missing[s]].getVector3fMap(),
+                    surface_normals[missing[s]], sv);
+        }
+      });
     }
   }
 
   // 3. Principal curvatures from the neighbours' normals, and the output.
-  bool dense = true;
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(&& : dense)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-    const auto s = static_cast<std::size_t>(i);
-    PointOutT& out = output[s];
-    PrincipalCurvatures pc;
-    const int* list = nb.begin(s);
-    const bool ok = normals[s].allFinite() &&
-                    principalCurvaturesFromNormals(
-                        normals[s], nb.count(s),
-                        [&](std::size_t j) { return surface_normals[list[j]]; }, pc);
-    if (!ok) {
-      out.normal_x = out.normal_y = out.normal_z = nan;
-      out.principal_curvature_x = out.principal_curvature_y = out.principal_curvature_z = nan;
-      out.curvature = out.pc1 = out.pc2 = nan;
-      dense = false;
-      continue;
+  std::atomic<bool> dense{true};
+  parallelFor(n, threads, kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      PointOutT& out = output[s];
+      PrincipalCurvatures pc;
+      const int* list = nb.begin(s);
+      const bool ok = normals[s].allFinite() &&
+                      principalCurvaturesFromNormals(
+                          normals[s], nb.count(s),
+                          [&](std::size_t j) { return surface_normals[list[j]]; }, pc);
+      if (!ok) {
+        out.normal_x = out.normal_y = out.normal_z = nan;
+        out.principal_curvature_x = out.principal_curvature_y = out.principal_curvature_z = nan;
+        out.curvature = out.pc1 = out.pc2 = nan;
+        dense.store(false, std::memory_order_relaxed);
+        continue;
+      }
+      out.normal_x = normals[s].x();
+      out.normal_y = normals[s].y();
+      out.normal_z = normals[s].z();
+      out.curvature = variation[s];
+      out.principal_curvature_x = pc.direction.x();
+      out.principal_curvature_y = pc.direction.y();
+      out.principal_curvature_z = pc.direction.z();
+      out.pc1 = pc.k_max;
+      out.pc2 = pc.k_min;
     }
-    out.normal_x = normals[s].x();
-    out.normal_y = normals[s].y();
-    out.normal_z = normals[s].z();
-    out.curvature = variation[s];
-    out.principal_curvature_x = pc.direction.x();
-    out.principal_curvature_y = pc.direction.y();
-    out.principal_curvature_z = pc.direction.z();
-    out.pc1 = pc.k_max;
-    out.pc2 = pc.k_min;
-  }
-  output.is_dense = dense;
+  });
+  output.is_dense = dense.load();
   search_.reset();
 }
 

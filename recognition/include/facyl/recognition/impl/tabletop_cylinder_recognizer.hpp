@@ -5,6 +5,8 @@
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
+#include <pcl/common/transforms.h>
+
 #include <pcl/common/point_tests.h>
 #include <pcl/type_traits.h>
 
@@ -38,6 +40,9 @@ void
 TabletopCylinderRecognizer<PointT>::configure()
 {
   cues_estimation_.setKSearch(params_.neighbours);
+  // A cluster's cues are a millisecond of work: threads would cost more in start-up and, beside
+  // other busy processes, in waiting for each other than they save.
+  cues_estimation_.setNumberOfThreads(1);
   // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
   // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
   // face from pulling the axis. Optionally a last try allows any normal sign: the inside of
@@ -63,13 +68,9 @@ template <typename PointT>
 bool
 TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& objects)
 {
-  using Clock = std::chrono::steady_clock;
-  const auto ms = [](Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-  };
   objects.clear();
   timing_ = RecognitionTiming{};
-  const auto t0 = Clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   const std::string why = validate(params_);
   if (!why.empty()) {
     PCL_ERROR("[facyl::TabletopCylinderRecognizer::recognize] Invalid parameters: %s.\n",
@@ -82,7 +83,46 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   }
   if (!configured_)
     configure();
+  const Eigen::Affine3f pose = plausibleSensorPose(*input_);
+  if (isIdentityPose(pose))
+    return recognizeInSensorFrame(objects, t0);
+  // Everything here works in the sensor's frame (pixels and depth seen from the origin, the
+  // camera of setCamera): the cloud is moved there, the results back to the cloud's frame, so
+  // that the answer does not depend on the frame the cloud is stored in.
+  const PointCloudConstPtr given = input_;
+  const Eigen::Vector3f given_up = up_;
+  typename PointCloud::Ptr local(new PointCloud);
+  pcl::transformPointCloud(*given, *local, pose.inverse());
+  local->sensor_origin_ = Eigen::Vector4f::Zero();
+  local->sensor_orientation_ = Eigen::Quaternionf::Identity();
+  input_ = local;
+  up_ = pose.linear().transpose() * up_;
+  const bool found = recognizeInSensorFrame(objects, t0);
+  input_ = given;
+  up_ = given_up;
+  segmentation_.setInputCloud(given);
+  std::vector<TabletopCluster> none;
+  segmentation_.transformResults(pose, none);
+  for (auto& o : objects) {
+    o.cluster.centroid = pose * o.cluster.centroid;
+    auto& m = o.cylinder;
+    m.point_on_axis = pose * m.point_on_axis;
+    m.base = pose * m.base;
+    m.top = pose * m.top;
+    m.axis = pose.linear() * m.axis;
+  }
+  return found;
+}
 
+template <typename PointT>
+bool
+TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
+  std::vector<RecognizedObject>& objects, std::chrono::steady_clock::time_point t0)
+{
+  using Clock = std::chrono::steady_clock;
+  const auto ms = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
   std::vector<TabletopCluster> clusters;
   segmentation_.setParameters(params_.segmentation);
   segmentation_.setInputCloud(input_);

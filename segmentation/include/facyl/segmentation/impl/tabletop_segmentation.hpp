@@ -7,6 +7,8 @@
 #include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 
+#include <pcl/common/transforms.h>
+
 #include <pcl/common/io.h>
 #include <pcl/common/point_tests.h>
 #include <pcl/features/integral_image_normal.h>
@@ -62,6 +64,13 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     PCL_ERROR("[facyl::TabletopSegmentation::segment] The up direction is not finite.\n");
     return false;
   }
+  if (camera_.valid() && !cameraUsable(camera_)) {
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] The camera given with setCamera (%g, %g, "
+              "%g, %g, %d x %d pixels) is not usable: finite intrinsics and at most 8192 x 8192 "
+              "pixels.\n",
+              camera_.fx, camera_.fy, camera_.cx, camera_.cy, camera_.width, camera_.height);
+    return false;
+  }
   if (!this->initCompute()) {
     PCL_ERROR("[facyl::TabletopSegmentation::segment] Invalid input or indices.\n");
     return false;
@@ -70,13 +79,61 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
   for (auto it = indices_->begin(); it != indices_->end() && finite < 3; ++it)
     finite += pcl::isFinite((*input_)[*it]);
   if (finite < 3) {
-    PCL_ERROR("[facyl::TabletopSegmentation::segment] The cloud has no finite points.\n");
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] The cloud has fewer than 3 finite points.\n");
     this->deinitCompute();
     return false;
   }
+  const Eigen::Affine3f pose = plausibleSensorPose(*input_);
+  bool found = false;
+  if (isIdentityPose(pose))
+    found = segmentInSensorFrame(clusters);
+  else {
+    // The search works in the sensor's frame (depth along the line of sight, pixels seen
+    // from the origin): the cloud is moved there, the results back to the cloud's frame.
+    const PointCloudConstPtr given = input_;
+    const Eigen::Vector3f given_up = up_;
+    typename PointCloud::Ptr local(new PointCloud);
+    pcl::transformPointCloud(*given, *local, pose.inverse());
+    local->sensor_origin_ = Eigen::Vector4f::Zero();
+    local->sensor_orientation_ = Eigen::Quaternionf::Identity();
+    input_ = local;
+    up_ = pose.linear().transpose() * up_;
+    found = segmentInSensorFrame(clusters);
+    input_ = given;
+    up_ = given_up;
+    if (found)
+      transformResults(pose, clusters);
+  }
+  this->deinitCompute();
+  return found;
+}
 
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::transformResults(const Eigen::Affine3f& pose,
+                                               std::vector<TabletopCluster>& clusters)
+{
+  for (auto& c : clusters)
+    c.centroid = pose * c.centroid;
+  for (auto& s : supports_) {
+    s.plane = transformPlane(s.plane, pose);
+    s.frame = pose * s.frame;
+  }
+  auto& t = table_coefficients_.values;
+  if (t.size() == 4) {
+    const Eigen::Vector4f moved = transformPlane(Eigen::Vector4f(t[0], t[1], t[2], t[3]), pose);
+    t = {moved[0], moved[1], moved[2], moved[3]};
+  }
+  pcl::transformPointCloud(*hull_, *hull_, pose);
+  image_down_ = pose.linear() * image_down_;
+}
+
+template <typename PointT>
+bool
+TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>& clusters)
+{
   std::vector<Candidate> candidates;
-  if (input_->isOrganized())
+  if (searchedAsImage())
     findPlanesOrganized(candidates);
   else
     findPlanesUnorganized(candidates);
@@ -87,7 +144,6 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
               params_.min_plane_points,
               up_.isZero() ? "" : " within max_support_tilt of the up direction");
     reset();
-    this->deinitCompute();
     return false;
   }
   pcl::Indices band;
@@ -96,11 +152,10 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane of at least %g m^2 found.\n",
               params_.min_support_area);
     reset();
-    this->deinitCompute();
     return false;
   }
   std::vector<pcl::Indices> groups;
-  if (input_->isOrganized())
+  if (searchedAsImage())
     clusterOrganized(band, groups);
   else
     clusterUnorganized(band, groups);
@@ -109,15 +164,33 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
   });
-  this->deinitCompute();
   return true;
+}
+
+template <typename PointT>
+int
+TabletopSegmentation<PointT>::planeStep() const
+{
+  if (params_.plane_step > 0)
+    return params_.plane_step;
+  return std::clamp(static_cast<int>(std::lround(input_->width / 160.0)), 1, 16);
+}
+
+template <typename PointT>
+bool
+TabletopSegmentation<PointT>::searchedAsImage() const
+{
+  // The image path needs a plane grid of at least 16 x 16 cells (its normals use a window of
+  // several cells); narrower organized clouds (a LiDAR's few rings, a strip) are point sets.
+  const auto cells = static_cast<std::uint32_t>(16 * planeStep());
+  return input_->isOrganized() && input_->width >= cells && input_->height >= cells;
 }
 
 template <typename PointT>
 bool
 TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candidates)
 {
-  const int step = params_.plane_step;
+  const int step = planeStep();
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
   std::vector<std::uint8_t> allowed; // only when indices were given
   if (!fake_indices_) {
@@ -165,7 +238,9 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
   ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
-  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step));
+  // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
+  // to their angular spacing at other resolutions.
+  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f / static_cast<float>(w));
   ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
   ne.setInputCloud(small);
   ne.compute(*normals);
@@ -476,7 +551,7 @@ TabletopSegmentation<PointT>::supportHull(const SupportPlane& s, const Candidate
     return Eigen::Vector2f((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
   };
   std::vector<Eigen::Vector2f> points;
-  if (!input_->isOrganized()) {
+  if (!searchedAsImage()) {
     const std::size_t stride = std::max<std::size_t>(1, idx.size() / params_.plane_samples);
     for (std::size_t k = 0; k < idx.size(); k += stride)
       points.push_back(flat(idx[k]));
