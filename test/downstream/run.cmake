@@ -1,6 +1,7 @@
 # ctest -R downstream: install facyl to a staging prefix, then configure, build and run a
-# separate project that uses find_package(facyl).
-# Variables: FACYL_BUILD_DIR, DOWNSTREAM_SOURCE_DIR, STAGE_DIR.
+# separate project that uses find_package(facyl), and run the installed tools as a user does
+# (no LD_LIBRARY_PATH: their RUNPATH must find the installed libraries).
+# Variables: FACYL_BUILD_DIR, DOWNSTREAM_SOURCE_DIR, STAGE_DIR, DATA_DIR (optional).
 file(REMOVE_RECURSE "${STAGE_DIR}")
 function(step)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
@@ -13,3 +14,18 @@ step(${CMAKE_COMMAND} -S "${DOWNSTREAM_SOURCE_DIR}" -B "${STAGE_DIR}/build"
      -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${STAGE_DIR}/prefix")
 step(${CMAKE_COMMAND} --build "${STAGE_DIR}/build")
 step("${STAGE_DIR}/build/facyl_downstream")
+if(DATA_DIR)
+  foreach(tool facyl_fit facyl_detect)
+    set(input "${DATA_DIR}/default_cylinder.pcd")
+    if(tool STREQUAL "facyl_detect")
+      set(input "${DATA_DIR}/default_scene.pcd")
+    endif()
+    execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=LD_LIBRARY_PATH
+                            "${STAGE_DIR}/prefix/bin/${tool}" "${input}"
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"radius\":")
+      message(FATAL_ERROR "installed ${tool} failed (${rc}): ${out} ${err}")
+    endif()
+    message(STATUS "installed ${tool}: ok")
+  endforeach()
+endif()
