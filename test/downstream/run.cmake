@@ -1,7 +1,8 @@
 # ctest -R downstream: install facyl to a staging prefix, then configure, build and run a
 # separate project that uses find_package(facyl), and run the installed tools as a user does
 # (no LD_LIBRARY_PATH: their RUNPATH must find the installed libraries).
-# Variables: FACYL_BUILD_DIR, DOWNSTREAM_SOURCE_DIR, STAGE_DIR, DATA_DIR (optional).
+# Variables: FACYL_BUILD_DIR, DOWNSTREAM_SOURCE_DIR, STAGE_DIR, DATA_DIR (optional),
+# CXX_FLAGS and EXE_LINKER_FLAGS (facyl's, e.g. the sanitizers').
 file(REMOVE_RECURSE "${STAGE_DIR}")
 function(step)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
@@ -11,7 +12,8 @@ function(step)
 endfunction()
 step(${CMAKE_COMMAND} --install "${FACYL_BUILD_DIR}" --prefix "${STAGE_DIR}/prefix")
 step(${CMAKE_COMMAND} -S "${DOWNSTREAM_SOURCE_DIR}" -B "${STAGE_DIR}/build"
-     -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${STAGE_DIR}/prefix")
+     -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${STAGE_DIR}/prefix"
+     "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${EXE_LINKER_FLAGS}")
 step(${CMAKE_COMMAND} --build "${STAGE_DIR}/build")
 step("${STAGE_DIR}/build/facyl_downstream")
 if(DATA_DIR)
