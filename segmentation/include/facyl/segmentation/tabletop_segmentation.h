@@ -340,7 +340,7 @@ private:
   pcl::ModelCoefficients table_coefficients_;
   typename PointCloud::Ptr hull_{new PointCloud};
   const Eigen::Affine3f identity_{Eigen::Affine3f::Identity()};
-  const pcl::PointIndices no_indices_;
+  const pcl::PointIndices no_indices_{};
   mutable pcl::PointCloud<pcl::PointXYZ>::Ptr masked_; ///< buffers of clusterOrganized
   mutable std::vector<std::uint8_t> has_depth_;
   mutable pcl::PointCloud<pcl::Label> labels_;

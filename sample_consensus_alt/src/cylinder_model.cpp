@@ -1,0 +1,78 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * The cylinder model: distances, angles, and the description of a model from its inliers.
+ */
+#include "fitting_detail.h"
+
+#include <facyl/sample_consensus_alt/cylinder_model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace facyl {
+
+using detail::basisFor;
+
+void
+CylinderModel::toCoefficients(pcl::ModelCoefficients& coefficients) const
+{
+  coefficients.values = {point_on_axis.x(), point_on_axis.y(), point_on_axis.z(),
+                         axis.x(),          axis.y(),          axis.z(),
+                         radius};
+}
+
+float
+CylinderModel::signedDistance(const Eigen::Vector3f& p) const
+{
+  return distanceToLine(p, point_on_axis, axis) - radius;
+}
+
+float
+axisAngle(const Eigen::Vector3f& a, const Eigen::Vector3f& b)
+{
+  // atan2 of |cross| and |dot| keeps precision at small angles, where acos(dot) rounds to 0.
+  const Eigen::Vector3f u = a.normalized(), v = b.normalized();
+  return std::atan2(u.cross(v).norm(), std::abs(u.dot(v)));
+}
+
+float
+distanceToLine(const Eigen::Vector3f& p, const Eigen::Vector3f& point, const Eigen::Vector3f& axis)
+{
+  const Eigen::Vector3f w = p - point;
+  return (w - w.dot(axis) * axis).norm();
+}
+
+void
+describeInliers(const Eigen::Matrix3Xf& points, CylinderModel& m)
+{
+  m.axis = foldToHemisphere(m.axis.normalized());
+  Eigen::Vector3f u, v;
+  basisFor(m.axis, u, v);
+  const Eigen::Vector3f origin = m.point_on_axis;
+  float t_min = std::numeric_limits<float>::max(), t_max = -t_min;
+  double sq = 0.0;
+  std::vector<char> sectors(36, 0);
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - origin;
+    const float t = w.dot(m.axis);
+    const Eigen::Vector3f d = w - t * m.axis;
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
+    const double e = d.norm() - m.radius;
+    sq += e * e;
+    const float angle = std::atan2(d.dot(v), d.dot(u)) + static_cast<float>(M_PI);
+    sectors[std::min<std::size_t>(35, static_cast<std::size_t>(angle / (2 * M_PI) * 36))] = 1;
+  }
+  if (points.cols() == 0)
+    t_min = t_max = 0.f;
+  m.base = origin + t_min * m.axis;
+  m.top = origin + t_max * m.axis;
+  m.point_on_axis = m.base;
+  m.height = t_max - t_min;
+  m.rms_error = points.cols() == 0 ? 0.f : static_cast<float>(std::sqrt(sq / points.cols()));
+  m.angular_coverage =
+      static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
+}
+
+} // namespace facyl
