@@ -18,6 +18,7 @@
 #include <array>
 #include <atomic>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -154,6 +155,40 @@ TEST(Reliability, AFrameInWorldCoordinatesGivesTheSameAnswer)
   EXPECT_TRUE(b.getTableFrame().isApprox(pose * a.getTableFrame(), 1e-4f));
   // The cloud is left as it was given.
   EXPECT_EQ(b.getInputCloud(), world);
+}
+
+TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
+{
+  // Found by fuzz_pcd: finite points near FLT_MAX made FLANN's k-d tree abort (an assertion in
+  // middleSplit) in the unorganized plane search. Now they count as missing pixels: the answer
+  // is the one for the same frame with those pixels NaN, organized or not.
+  const Cloud::Ptr scene = defaultScene();
+  Cloud::Ptr garbage(new Cloud(*scene)), missing(new Cloud(*scene));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < scene->size(); i += 97) {
+    (*garbage)[i].x = (i % 2 ? 3.3e38f : -2e7f);
+    (*garbage)[i].y = 1.f;
+    (*garbage)[i].z = (i % 3 ? 3.2e38f : 1.f);
+    (*missing)[i].x = (*missing)[i].y = (*missing)[i].z = nan;
+  }
+  EXPECT_EQ(facyl::countFarPoints(*garbage), (scene->size() + 96) / 97);
+  EXPECT_EQ(facyl::countFarPoints(*missing), 0u);
+  for (const bool organized : {true, false}) {
+    SCOPED_TRACE(organized ? "organized" : "unorganized");
+    Cloud::Ptr a(new Cloud(*garbage)), b(new Cloud(*missing));
+    if (!organized)
+      for (auto* c : {a.get(), b.get()}) {
+        c->width = static_cast<std::uint32_t>(c->size());
+        c->height = 1;
+      }
+    bool ok_a = false, ok_b = false;
+    const auto with_garbage = recognize(a, &ok_a);
+    const auto with_holes = recognize(b, &ok_b);
+    EXPECT_TRUE(ok_a);
+    EXPECT_EQ(ok_a, ok_b);
+    EXPECT_EQ(fingerprint(with_garbage), fingerprint(with_holes));
+    EXPECT_GE(with_garbage.size(), 5u);
+  }
 }
 
 TEST(Reliability, AViewerOrientationThatPutsThePointsBehindTheSensorIsIgnored)

@@ -7,11 +7,14 @@
 #include <facyl/segmentation/tabletop_geometry.h>
 
 #include <pcl/ModelCoefficients.h>
+#include <pcl/common/point_tests.h>
+#include <pcl/common/transforms.h>
 #include <pcl/PointIndices.h>
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,6 +83,50 @@ plausibleSensorPose(const pcl::PointCloud<PointT>& cloud)
   for (std::size_t i = 0; i < cloud.size(); i += step)
     sample.col(n++) = cloud[i].getVector3fMap();
   return plausibleSensorPose(sample.leftCols(n), cloud.sensor_origin_, cloud.sensor_orientation_);
+}
+
+/** \brief Largest |coordinate| of a point the tabletop pipeline processes: a thousand km in
+ * metres, a km in millimetres. Finite points beyond it (a corrupt file, a sensor's error code)
+ * are treated as missing: the float arithmetic of the searches (bounding boxes, squared
+ * distances) overflows near them, and FLANN's k-d tree aborts on such a box. */
+constexpr float kMaxCoordinate = 1e6f;
+
+/** \brief True when every coordinate of \a p is within +-kMaxCoordinate (false for NaN). */
+inline bool
+withinCoordinateRange(const Eigen::Vector3f& p)
+{
+  return (p.array().abs() <= kMaxCoordinate).all();
+}
+
+/** \brief Number of finite points of \a cloud with a coordinate beyond +-kMaxCoordinate. */
+template <typename PointT>
+std::size_t
+countFarPoints(const pcl::PointCloud<PointT>& cloud)
+{
+  std::size_t far = 0;
+  for (const auto& p : cloud)
+    far += pcl::isFinite(p) && !withinCoordinateRange(p.getVector3fMap());
+  return far;
+}
+
+/** \brief The copy of \a cloud that the tabletop pipeline works on: moved to the sensor's frame
+ * (the inverse of \a pose applied, sensor pose reset), every point outside
+ * withinCoordinateRange there set to NaN (is_dense false when any is). */
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr
+sensorFrameCopy(const pcl::PointCloud<PointT>& cloud, const Eigen::Affine3f& pose)
+{
+  typename pcl::PointCloud<PointT>::Ptr local(new pcl::PointCloud<PointT>);
+  pcl::transformPointCloud(cloud, *local, pose.inverse());
+  local->sensor_origin_ = Eigen::Vector4f::Zero();
+  local->sensor_orientation_ = Eigen::Quaternionf::Identity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (auto& p : *local)
+    if (!withinCoordinateRange(p.getVector3fMap())) {
+      p.x = p.y = p.z = nan;
+      local->is_dense = false;
+    }
+  return local;
 }
 
 /** \brief One object above a support. */

@@ -84,18 +84,20 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   if (!configured_)
     configure();
   const Eigen::Affine3f pose = plausibleSensorPose(*input_);
-  if (isIdentityPose(pose))
+  const std::size_t far = countFarPoints(*input_);
+  if (far > 0)
+    PCL_WARN("[facyl::TabletopCylinderRecognizer::recognize] %zu points have a coordinate "
+             "beyond +-%g and are ignored (treated as missing).\n",
+             far, static_cast<double>(kMaxCoordinate));
+  if (isIdentityPose(pose) && far == 0)
     return recognizeInSensorFrame(objects, t0);
   // Everything here works in the sensor's frame (pixels and depth seen from the origin, the
-  // camera of setCamera): the cloud is moved there, the results back to the cloud's frame, so
-  // that the answer does not depend on the frame the cloud is stored in.
+  // camera of setCamera): the cloud is moved there (points beyond kMaxCoordinate dropped), the
+  // results back to the cloud's frame, so that the answer does not depend on the frame the
+  // cloud is stored in.
   const PointCloudConstPtr given = input_;
   const Eigen::Vector3f given_up = up_;
-  typename PointCloud::Ptr local(new PointCloud);
-  pcl::transformPointCloud(*given, *local, pose.inverse());
-  local->sensor_origin_ = Eigen::Vector4f::Zero();
-  local->sensor_orientation_ = Eigen::Quaternionf::Identity();
-  input_ = local;
+  input_ = sensorFrameCopy(*given, pose);
   up_ = pose.linear().transpose() * up_;
   const bool found = recognizeInSensorFrame(objects, t0);
   input_ = given;

@@ -84,19 +84,20 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     return false;
   }
   const Eigen::Affine3f pose = plausibleSensorPose(*input_);
+  const std::size_t far = countFarPoints(*input_);
+  if (far > 0)
+    PCL_WARN("[facyl::TabletopSegmentation::segment] %zu points have a coordinate beyond +-%g "
+             "and are ignored (treated as missing).\n",
+             far, static_cast<double>(kMaxCoordinate));
   bool found = false;
-  if (isIdentityPose(pose))
+  if (isIdentityPose(pose) && far == 0)
     found = segmentInSensorFrame(clusters);
   else {
     // The search works in the sensor's frame (depth along the line of sight, pixels seen
     // from the origin): the cloud is moved there, the results back to the cloud's frame.
     const PointCloudConstPtr given = input_;
     const Eigen::Vector3f given_up = up_;
-    typename PointCloud::Ptr local(new PointCloud);
-    pcl::transformPointCloud(*given, *local, pose.inverse());
-    local->sensor_origin_ = Eigen::Vector4f::Zero();
-    local->sensor_orientation_ = Eigen::Quaternionf::Identity();
-    input_ = local;
+    input_ = sensorFrameCopy(*given, pose);
     up_ = pose.linear().transpose() * up_;
     found = segmentInSensorFrame(clusters);
     input_ = given;
