@@ -124,6 +124,7 @@ struct Settings {
   std::string overlay, clusters_dir;
   int repeat{1};
   bool many{false};
+  facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
 };
 
 /** Camera for drawing: given, or estimated from an organized cloud (every 17th pixel). */
@@ -164,7 +165,7 @@ writeObject(std::ostream& out, std::size_t id, const facyl::RecognizedObject& o)
     out << "null";
   else
     out << "[" << b[0] << "," << b[1] << "," << b[2] << "," << b[3] << "]";
-  out << ",\"p_cylinder\":" << optional(e.p_cylinder)
+  out << ",\"p_cylinder\":" << optional(e.p_cylinder) << ",\"p_network\":" << optional(e.p_network)
       << ",\"inlier_ratio\":" << facyl_cli::number(e.inlier_ratio)
       << ",\"surface_ratio\":" << facyl_cli::number(e.surface_ratio)
       << ",\"curvature_ratio\":" << optional(e.curvature_ratio)
@@ -316,6 +317,7 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   rec.setParameters(s.params);
   rec.setCamera(s.camera);
   rec.setUpDirection(s.up);
+  rec.setClassifier(s.classifier);
   rec.setInputCloud(cloud);
   std::vector<facyl::RecognizedObject> objects;
   std::vector<facyl::RecognitionTiming> timings;
@@ -359,6 +361,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   if (files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
   facyl_cli::applyRecognizerOptions(args, s.params, s.up);
+  s.classifier = facyl_cli::classifierFromOptions(args);
   if (args.has("--camera")) {
     std::istringstream in(args.text("--camera", ""));
     char c1 = 0, c2 = 0, c3 = 0;

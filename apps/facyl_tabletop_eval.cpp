@@ -187,15 +187,24 @@ segmentationHeader(const std::string& title)
 }
 
 void
-timingReport(const std::vector<facyl::RecognitionTiming>& t)
+timingReport(const std::vector<facyl::RecognitionTiming>& t, const std::vector<double>& objects)
 {
   std::vector<double> s, c, f, total;
   for (const auto& x : t)
     s.push_back(x.segmentation), c.push_back(x.classification), f.push_back(x.fitting),
       total.push_back(x.total);
+  const auto mean = [](const std::vector<double>& v) {
+    double m = 0.0;
+    for (const double x : v)
+      m += x / static_cast<double>(std::max<std::size_t>(1, v.size()));
+    return m;
+  };
   std::printf("\nTiming per frame (ms, median over %zu frames): segmentation %.2f, "
               "classification %.2f, fitting %.2f, total %.2f (p90 %.2f)\n",
               t.size(), median(s), median(c), median(f), median(total), percentile(total, 0.9));
+  std::printf("Mean per frame: %.2f objects; segmentation %.2f, classification %.2f, fitting "
+              "%.2f, total %.2f ms\n",
+              mean(objects), mean(s), mean(c), mean(f), mean(total));
 }
 
 struct Options {
@@ -207,6 +216,7 @@ struct Options {
   facyl::TabletopSceneParameters scene; ///< layout, sensor and image options; seed per scene
   std::string mosd, csv;
   facyl::TabletopRecognizerParameters params;
+  facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
 };
 
 class CsvWriter {
@@ -218,7 +228,7 @@ public:
     out_.open(path);
     out_ << "set,scene,object,kind,pose,positive,touching,found,pieces,recovered,iou,merged,"
             "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,arc_gap,taper,"
-            "radius,true_radius,axis_error_deg\n";
+            "radius,true_radius,axis_error_deg,p_network,p_cylinder\n";
   }
   void
   write(const std::string& set, const std::vector<Row>& rows)
@@ -232,7 +242,8 @@ public:
            << r.segment.recovered << "," << r.segment.best_iou << "," << r.segment.merged << ","
            << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << ","
            << e.surface_ratio << "," << e.curvature_ratio << "," << e.angular_coverage << ","
-           << e.arc_gap << "," << e.taper << "," << r.radius << "," << r.true_radius << "," << r.axis_error_deg << "\n";
+           << e.arc_gap << "," << e.taper << "," << r.radius << "," << r.true_radius << ","
+           << r.axis_error_deg << "," << e.p_network << "," << e.p_cylinder << "\n";
     }
   }
 
@@ -328,6 +339,7 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<Row> all;
   std::vector<Stray> stray;
   std::vector<facyl::RecognitionTiming> timing;
+  std::vector<double> object_counts;
   std::size_t failures = 0, wrong_plane = 0;
   for (std::size_t k = 0; k < opt.sim; ++k) {
     facyl::TabletopSceneParameters sp = opt.scene;
@@ -344,8 +356,10 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
         all.push_back(r);
       continue;
     }
-    if (k > 0) // the first frame pays for the buffers
+    if (k > 0) { // the first frame pays for the buffers
       timing.push_back(rec.getTiming());
+      object_counts.push_back(static_cast<double>(objects.size()));
+    }
     const auto& c = rec.getTableCoefficients().values;
     if (Eigen::Vector3f(c[0], c[1], c[2]).dot(scene.table_plane.head<3>()) < std::cos(0.1f) ||
         std::abs(c[3] - scene.table_plane[3]) > 0.03f) {
@@ -373,7 +387,7 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   }
   csv.write(opt.cluttered ? "sim-cluttered-" + opt.sensor : "sim-" + opt.sensor, all);
   reportSimulated(all, stray, opt, failures, wrong_plane);
-  timingReport(timing);
+  timingReport(timing, object_counts);
   return 0;
 }
 
@@ -430,6 +444,7 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
                          "occluded objects (learn25-32)", "cylindric objects (learn33-44)"};
   std::vector<std::vector<Row>> by_group(4);
   std::vector<facyl::RecognitionTiming> timing;
+  std::vector<double> object_counts;
   int status = 0;
   for (int g = 0; g < 4; ++g)
     for (int k = groups[g].first; k <= groups[g].second; ++k) {
@@ -457,8 +472,10 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
       rec.setInputCloud(cloud);
       std::vector<facyl::RecognizedObject> objects;
       // Run twice: the second run gives the steady-state timing of a stream.
-      if (rec.recognize(objects) && rec.recognize(objects))
+      if (rec.recognize(objects) && rec.recognize(objects)) {
         timing.push_back(rec.getTiming());
+        object_counts.push_back(static_cast<double>(objects.size()));
+      }
       else
         std::fprintf(stderr, "facyl_tabletop_eval: %s: no table\n", name.c_str());
       scoreRows(objects, truth, rows);
@@ -475,7 +492,7 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
   }
   segmentationLine(all, "all", [](const Row&) { return true; });
   csv.write("mosd-segmentation", all);
-  timingReport(timing);
+  timingReport(timing, object_counts);
   return status;
 }
 
@@ -613,6 +630,7 @@ parseOptions(int argc, char** argv)
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");
   facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
+  opt.classifier = facyl_cli::classifierFromOptions(args);
   if (opt.sim == 0 && opt.mosd.empty())
     throw std::invalid_argument("give --sim N and/or --mosd DIR");
   return opt;
@@ -639,6 +657,7 @@ main(int argc, char** argv)
   Recognizer rec;
   rec.setParameters(opt.params);
   rec.setUpDirection(opt.up);
+  rec.setClassifier(opt.classifier);
   int status = 0;
   if (opt.sim > 0)
     status = std::max(status, evaluateSimulated(opt, rec, csv));

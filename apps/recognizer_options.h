@@ -6,6 +6,7 @@
 
 #include "cli.h"
 
+#include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
 #include <set>
@@ -21,7 +22,8 @@ recognizerValueOptions()
   return {"--min-score", "--score", "--max-curvature-ratio", "--min-coverage", "--max-taper",
           "--prior", "--radius-limits", "--orientations", "--max-fit-points", "--neighbours",
           "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
-          "--cluster-size", "--up", "--clustering", "--support", "--max-cylinders-per-cluster"};
+          "--cluster-size", "--up", "--clustering", "--support", "--max-cylinders-per-cluster",
+          "--model", "--reject-below", "--min-probability"};
 }
 
 /** Switches that applyRecognizerOptions reads. */
@@ -35,7 +37,14 @@ recognizerSwitches()
 inline const char*
 recognizerOptionsHelp()
 {
-  return "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
+  return "Shape classifier (paper III-B; a CNN on each object's view, run by OpenCV DNN):\n"
+         "  --model M              default (the model shipped with facyl) | none | PATH.onnx\n"
+         "                         (with PATH.cfg beside it, see CylinderClassifier)\n"
+         "  --reject-below P       clusters whose network probability is below P are not\n"
+         "                         fitted (default 0.1; 0 fits all)\n"
+         "  --min-probability P    with a model: a cylinder also needs p_cylinder >= P, the\n"
+         "                         network fused with the fit's evidence (default 0.3)\n"
+         "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
          "angular coverage >= V and taper <= T):\n"
          "  --score S              surface (default: lateral inliers + points on the end caps\n"
          "                         and inner wall, over all points) | inlier (paper eq. 4)\n"
@@ -134,6 +143,9 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
     throw std::invalid_argument("--support must be standing or largest");
   g.support = support == "largest" ? facyl::TabletopSegmentationParameters::Support::LargestPlane
                                    : facyl::TabletopSegmentationParameters::Support::ObjectsStanding;
+  p.reject_below = static_cast<float>(args.number("--reject-below", p.reject_below, 0.0, 1.0));
+  d.min_probability =
+    static_cast<float>(args.number("--min-probability", d.min_probability, 0.0, 1.0));
   up = Eigen::Vector3f::Zero();
   if (args.has("--up")) {
     up = args.vector3("--up", up);
@@ -143,6 +155,32 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   const std::string why = facyl::validate(p);
   if (!why.empty())
     throw std::invalid_argument(why);
+}
+
+/** The classifier that --model names: nullptr for "none"; the shipped model for "default"
+ * (\a fallback when --model is not given).
+ * \throws std::invalid_argument naming the model when it cannot be loaded. */
+inline facyl::ShapeClassifier::Ptr
+classifierFromOptions(const Arguments& args, const std::string& fallback = "default")
+{
+  const std::string model = args.text("--model", fallback);
+  if (model == "none")
+    return nullptr;
+  std::string path = model;
+  if (model == "default") {
+    path = facyl::CylinderClassifier::defaultModelPath();
+    if (path.empty())
+      throw std::invalid_argument("--model default: the shipped model (cylinder_net.onnx) is not "
+                                  "installed; give --model PATH or --model none");
+  }
+  auto classifier = std::make_shared<facyl::CylinderClassifier>();
+  try {
+    classifier->load(path);
+  }
+  catch (const std::runtime_error& e) {
+    throw std::invalid_argument(std::string("--model: ") + e.what());
+  }
+  return classifier;
 }
 
 } // namespace facyl_cli

@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages facyl needs; skips apt-get when all are present already.
 set -euo pipefail
 packages=(g++ make cmake git pkg-config libpcl-dev libeigen3-dev libnanoflann-dev
-          libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib)
+          libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib
+          libopencv-dnn-dev python3-numpy python3-torch python3-onnx python3-opencv)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -460,7 +460,7 @@ TEST(TabletopCylinderRecognizer, ClassifierRejectsBeforeFitting)
   Cloud::Ptr cloud(new Cloud(s.cloud));
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
   rec.setInputCloud(cloud);
-  auto no = std::make_shared<FixedClassifier>(0.1f);
+  auto no = std::make_shared<FixedClassifier>(0.05f); // below reject_below (0.1)
   rec.setClassifier(no);
   std::vector<facyl::RecognizedObject> objects;
   ASSERT_TRUE(rec.recognize(objects));
@@ -468,7 +468,7 @@ TEST(TabletopCylinderRecognizer, ClassifierRejectsBeforeFitting)
   EXPECT_EQ(no->calls, static_cast<int>(objects.size()));
   EXPECT_TRUE(no->crop_ok);
   for (const auto& o : objects) {
-    EXPECT_FLOAT_EQ(o.evidence.p_cylinder, 0.1f);
+    EXPECT_FLOAT_EQ(o.evidence.p_cylinder, 0.05f);
     EXPECT_FALSE(o.evidence.fitted);
     EXPECT_FALSE(o.is_cylinder);
   }

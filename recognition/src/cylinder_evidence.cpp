@@ -30,12 +30,44 @@ validate(const CylinderDecision& d)
 }
 
 bool
-acceptCylinder(const CylinderEvidence& e, const CylinderDecision& d)
+acceptGeometry(const CylinderEvidence& e, const CylinderDecision& d)
 {
-  return e.fitted && !(e.p_cylinder < d.min_probability) && e.score(d) >= d.min_score &&
-         !(e.curvature_ratio > d.max_curvature_ratio) &&
+  return e.fitted && e.score(d) >= d.min_score && !(e.curvature_ratio > d.max_curvature_ratio) &&
          e.angular_coverage >= d.min_angular_coverage && !(e.arc_gap > d.max_arc_gap) &&
          !(e.taper > d.max_taper);
+}
+
+bool
+acceptCylinder(const CylinderEvidence& e, const CylinderDecision& d)
+{
+  return !(e.p_cylinder < d.min_probability) && acceptGeometry(e, d);
+}
+
+std::array<float, kFusionFeatures>
+fusionFeatures(float p_network, const CylinderEvidence& e, const CylinderDecision& d)
+{
+  const float p = std::isfinite(p_network) ? std::clamp(p_network, 1e-4f, 1.f - 1e-4f) : 0.5f;
+  const auto known = [](float v, float fallback) { return std::isfinite(v) ? v : fallback; };
+  return {1.f,
+          std::log(p / (1.f - p)),
+          known(e.surface_ratio, 0.f),
+          known(e.inlier_ratio, 0.f),
+          known(e.curvature_ratio, 1.f),
+          known(e.angular_coverage, 0.f),
+          std::clamp(known(e.taper, 0.f), 0.f, 1.f),
+          known(e.arc_gap, 0.f),
+          acceptGeometry(e, d) ? 1.f : 0.f};
+}
+
+float
+fusedProbability(const std::array<float, kFusionFeatures>& w, float p_network,
+                 const CylinderEvidence& e, const CylinderDecision& d)
+{
+  const auto f = fusionFeatures(p_network, e, d);
+  double z = 0.0;
+  for (std::size_t i = 0; i < kFusionFeatures; ++i)
+    z += static_cast<double>(w[i]) * f[i];
+  return static_cast<float>(1.0 / (1.0 + std::exp(-z)));
 }
 
 float

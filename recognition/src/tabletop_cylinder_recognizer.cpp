@@ -33,6 +33,8 @@ validate(const TabletopRecognizerParameters& p)
     s << "max_cylinders_per_cluster " << p.max_cylinders_per_cluster << " must be in [1, 20]";
   else if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))
     s << "min_explained_share " << p.min_explained_share << " must be in (0, 1]";
+  else if (!(p.reject_below >= 0.f && p.reject_below <= 1.f))
+    s << "reject_below " << p.reject_below << " must be in [0, 1]";
   else if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))
     s << "recovery_margin " << p.recovery_margin << " must be in [0, 1] m";
   return s.str();

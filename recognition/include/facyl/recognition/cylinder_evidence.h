@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -26,7 +27,10 @@ struct CylinderDecision {
    * the points on the fitted cylinder's end caps and inner wall as explained. */
   enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
   float min_score{0.5f};            ///< score at least this, in [0, 1]
-  float min_probability{0.5f};      ///< classifier probability at least this, in [0, 1]
+  /** With a classifier: p_cylinder at least this, in [0, 1]. 0.3: on held-out simulated
+   * objects the F1 of the decision is flat from 0.3 to 0.6 (docs/classifier.md); the lowest
+   * keeps the most recall when real views look less like the simulator's. */
+  float min_probability{0.3f};
   /** The inliers' curvature ratio at most this, in (0, 1]; 1 turns the check off. Rejects
    * most spheres and bowls. */
   float max_curvature_ratio{0.35f};
@@ -50,8 +54,12 @@ validate(const CylinderDecision& decision);
 /** \brief What the decision looks at for one object. */
 struct CylinderEvidence {
   bool fitted{false};      ///< a cylinder was fitted
-  /** Classifier probability of "cylinder"; NaN without a classifier (or when it cannot tell). */
+  /** The probability that the object is a cylinder: with a classifier, its network's output
+   * for the object's view fused with this evidence (ShapeClassifier::fuse; the network's alone
+   * when the object was not fitted); NaN without a classifier. */
   float p_cylinder{std::numeric_limits<float>::quiet_NaN()};
+  /** The classifier network's output for the object's view; NaN without a classifier. */
+  float p_network{std::numeric_limits<float>::quiet_NaN()};
   float inlier_ratio{0.f}; ///< paper eq. 4 on the points fitted
   /** (lateral inliers + points on the end caps + points on the inner wall of an open
    * container) / points fitted */
@@ -81,6 +89,27 @@ struct CylinderEvidence {
  * min_angular_coverage, arc gap <= max_arc_gap and taper <= max_taper (both when known). */
 bool
 acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
+
+/** \brief The decision without its probability test: what acceptCylinder says when
+ * p_cylinder is unknown. */
+bool
+acceptGeometry(const CylinderEvidence& evidence, const CylinderDecision& decision);
+
+/** \brief Number of features of the fusion model (see fusionFeatures). */
+constexpr std::size_t kFusionFeatures = 9;
+
+/** \brief What the fusion model (a logistic regression fitted on simulated objects by
+ * recognition/training) sees of a fitted object: 1, logit(p_network) (p clamped to [1e-4,
+ * 1 - 1e-4]), surface ratio, inlier ratio, curvature ratio (1 when unknown), angular coverage,
+ * taper clamped to [0, 1] (0 when unknown), arc gap (0 when unknown), and 1 when
+ * acceptGeometry(evidence, decision) holds, else 0. */
+std::array<float, kFusionFeatures>
+fusionFeatures(float p_network, const CylinderEvidence& evidence, const CylinderDecision& decision);
+
+/** \brief 1 / (1 + exp(-w . fusionFeatures(...))). */
+float
+fusedProbability(const std::array<float, kFusionFeatures>& weights, float p_network,
+                 const CylinderEvidence& evidence, const CylinderDecision& decision);
 
 /** \brief Median |k_min| / median |k_max| of \a cues over \a inliers (indices into cues):
  * 0 on an ideal cylinder, 1 on a sphere. NaN when no inlier has finite curvatures; 1 when the

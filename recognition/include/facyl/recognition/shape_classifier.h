@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 
 #include <Eigen/Core>
@@ -27,11 +28,14 @@ struct RgbImage {
 };
 
 /** \brief What a shape classifier sees of one cluster: its RGB crop (the pixels of the box;
- * for unorganized clouds, the points drawn at their projections) and its points. */
+ * for unorganized clouds, the points drawn at their projections), its points and the pixel
+ * each point was seen at (see objectView). */
 struct ObjectView {
-  RgbImage crop;            ///< empty when the cloud has no colour and no image position
-  PixelBox box{-1, -1, -1, -1};
+  RgbImage crop;            ///< the pixels of box; empty when the cloud has no colour
+  PixelBox box{-1, -1, -1, -1}; ///< in the full image; all -1 when unknown
   Eigen::Matrix3Xf points;  ///< camera frame
+  /** Pixel (u, v) of each point in the full image; empty or -1 where unknown. */
+  Eigen::Matrix2Xi pixels;
 };
 
 /** \brief Interface of the optional stage that rejects non-cylinders before fitting (paper
@@ -45,6 +49,28 @@ public:
    * object is then fitted as if there were no classifier). */
   virtual float
   cylinderProbability(const ObjectView& view) = 0;
+  /** \brief cylinderProbability of every view, in order; implementations may run them as one
+   * batch (the default calls cylinderProbability for each). */
+  virtual std::vector<float>
+  cylinderProbabilities(const std::vector<ObjectView>& views)
+  {
+    std::vector<float> p;
+    p.reserve(views.size());
+    for (const auto& v : views)
+      p.push_back(cylinderProbability(v));
+    return p;
+  }
+  /** \brief The final probability that a fitted object is a cylinder, from the classifier's
+   * \a p_network for its view and the fit's \a evidence under \a decision (see
+   * fusionFeatures). The default returns \a p_network; a classifier with a calibrated fusion
+   * model overrides it. */
+  virtual float
+  fuse(float p_network, const CylinderEvidence& evidence, const CylinderDecision& decision) const
+  {
+    (void)evidence;
+    (void)decision;
+    return p_network;
+  }
   /** \brief A short name for reports. */
   virtual std::string
   name() const = 0;

@@ -5,6 +5,7 @@
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_evidence.h>
+#include <facyl/recognition/classifier_input.h>
 #include <facyl/recognition/shape_classifier.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
@@ -67,6 +68,9 @@ struct TabletopRecognizerParameters {
    * angular scale near and far; 0: every pixel. In [0, 0.1]. */
   float fit_point_angle{0.006f};
   std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
+  /** With a classifier: clusters whose network probability is below this are not fitted
+   * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
+  float reject_below{0.1f};
   int neighbours{16};             ///< k of the normal/curvature estimation, in [5, 200]
   std::uint64_t seed{0};
 };
@@ -205,8 +209,13 @@ private:
   /** Builds the cue estimation and the estimators (one per prior of the retries). */
   void
   configure();
-  ObjectView
-  makeView(const TabletopCluster& cluster) const;
+  /** The classifier's network probability of each cluster (one batch); NaN without one. */
+  std::vector<float>
+  classifyClusters(const std::vector<TabletopCluster>& clusters);
+  /** The objects [first, end) made of one cluster of network probability \a p_cluster: their
+   * p_network (split parts: of their own view), p_cylinder (fused) and the decision. */
+  void
+  applyClassifier(std::vector<RecognizedObject>& objects, std::size_t first, float p_cluster);
   /** Subsamples \a cluster and estimates normals and curvatures. */
   FitInput
   prepareFit(const TabletopCluster& cluster);
@@ -218,7 +227,8 @@ private:
   fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
   /** Classifies, fits and decides one cluster: one object, or several (recovery). */
   void
-  recognizeCluster(TabletopCluster cluster, std::vector<RecognizedObject>& objects);
+  recognizeCluster(TabletopCluster cluster, float p_network,
+                   std::vector<RecognizedObject>& objects);
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
   std::vector<Fit>

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/recognition/impl/classifier_input.hpp>
 
 #include <pcl/common/transforms.h>
 
@@ -139,24 +140,79 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
   }
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
   cues_estimation_.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
+  const std::vector<float> p_network = classifyClusters(clusters);
   int frame_of = -1;
-  for (auto& cluster : clusters) {
+  for (std::size_t k = 0; k < clusters.size(); ++k) {
     // The prior is set in the frame of the support the object stands on.
-    if (cluster.support != frame_of) {
-      frame_of = cluster.support;
+    if (clusters[k].support != frame_of) {
+      frame_of = clusters[k].support;
       const auto& support = segmentation_.getSupports()[static_cast<std::size_t>(frame_of)];
       for (auto& hough : estimators_)
         hough.setReferenceFrame(support.frame.linear());
     }
-    recognizeCluster(std::move(cluster), objects);
+    const std::size_t first = objects.size();
+    recognizeCluster(std::move(clusters[k]), p_network[k], objects);
+    if (classifier_)
+      applyClassifier(objects, first, p_network[k]);
   }
   timing_.total = ms(t0, Clock::now());
   return true;
 }
 
 template <typename PointT>
+std::vector<float>
+TabletopCylinderRecognizer<PointT>::classifyClusters(const std::vector<TabletopCluster>& clusters)
+{
+  std::vector<float> p(clusters.size(), std::numeric_limits<float>::quiet_NaN());
+  if (!classifier_ || clusters.empty())
+    return p;
+  const auto t = std::chrono::steady_clock::now();
+  std::vector<ObjectView> views;
+  views.reserve(clusters.size());
+  for (const auto& c : clusters)
+    views.push_back(objectView(*input_, c.indices.indices, camera_));
+  p = classifier_->cylinderProbabilities(views);
+  timing_.classification +=
+    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  return p;
+}
+
+template <typename PointT>
 void
-TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster,
+TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject>& objects,
+                                                    std::size_t first, float p_cluster)
+{
+  const auto t = std::chrono::steady_clock::now();
+  // A cluster split into several objects: each fitted part is classified on its own view.
+  const bool split = objects.size() - first > 1;
+  std::vector<ObjectView> views;
+  std::vector<std::size_t> which;
+  for (std::size_t k = first; k < objects.size(); ++k) {
+    auto& e = objects[k].evidence;
+    e.p_network = p_cluster;
+    if (split && e.fitted) {
+      views.push_back(objectView(*input_, objects[k].cluster.indices.indices, camera_));
+      which.push_back(k);
+    }
+  }
+  if (!views.empty()) {
+    const std::vector<float> p = classifier_->cylinderProbabilities(views);
+    for (std::size_t j = 0; j < which.size(); ++j)
+      objects[which[j]].evidence.p_network = p[j];
+  }
+  for (std::size_t k = first; k < objects.size(); ++k) {
+    auto& o = objects[k];
+    auto& e = o.evidence;
+    e.p_cylinder = e.fitted ? classifier_->fuse(e.p_network, e, params_.decision) : e.p_network;
+    o.is_cylinder = o.is_cylinder && !(e.p_cylinder < params_.decision.min_probability);
+  }
+  timing_.classification +=
+    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, float p_network,
                                                      std::vector<RecognizedObject>& objects)
 {
   using Clock = std::chrono::steady_clock;
@@ -166,21 +222,13 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster,
   RecognizedObject object;
   object.cluster = std::move(cluster);
   auto t = Clock::now();
-  if (classifier_) {
-    object.evidence.p_cylinder = classifier_->cylinderProbability(makeView(object.cluster));
-    const auto t1 = Clock::now();
-    timing_.classification += ms(t, t1);
-    t = t1;
-    if (object.evidence.p_cylinder < params_.decision.min_probability) {
-      objects.push_back(std::move(object)); // rejected before fitting
-      return;
-    }
+  if (classifier_ && p_network < params_.reject_below) {
+    objects.push_back(std::move(object)); // rejected before fitting (paper III-B)
+    return;
   }
   const FitInput input = prepareFit(object.cluster);
   Fit best = fitWithRetries(input, {});
-  const float p_cylinder = object.evidence.p_cylinder;
   if (best.evidence.fitted) {
-    best.evidence.p_cylinder = p_cylinder;
     object.evidence = best.evidence;
     object.cylinder = best.model;
     for (auto& i : object.cylinder.inliers)
@@ -194,8 +242,6 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster,
       (!object.is_cylinder || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {
-      for (auto& part : parts)
-        part.evidence.p_cylinder = p_cylinder;
       splitCluster(object, input, parts, objects);
       timing_.fitting += ms(t, Clock::now());
       return;
@@ -385,11 +431,8 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     o.is_cylinder = true;
     objects.push_back(std::move(o));
   }
-  if (rest_is_object) {
-    RecognizedObject o = make(-1);
-    o.evidence.p_cylinder = whole.evidence.p_cylinder;
-    objects.push_back(std::move(o));
-  }
+  if (rest_is_object)
+    objects.push_back(make(-1));
 }
 
 template <typename PointT>
@@ -509,54 +552,6 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input,
       best = std::move(f);
   }
   return best;
-}
-
-template <typename PointT>
-ObjectView
-TabletopCylinderRecognizer<PointT>::makeView(const TabletopCluster& cluster) const
-{
-  ObjectView view;
-  view.box = cluster.box;
-  const auto& idx = cluster.indices.indices;
-  view.points.resize(3, static_cast<Eigen::Index>(idx.size()));
-  for (std::size_t k = 0; k < idx.size(); ++k)
-    view.points.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
-  if constexpr (pcl::traits::has_color_v<PointT>) {
-    const PixelBox& b = cluster.box;
-    if (b[0] < 0)
-      return view;
-    RgbImage& crop = view.crop;
-    crop.width = b[2] - b[0] + 1;
-    crop.height = b[3] - b[1] + 1;
-    crop.data.assign(static_cast<std::size_t>(crop.width) * crop.height * 3, 0);
-    if (input_->isOrganized()) {
-      for (int v = b[1]; v <= b[3]; ++v)
-        for (int u = b[0]; u <= b[2]; ++u) {
-          const auto& p = input_->at(u, v);
-          std::uint8_t* px =
-            &crop.data[3 * (static_cast<std::size_t>(v - b[1]) * crop.width + (u - b[0]))];
-          px[0] = p.r;
-          px[1] = p.g;
-          px[2] = p.b;
-        }
-    } else {
-      for (const auto i : idx) {
-        const auto& p = (*input_)[i];
-        if (!(p.z > 0.f))
-          continue;
-        const Eigen::Vector2f px = camera_.project(p.getVector3fMap());
-        const int u = static_cast<int>(std::lround(px.x())) - b[0];
-        const int v = static_cast<int>(std::lround(px.y())) - b[1];
-        if (u < 0 || v < 0 || u >= crop.width || v >= crop.height)
-          continue;
-        std::uint8_t* q = &crop.data[3 * (static_cast<std::size_t>(v) * crop.width + u)];
-        q[0] = p.r;
-        q[1] = p.g;
-        q[2] = p.b;
-      }
-    }
-  }
-  return view;
 }
 
 } // namespace facyl

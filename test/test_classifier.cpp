@@ -1,0 +1,327 @@
+/*
+ * facyl: the shape classifier (paper III-B): its input images, the model description, the
+ * shipped model on simulated crops it never saw, clear errors for bad models, the fusion and
+ * the recognizer with the classifier.
+ */
+#include <facyl/recognition/classifier_input.h>
+#include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/simulation/tabletop_scene.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+
+/** An organized 40 x 30 cloud whose pixels [10, 30) x [5, 25) see a cylinder of radius 5 cm
+ * 1 m away (axis along y), the rest nothing. */
+Cloud::Ptr
+cylinderPatch(std::vector<int>& indices)
+{
+  Cloud::Ptr cloud(new Cloud(40, 30));
+  for (int v = 0; v < 30; ++v)
+    for (int u = 0; u < 40; ++u) {
+      auto& p = cloud->at(u, v);
+      p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+      p.r = p.g = p.b = 10;
+      if (u >= 10 && u < 30 && v >= 5 && v < 25) {
+        const float x = 0.005f * static_cast<float>(u - 20);
+        p.x = x;
+        p.y = 0.005f * static_cast<float>(v - 15);
+        p.z = 1.f - std::sqrt(std::max(0.f, 0.05f * 0.05f - x * x));
+        p.r = 200;
+        indices.push_back(v * 40 + u);
+      }
+    }
+  cloud->is_dense = false;
+  return cloud;
+}
+
+std::string
+writeFile(const std::string& name, const std::string& text)
+{
+  const auto path = std::filesystem::temp_directory_path() / ("facyl_test_classifier_" + name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+std::string
+readFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+} // namespace
+
+// ------------------------------------------------------------------------- input images
+
+TEST(ClassifierInput, ViewOfAnOrganizedCluster)
+{
+  std::vector<int> idx;
+  const Cloud::Ptr cloud = cylinderPatch(idx);
+  const facyl::ObjectView view = facyl::objectView(*cloud, idx, facyl::PinholeCamera{});
+  EXPECT_EQ(view.box, (facyl::PixelBox{10, 5, 29, 24}));
+  ASSERT_EQ(view.pixels.cols(), static_cast<Eigen::Index>(idx.size()));
+  EXPECT_EQ(view.pixels(0, 0), 10);
+  EXPECT_EQ(view.pixels(1, 0), 5);
+  EXPECT_EQ(view.crop.width, 20);
+  EXPECT_EQ(view.crop.height, 20);
+  EXPECT_EQ(view.crop.data[0], 200);
+}
+
+TEST(ClassifierInput, DepthImageHasTheMaskAndTheRelativeDepth)
+{
+  std::vector<int> idx;
+  const Cloud::Ptr cloud = cylinderPatch(idx);
+  const facyl::ObjectView view = facyl::objectView(*cloud, idx, facyl::PinholeCamera{});
+  const auto image = facyl::classifierImage(view, {facyl::ClassifierChannels::Depth, 16});
+  ASSERT_EQ(image.size(), 2u * 16 * 16);
+  // The box is square: every pixel is the object's.
+  for (int i = 0; i < 256; ++i)
+    ASSERT_EQ(image[static_cast<std::size_t>(i)], 255) << i;
+  // Nearer in the middle column (the cylinder's front), farther at the sides.
+  const auto depth = [&](int x, int y) { return image[256 + static_cast<std::size_t>(y * 16 + x)]; };
+  EXPECT_LT(depth(8, 8), depth(0, 8));
+  EXPECT_LT(depth(8, 8), depth(15, 8));
+  EXPECT_EQ(depth(3, 2), depth(3, 13)); // constant along the axis
+  // A view without pixels or a box gives nothing.
+  facyl::ObjectView empty;
+  EXPECT_TRUE(facyl::classifierImage(empty, {facyl::ClassifierChannels::Depth, 16}).empty());
+  EXPECT_TRUE(facyl::classifierImage(empty, {facyl::ClassifierChannels::Rgb, 16}).empty());
+  EXPECT_TRUE(facyl::classifierImage(view, {facyl::ClassifierChannels::Depth, 4}).empty());
+}
+
+TEST(ClassifierInput, RgbImageIsTheCropPaddedToASquare)
+{
+  std::vector<int> idx;
+  Cloud::Ptr cloud = cylinderPatch(idx);
+  // Only the upper half: a 20 x 10 box, padded to 20 x 20 about its centre.
+  std::vector<int> half(idx.begin(), idx.begin() + 200);
+  const facyl::ObjectView view = facyl::objectView(*cloud, half, facyl::PinholeCamera{});
+  EXPECT_EQ(view.box, (facyl::PixelBox{10, 5, 29, 14}));
+  const auto image = facyl::classifierImage(view, {facyl::ClassifierChannels::Rgb, 20});
+  ASSERT_EQ(image.size(), 3u * 20 * 20);
+  EXPECT_EQ(image[0], 0);              // row 0: padding
+  EXPECT_EQ(image[10 * 20 + 5], 200);  // row 10: the crop (red)
+  EXPECT_EQ(image[400 + 10 * 20 + 5], 10); // green plane
+}
+
+// ------------------------------------------------------------------ model description
+
+TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
+{
+  facyl::ClassifierModelInfo info;
+  EXPECT_EQ(facyl::parseClassifierModelInfo("channels rgb\nsize 227 # the paper's\nmean 0\n"
+                                            "scale 1\noutput sigmoid\n",
+                                            info),
+            "");
+  EXPECT_EQ(info.input.channels, facyl::ClassifierChannels::Rgb);
+  EXPECT_EQ(info.input.size, 227);
+  EXPECT_FALSE(info.softmax);
+  EXPECT_FALSE(info.has_fusion);
+  EXPECT_EQ(facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info), "");
+  EXPECT_TRUE(info.has_fusion);
+  EXPECT_EQ(info.fusion[8], 9.f);
+  EXPECT_NE(facyl::parseClassifierModelInfo("size 64\n", info), "");
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels hsv\nsize 64\n", info).find("line 1"), std::string::npos);
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 4\n", info), "");
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2\n", info), "");
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nwidth 3\n", info).find("unknown key"),
+            std::string::npos);
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb 3\nsize 64\n", info), "");
+}
+
+TEST(CylinderEvidence, FusionFeaturesAndProbability)
+{
+  facyl::CylinderEvidence e;
+  e.fitted = true;
+  e.surface_ratio = 0.9f;
+  e.inlier_ratio = 0.7f;
+  e.angular_coverage = 0.4f;
+  const facyl::CylinderDecision d;
+  const auto f = facyl::fusionFeatures(0.5f, e, d);
+  EXPECT_EQ(f[0], 1.f);
+  EXPECT_NEAR(f[1], 0.f, 1e-6f);
+  EXPECT_EQ(f[2], 0.9f);
+  EXPECT_EQ(f[4], 1.f); // unknown curvature ratio
+  EXPECT_EQ(f[8], 1.f); // the geometric rule holds
+  std::array<float, facyl::kFusionFeatures> w{};
+  w[1] = 1.f;
+  EXPECT_NEAR(facyl::fusedProbability(w, 0.8f, e, d), 0.8f, 1e-5f);
+  w = {};
+  w[8] = -2.f;
+  EXPECT_NEAR(facyl::fusedProbability(w, 0.8f, e, d), 1.f / (1.f + std::exp(2.f)), 1e-6f);
+  EXPECT_TRUE(std::isfinite(facyl::fusionFeatures(0.f, e, d)[1]));
+  EXPECT_TRUE(std::isfinite(facyl::fusionFeatures(1.f, e, d)[1]));
+}
+
+// ------------------------------------------------------------------------ the model
+
+TEST(CylinderClassifier, ShippedModelLoads)
+{
+  const std::string path = facyl::CylinderClassifier::defaultModelPath();
+  ASSERT_FALSE(path.empty());
+  facyl::CylinderClassifier c;
+  ASSERT_NO_THROW(c.load(path));
+  EXPECT_TRUE(c.loaded());
+  EXPECT_TRUE(c.getModelInfo().has_fusion);
+}
+
+TEST(CylinderClassifier, ShippedModelSeparatesSimulatedObjectsItNeverSaw)
+{
+  // Scenes 1000..1007 (training used 50000..): the recognizer's objects, labelled by the
+  // ground truth; cylinders must rank above the rest.
+  facyl::CylinderClassifier c;
+  c.load(facyl::CylinderClassifier::defaultModelPath());
+  std::vector<float> pos, neg;
+  for (std::uint64_t seed = 1000; seed < 1008; ++seed) {
+    facyl::TabletopSceneParameters p =
+      seed % 2 ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
+    p.seed = seed;
+    const facyl::RenderedScene scene = facyl::simulateTabletopScene(p);
+    Cloud::Ptr cloud(new Cloud(scene.cloud));
+    facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    ASSERT_TRUE(rec.recognize(objects));
+    std::vector<facyl::ObjectView> views;
+    std::vector<int> labels;
+    for (const auto& o : objects) {
+      std::map<int, std::size_t> votes;
+      for (const auto i : o.cluster.indices.indices)
+        ++votes[scene.object_id[static_cast<std::size_t>(i)]];
+      const auto best = std::max_element(votes.begin(), votes.end(),
+                                         [](auto a, auto b) { return a.second < b.second; });
+      if (best->first < 2 || best->second * 2 < o.cluster.indices.indices.size())
+        continue;
+      const auto& so = scene.scene.objects[static_cast<std::size_t>(best->first - 2)];
+      views.push_back(facyl::objectView(*cloud, o.cluster.indices.indices, facyl::PinholeCamera{}));
+      labels.push_back(so.cls == facyl::SceneClass::Cylinder);
+    }
+    const std::vector<float> p_net = c.cylinderProbabilities(views);
+    ASSERT_EQ(p_net.size(), views.size());
+    for (std::size_t k = 0; k < p_net.size(); ++k) {
+      ASSERT_TRUE(p_net[k] >= 0.f && p_net[k] <= 1.f);
+      (labels[k] ? pos : neg).push_back(p_net[k]);
+      // One view alone gives what the batch gave.
+      if (k == 0) {
+        EXPECT_NEAR(c.cylinderProbability(views[k]), p_net[k], 1e-5f);
+      }
+    }
+  }
+  ASSERT_GE(pos.size(), 10u);
+  ASSERT_GE(neg.size(), 10u);
+  std::size_t above = 0;
+  for (const float a : pos)
+    for (const float b : neg)
+      above += a > b;
+  const double auc = static_cast<double>(above) / static_cast<double>(pos.size() * neg.size());
+  EXPECT_GT(auc, 0.9) << pos.size() << " cylinders, " << neg.size() << " others";
+}
+
+TEST(CylinderClassifier, BadModelsGiveErrorsThatNameTheFile)
+{
+  const std::string good = facyl::CylinderClassifier::defaultModelPath();
+  ASSERT_FALSE(good.empty());
+  const std::string cfg = readFile(good.substr(0, good.size() - 5) + ".cfg");
+  const std::string onnx = readFile(good);
+  facyl::CylinderClassifier c;
+  const auto message = [&](const std::string& path) {
+    try {
+      c.load(path);
+    }
+    catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // Missing model, missing description.
+  EXPECT_NE(message("/nonexistent/net.onnx").find("/nonexistent/net.cfg: no such file"),
+            std::string::npos);
+  writeFile("lonely.cfg", cfg);
+  EXPECT_NE(message(std::filesystem::temp_directory_path() / "facyl_test_classifier_lonely.onnx")
+              .find("lonely.onnx: no such file"),
+            std::string::npos);
+  // Truncated.
+  writeFile("truncated.cfg", cfg);
+  const std::string truncated = writeFile("truncated.onnx", onnx.substr(0, onnx.size() / 3));
+  EXPECT_NE(message(truncated).find("cannot read it as an ONNX network"), std::string::npos);
+  EXPECT_FALSE(c.loaded());
+  // Not ONNX at all.
+  writeFile("text.cfg", cfg);
+  EXPECT_NE(message(writeFile("text.onnx", "hello")).find("cannot read it"), std::string::npos);
+  // Wrong input shape (channels) and wrong output count.
+  std::string rgb = cfg;
+  rgb.replace(rgb.find("channels depth"), 14, "channels rgb");
+  writeFile("rgb.cfg", rgb);
+  EXPECT_NE(message(writeFile("rgb.onnx", onnx)).find("does not take the described input"),
+            std::string::npos);
+  std::string sigmoid = cfg;
+  sigmoid.replace(sigmoid.find("output softmax"), 14, "output sigmoid");
+  writeFile("sigmoid.cfg", sigmoid);
+  EXPECT_NE(message(writeFile("sigmoid.onnx", onnx)).find("outputs per view"), std::string::npos);
+  // A bad description.
+  writeFile("badcfg.cfg", "channels depth\nsize 64\nfusion 1 2\n");
+  EXPECT_NE(message(writeFile("badcfg.onnx", onnx)).find("badcfg.cfg: line 3 (fusion)"),
+            std::string::npos);
+  // Unloaded: a clear logic error, not a crash.
+  EXPECT_THROW(c.cylinderProbability(facyl::ObjectView{}), std::logic_error);
+}
+
+TEST(CylinderClassifier, ViewsWithoutAnImageGiveNaN)
+{
+  facyl::CylinderClassifier c;
+  c.load(facyl::CylinderClassifier::defaultModelPath());
+  std::vector<int> idx;
+  const Cloud::Ptr cloud = cylinderPatch(idx);
+  const std::vector<float> p = c.cylinderProbabilities(
+    {facyl::ObjectView{}, facyl::objectView(*cloud, idx, facyl::PinholeCamera{})});
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_TRUE(std::isnan(p[0]));
+  EXPECT_TRUE(p[1] >= 0.f && p[1] <= 1.f);
+  EXPECT_TRUE(c.cylinderProbabilities({}).empty());
+}
+
+// ------------------------------------------------------------------- in the recognizer
+
+TEST(CylinderClassifier, RecognizerReportsACalibratedProbabilityPerObject)
+{
+  Cloud::Ptr cloud(new Cloud);
+  ASSERT_EQ(pcl::io::loadPCDFile(FACYL_SOURCE_DIR "/data/default_scene.pcd", *cloud), 0);
+  auto c = std::make_shared<facyl::CylinderClassifier>();
+  c->load(facyl::CylinderClassifier::defaultModelPath());
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> with, without;
+  with.setClassifier(c);
+  with.setInputCloud(cloud);
+  without.setInputCloud(cloud);
+  std::vector<facyl::RecognizedObject> a, b;
+  ASSERT_TRUE(with.recognize(a));
+  ASSERT_TRUE(without.recognize(b));
+  std::size_t cylinders = 0;
+  const float reject = with.getParameters().reject_below;
+  for (const auto& o : a) {
+    const auto& e = o.evidence;
+    ASSERT_TRUE(e.p_cylinder >= 0.f && e.p_cylinder <= 1.f);
+    ASSERT_TRUE(e.p_network >= 0.f && e.p_network <= 1.f);
+    if (o.is_cylinder) {
+      EXPECT_GE(e.p_cylinder, with.getParameters().decision.min_probability);
+      ++cylinders;
+    }
+    if (!e.fitted && e.p_network < reject) {
+      EXPECT_EQ(e.p_cylinder, e.p_network); // rejected before fitting
+    }
+  }
+  EXPECT_GE(cylinders, 3u);
+  EXPECT_GT(with.getTiming().classification, 0.0);
+  for (const auto& o : b)
+    EXPECT_TRUE(std::isnan(o.evidence.p_cylinder));
+}
