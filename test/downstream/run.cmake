@@ -35,3 +35,18 @@ if(DATA_DIR)
     message(STATUS "installed ${tool}: ok")
   endforeach()
 endif()
+# The installed Python module imports with the interpreter's path set to its install folder
+# (not under the sanitizers: an ASan-built module needs the ASan runtime preloaded).
+file(GLOB_RECURSE modules "${STAGE_DIR}/prefix/*/facyl.cpython-*.so")
+if(modules AND NOT CXX_FLAGS MATCHES "sanitize")
+  list(GET modules 0 module)
+  get_filename_component(module_dir "${module}" DIRECTORY)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=LD_LIBRARY_PATH
+                          "PYTHONPATH=${module_dir}" /usr/bin/python3 -c
+                          "import facyl; c = facyl.fit_cylinders(facyl.simulate_cylinder(radius=0.05, random_axis=True, seed=1)['points']); print(facyl.__file__, c[0])"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "radius=0.05")
+    message(FATAL_ERROR "installed Python module failed (${rc}): ${out} ${err}")
+  endif()
+  message(STATUS "installed Python module: ${out}")
+endif()

@@ -1,0 +1,676 @@
+/*
+ * facyl: Python bindings (pybind11). numpy in, numpy out; the GIL is released while facyl
+ * computes. Every input is checked here, before C++ sees it: ValueError / TypeError with the
+ * argument's name, never a crash.
+ */
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
+#include <facyl/simulation/cylinder_simulation.h>
+#include <facyl/simulation/tabletop_scene.h>
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/console/print.h>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Cues = pcl::PointCloud<facyl::NormalCurvature>;
+
+// ------------------------------------------------------------------------------ inputs
+
+/** The float32 or float64 array \a obj as float64 values, checked to have \a cols columns
+ * (ndim 2) or, with \a frame, shape (H, W, cols). */
+py::array_t<double, py::array::c_style | py::array::forcecast>
+floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame = false)
+{
+  if (!py::isinstance<py::array>(obj))
+    throw py::type_error(std::string(name) + ": expected a numpy array, got " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+  const auto a = py::reinterpret_borrow<py::array>(obj);
+  const auto kind = a.dtype().kind();
+  if (kind != 'f')
+    throw py::type_error(std::string(name) + ": expected float32 or float64 values, got dtype " +
+                         std::string(py::str(a.dtype())));
+  const bool ok = frame ? (a.ndim() == 3 && a.shape(2) == cols) : (a.ndim() == 2 && a.shape(1) == cols);
+  if (!ok) {
+    std::string shape = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i)
+      shape += (i ? ", " : "") + std::to_string(a.shape(i));
+    throw py::value_error(std::string(name) + ": expected shape " +
+                          (frame ? "(H, W, " : "(N, ") + std::to_string(cols) + "), got " +
+                          shape + (a.ndim() == 1 ? ",)" : ")"));
+  }
+  if (a.size() == 0)
+    throw py::value_error(std::string(name) + ": the array is empty");
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+/** Rows of \a a (N x 3, float64) as PCL points; NaN rows stay (as missing points). Raises
+ * when no row is finite. */
+Cloud::Ptr
+toCloud(const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name)
+{
+  const auto n = static_cast<std::size_t>(a.size() / 3);
+  Cloud::Ptr cloud(new Cloud);
+  cloud->resize(n);
+  const double* d = a.data();
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& p = (*cloud)[i];
+    p.x = static_cast<float>(d[3 * i]);
+    p.y = static_cast<float>(d[3 * i + 1]);
+    p.z = static_cast<float>(d[3 * i + 2]);
+    finite += std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  }
+  cloud->is_dense = finite == n;
+  if (finite == 0)
+    throw py::value_error(std::string(name) + ": no row is finite (all NaN or inf)");
+  return cloud;
+}
+
+py::array_t<float>
+vector3(const Eigen::Vector3f& v)
+{
+  py::array_t<float> a(3);
+  std::memcpy(a.mutable_data(), v.data(), 3 * sizeof(float));
+  return a;
+}
+
+std::optional<Eigen::Vector3f>
+optionalVector(const std::optional<std::vector<double>>& v, const char* name)
+{
+  if (!v)
+    return std::nullopt;
+  if (v->size() != 3 || !std::isfinite((*v)[0]) || !std::isfinite((*v)[1]) ||
+      !std::isfinite((*v)[2]))
+    throw py::value_error(std::string(name) + ": expected 3 finite numbers");
+  const Eigen::Vector3f u((*v)[0], (*v)[1], (*v)[2]);
+  if (!(u.norm() > 0.f))
+    throw py::value_error(std::string(name) + ": must not be the zero vector");
+  return u;
+}
+
+// ---------------------------------------------------------------------------- results
+
+/** A fitted cylinder as Python sees it. */
+struct PyCylinder {
+  facyl::CylinderModel model;
+};
+
+py::dict
+cylinderDict(const facyl::CylinderModel& m)
+{
+  py::dict d;
+  d["point_on_axis"] = vector3(m.point_on_axis);
+  d["axis"] = vector3(m.axis);
+  d["radius"] = m.radius;
+  d["height"] = m.height;
+  return d;
+}
+
+// ------------------------------------------------------------------- normals, curvatures
+
+Cues::Ptr
+estimateCues(const Cloud::ConstPtr& cloud, int k)
+{
+  Cues::Ptr cues(new Cues);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(k);
+  ne.compute(*cues);
+  return cues;
+}
+
+void
+checkK(int k, std::size_t points)
+{
+  if (k < 3 || k > 1000)
+    throw py::value_error("k: " + std::to_string(k) + " is not in [3, 1000]");
+  if (points < static_cast<std::size_t>(k))
+    throw py::value_error("points: " + std::to_string(points) + " rows are fewer than k = " +
+                          std::to_string(k));
+}
+
+py::tuple
+estimateNormalsCurvatures(const py::object& points, int k)
+{
+  const auto a = floatArray(points, "points", 3);
+  const Cloud::Ptr cloud = toCloud(a, "points");
+  checkK(k, cloud->size());
+  Cues::Ptr cues;
+  {
+    py::gil_scoped_release release;
+    cues = estimateCues(cloud, k);
+  }
+  const auto n = static_cast<py::ssize_t>(cloud->size());
+  py::array_t<float> normals({n, py::ssize_t(3)}), directions({n, py::ssize_t(3)}), k_max(n),
+    k_min(n);
+  auto nm = normals.mutable_unchecked<2>();
+  auto dm = directions.mutable_unchecked<2>();
+  auto kx = k_max.mutable_unchecked<1>();
+  auto kn = k_min.mutable_unchecked<1>();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto& c = (*cues)[static_cast<std::size_t>(i)];
+    const bool ok = cues->size() == cloud->size();
+    nm(i, 0) = ok ? c.normal_x : nan;
+    nm(i, 1) = ok ? c.normal_y : nan;
+    nm(i, 2) = ok ? c.normal_z : nan;
+    dm(i, 0) = ok ? c.principal_curvature_x : nan;
+    dm(i, 1) = ok ? c.principal_curvature_y : nan;
+    dm(i, 2) = ok ? c.principal_curvature_z : nan;
+    kx(i) = ok ? c.pc1 : nan;
+    kn(i) = ok ? c.pc2 : nan;
+  }
+  return py::make_tuple(normals, directions, k_max, k_min);
+}
+
+// ------------------------------------------------------------------------------- fitting
+
+struct FitSettings {
+  facyl::HoughCylinderParameters params;
+  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
+  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
+  int k{16};
+  std::uint64_t seed{0};
+};
+
+FitSettings
+fitSettings(const std::pair<double, double>& radius_limits, const std::string& prior,
+            const std::optional<std::vector<double>>& up, int max_cylinders,
+            const std::string& voting, int k, const std::optional<double>& distance_threshold,
+            long long seed)
+{
+  FitSettings s;
+  if (!facyl::parseOrientationPrior(prior, s.prior))
+    throw py::value_error("prior: '" + prior +
+                          "' is not uniform, vertical, vertical-strong or horizontal");
+  if (!facyl::parseVotingMode(voting, s.params.voting_mode))
+    throw py::value_error("voting: '" + voting + "' is not soft-curvature, soft-normal or rabbani");
+  if (const auto u = optionalVector(up, "up"))
+    s.up = *u;
+  if (!(radius_limits.first >= 0.0 && radius_limits.second > radius_limits.first &&
+        radius_limits.second <= 1e4))
+    throw py::value_error("radius_limits: expected (min, max) with 0 <= min < max <= 1e4 (m)");
+  s.params.radius_min = static_cast<float>(radius_limits.first);
+  s.params.radius_max = static_cast<float>(radius_limits.second);
+  if (max_cylinders < 1 || max_cylinders > 100)
+    throw py::value_error("max_cylinders: " + std::to_string(max_cylinders) + " is not in [1, 100]");
+  s.params.max_cylinders = static_cast<std::size_t>(max_cylinders);
+  if (distance_threshold) {
+    if (!(*distance_threshold > 0.0 && *distance_threshold < 1e4))
+      throw py::value_error("distance_threshold: expected a positive number of metres or None");
+    s.params.distance_threshold = static_cast<float>(*distance_threshold);
+  }
+  if (seed < 0)
+    throw py::value_error("seed: must be >= 0");
+  s.seed = static_cast<std::uint64_t>(seed);
+  s.k = k;
+  const std::string why = facyl::validate(s.params);
+  if (!why.empty())
+    throw py::value_error(why);
+  return s;
+}
+
+/** The fit of facyl_fit (same estimator, same settings): cues estimated unless \a normals. */
+std::vector<facyl::CylinderModel>
+fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
+         const FitSettings& s)
+{
+  Cues::Ptr cues(new Cues);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(s.k);
+  if (normals)
+    ne.setInputNormals(normals);
+  ne.compute(*cues);
+  std::vector<facyl::CylinderModel> models;
+  if (cues->size() != cloud->size())
+    return models;
+  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
+  hough.setParameters(s.params);
+  hough.setOrientationPrior(s.prior);
+  hough.setUpDirection(s.up);
+  hough.setSeed(s.seed);
+  hough.setInputCloud(cloud);
+  hough.setInputNormals(cues);
+  hough.segment(models);
+  return models;
+}
+
+pcl::PointCloud<pcl::Normal>::Ptr
+toNormals(const py::object& normals, std::size_t rows)
+{
+  if (normals.is_none())
+    return nullptr;
+  const auto a = floatArray(normals, "normals", 3);
+  if (static_cast<std::size_t>(a.shape(0)) != rows)
+    throw py::value_error("normals: " + std::to_string(a.shape(0)) + " rows, points has " +
+                          std::to_string(rows));
+  pcl::PointCloud<pcl::Normal>::Ptr out(new pcl::PointCloud<pcl::Normal>);
+  out->resize(rows);
+  const double* d = a.data();
+  for (std::size_t i = 0; i < rows; ++i) {
+    auto& n = (*out)[i];
+    n.normal_x = static_cast<float>(d[3 * i]);
+    n.normal_y = static_cast<float>(d[3 * i + 1]);
+    n.normal_z = static_cast<float>(d[3 * i + 2]);
+  }
+  return out;
+}
+
+std::vector<PyCylinder>
+fitCylinders(const py::object& points, const py::object& normals,
+             const std::pair<double, double>& radius_limits, const std::string& prior,
+             const std::optional<std::vector<double>>& up, int max_cylinders,
+             const std::string& voting, int k, const std::optional<double>& distance_threshold,
+             long long seed)
+{
+  const auto a = floatArray(points, "points", 3);
+  const Cloud::Ptr cloud = toCloud(a, "points");
+  const auto given = toNormals(normals, cloud->size());
+  checkK(k, cloud->size());
+  const FitSettings s = fitSettings(radius_limits, prior, up, max_cylinders, voting, k,
+                                    distance_threshold, seed);
+  std::vector<facyl::CylinderModel> models;
+  {
+    py::gil_scoped_release release;
+    models = fitCloud(cloud, given, s);
+  }
+  std::vector<PyCylinder> out;
+  for (auto& m : models)
+    out.push_back({std::move(m)});
+  return out;
+}
+
+/** Median milliseconds of \a repeats calls of the same fit inside C++ (no Python between
+ * them): the reference for the binding's overhead. */
+double
+timeFitInCpp(const py::object& points, int repeats, int k)
+{
+  const auto a = floatArray(points, "points", 3);
+  const Cloud::Ptr cloud = toCloud(a, "points");
+  checkK(k, cloud->size());
+  if (repeats < 1 || repeats > 100000)
+    throw py::value_error("repeats: must be in [1, 100000]");
+  const FitSettings s = fitSettings({0.01, 0.25}, "uniform", std::nullopt, 1, "soft-curvature",
+                                    k, std::nullopt, 0);
+  std::vector<double> ms;
+  py::gil_scoped_release release;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto models = fitCloud(cloud, nullptr, s);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// -------------------------------------------------------------------------------- detect
+
+using RgbCloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+
+RgbCloud::Ptr
+frameCloud(const py::object& points, const py::object& colors, bool& organized)
+{
+  const auto a = py::reinterpret_borrow<py::array>(points.ptr());
+  organized = py::isinstance<py::array>(points) && a.ndim() == 3;
+  const auto xyz = floatArray(points, "points", 3, organized);
+  const py::ssize_t h = organized ? xyz.shape(0) : 1, w = organized ? xyz.shape(1) : xyz.shape(0);
+  py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast> rgb;
+  if (!colors.is_none()) {
+    if (!py::isinstance<py::array>(colors))
+      throw py::type_error("colors: expected a numpy array of uint8");
+    const auto c = py::reinterpret_borrow<py::array>(colors);
+    if (c.dtype().kind() != 'u' || c.itemsize() != 1)
+      throw py::type_error("colors: expected dtype uint8, got " + std::string(py::str(c.dtype())));
+    const bool same = organized ? (c.ndim() == 3 && c.shape(0) == h && c.shape(1) == w && c.shape(2) == 3)
+                                : (c.ndim() == 2 && c.shape(0) == w && c.shape(1) == 3);
+    if (!same)
+      throw py::value_error("colors: expected the shape of points (RGB, uint8)");
+    rgb = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(c);
+  }
+  RgbCloud::Ptr cloud(new RgbCloud);
+  cloud->resize(static_cast<std::size_t>(h * w));
+  cloud->width = static_cast<std::uint32_t>(w);
+  cloud->height = static_cast<std::uint32_t>(h);
+  cloud->is_dense = false;
+  const double* d = xyz.data();
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    auto& p = (*cloud)[i];
+    p.x = static_cast<float>(d[3 * i]);
+    p.y = static_cast<float>(d[3 * i + 1]);
+    p.z = static_cast<float>(d[3 * i + 2]);
+    finite += std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    p.r = p.g = p.b = 128;
+    p.a = 255;
+    if (rgb.size()) {
+      p.r = rgb.data()[3 * i];
+      p.g = rgb.data()[3 * i + 1];
+      p.b = rgb.data()[3 * i + 2];
+    }
+  }
+  if (finite < 3)
+    throw py::value_error("points: fewer than 3 finite points");
+  return cloud;
+}
+
+py::dict
+objectDict(const facyl::RecognizedObject& o, std::size_t id)
+{
+  const auto& e = o.evidence;
+  const auto optional = [](float v) -> py::object {
+    return std::isfinite(v) ? py::object(py::float_(v)) : py::object(py::none());
+  };
+  py::dict d;
+  d["id"] = id;
+  d["support"] = o.cluster.support;
+  d["centroid"] = vector3(o.cluster.centroid);
+  d["n_points"] = o.cluster.indices.indices.size();
+  d["indices"] = py::array_t<std::int64_t>(
+    static_cast<py::ssize_t>(o.cluster.indices.indices.size()),
+    std::vector<std::int64_t>(o.cluster.indices.indices.begin(), o.cluster.indices.indices.end()).data());
+  d["bbox"] = std::vector<int>(o.cluster.box.begin(), o.cluster.box.end());
+  d["p_cylinder"] = optional(e.p_cylinder);
+  d["p_network"] = optional(e.p_network);
+  d["inlier_ratio"] = e.inlier_ratio;
+  d["surface_ratio"] = e.surface_ratio;
+  d["curvature_ratio"] = optional(e.curvature_ratio);
+  d["is_cylinder"] = o.is_cylinder;
+  d["cylinder"] = e.fitted ? py::object(cylinderDict(o.cylinder)) : py::object(py::none());
+  return d;
+}
+
+py::dict
+detect(const py::object& points, const py::object& colors,
+       const std::optional<std::vector<double>>& camera,
+       const std::optional<std::vector<double>>& up, const std::string& model)
+{
+  bool organized = false;
+  const RgbCloud::Ptr cloud = frameCloud(points, colors, organized);
+  facyl::PinholeCamera cam;
+  if (camera) {
+    const auto& c = *camera;
+    if (c.size() != 4 || !(c[0] > 0 && c[0] <= 1e5 && c[1] > 0 && c[1] <= 1e5 && c[2] >= 0 &&
+                           c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
+      throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
+                            "0 <= cx, cy <= 4000 (pixels)");
+    cam = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]),
+           static_cast<float>(c[3]), static_cast<int>(std::ceil(2 * c[2] + 1)),
+           static_cast<int>(std::ceil(2 * c[3] + 1))};
+  }
+  facyl::ShapeClassifier::Ptr classifier;
+  if (model != "none") {
+    const std::string path = model == "default" ? facyl::CylinderClassifier::defaultModelPath() : model;
+    if (path.empty())
+      throw py::value_error("model: the shipped model is not installed; give a path or 'none'");
+    auto c = std::make_shared<facyl::CylinderClassifier>();
+    try {
+      c->load(path);
+    }
+    catch (const std::runtime_error& e) {
+      throw py::value_error(std::string("model: ") + e.what());
+    }
+    classifier = c;
+  }
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setInputCloud(cloud);
+  rec.setCamera(cam);
+  rec.setClassifier(classifier);
+  if (const auto u = optionalVector(up, "up"))
+    rec.setUpDirection(*u);
+  std::vector<facyl::RecognizedObject> objects;
+  bool ok = false;
+  {
+    py::gil_scoped_release release;
+    ok = rec.recognize(objects);
+  }
+  if (!ok)
+    throw py::value_error("detect: no table found (no plane with objects on it)");
+  py::dict out;
+  const auto& t = rec.getTableCoefficients().values;
+  py::dict table;
+  table["coefficients"] = std::vector<float>(t.begin(), t.end());
+  table["found"] = rec.tableFound();
+  out["table"] = table;
+  py::list supports;
+  for (const auto& s : rec.getSupports()) {
+    py::dict sd;
+    sd["coefficients"] = std::vector<float>(s.plane.data(), s.plane.data() + 4);
+    supports.append(sd);
+  }
+  out["supports"] = supports;
+  py::list list;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    list.append(objectDict(objects[i], i));
+  out["objects"] = list;
+  const auto& tm = rec.getTiming();
+  py::dict timing;
+  timing["segmentation"] = tm.segmentation;
+  timing["classification"] = tm.classification;
+  timing["fitting"] = tm.fitting;
+  timing["total"] = tm.total;
+  out["timing_ms"] = timing;
+  out["organized"] = organized;
+  return out;
+}
+
+// ---------------------------------------------------------------------------- simulation
+
+py::dict
+simulateCylinder(double radius, double height, const std::vector<double>& axis,
+                 const std::vector<double>& base, int points, double lid_ratio, double noise,
+                 double occlusion, bool random_axis, long long seed)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = static_cast<float>(radius);
+  p.height = static_cast<float>(height);
+  if (axis.size() != 3 || base.size() != 3)
+    throw py::value_error("axis and base: expected 3 numbers each");
+  p.axis = Eigen::Vector3f(axis[0], axis[1], axis[2]);
+  p.base = Eigen::Vector3f(base[0], base[1], base[2]);
+  if (points < 10 || points > 10000000)
+    throw py::value_error("points: must be in [10, 1e7]");
+  p.lateral_points = static_cast<std::size_t>(points);
+  p.lid_ratio = static_cast<float>(lid_ratio);
+  p.noise = static_cast<float>(noise);
+  p.occlusion = static_cast<float>(occlusion);
+  p.random_axis = random_axis;
+  if (seed < 0)
+    throw py::value_error("seed: must be >= 0");
+  p.seed = static_cast<std::uint64_t>(seed);
+  const std::string why = facyl::validate(p);
+  if (!why.empty())
+    throw py::value_error(why);
+  const facyl::SimulatedCylinder sim = facyl::simulateCylinder(p);
+  const auto n = static_cast<py::ssize_t>(sim.cloud.size());
+  py::array_t<float> xyz({n, py::ssize_t(3)}), normals({n, py::ssize_t(3)});
+  py::array_t<bool> is_lid(n);
+  auto x = xyz.mutable_unchecked<2>();
+  auto nm = normals.mutable_unchecked<2>();
+  auto lid = is_lid.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto& q = sim.cloud[static_cast<std::size_t>(i)];
+    x(i, 0) = q.x, x(i, 1) = q.y, x(i, 2) = q.z;
+    nm(i, 0) = q.normal_x, nm(i, 1) = q.normal_y, nm(i, 2) = q.normal_z;
+    lid(i) = sim.is_lid[static_cast<std::size_t>(i)] != 0;
+  }
+  py::dict truth;
+  truth["base"] = vector3(sim.truth.base);
+  truth["axis"] = vector3(sim.truth.axis);
+  truth["radius"] = sim.truth.radius;
+  truth["height"] = sim.truth.height;
+  py::dict out;
+  out["points"] = xyz;
+  out["normals"] = normals;
+  out["is_lid"] = is_lid;
+  out["truth"] = truth;
+  return out;
+}
+
+py::dict
+renderTabletopScene(long long seed, const std::string& layout, const std::string& sensor)
+{
+  if (seed < 0)
+    throw py::value_error("seed: must be >= 0");
+  if (layout != "spread" && layout != "cluttered")
+    throw py::value_error("layout: '" + layout + "' is not spread or cluttered");
+  facyl::TabletopSceneParameters p =
+    layout == "cluttered" ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
+  if (!facyl::parseSensorPreset(sensor, p.sensor, p.camera))
+    throw py::value_error("sensor: '" + sensor + "' is not kinect or stereo");
+  p.seed = static_cast<std::uint64_t>(seed);
+  facyl::RenderedScene scene;
+  {
+    py::gil_scoped_release release;
+    scene = facyl::simulateTabletopScene(p);
+  }
+  const py::ssize_t h = scene.cloud.height, w = scene.cloud.width;
+  py::array_t<float> xyz({h, w, py::ssize_t(3)});
+  py::array_t<std::uint8_t> rgb({h, w, py::ssize_t(3)});
+  py::array_t<std::uint16_t> ids({h, w});
+  float* x = xyz.mutable_data();
+  std::uint8_t* c = rgb.mutable_data();
+  std::uint16_t* id = ids.mutable_data();
+  for (std::size_t i = 0; i < scene.cloud.size(); ++i) {
+    const auto& q = scene.cloud[i];
+    x[3 * i] = q.x, x[3 * i + 1] = q.y, x[3 * i + 2] = q.z;
+    c[3 * i] = q.r, c[3 * i + 1] = q.g, c[3 * i + 2] = q.b;
+    id[i] = scene.object_id[i];
+  }
+  py::dict out;
+  out["points"] = xyz;
+  out["colors"] = rgb;
+  out["object_id"] = ids;
+  out["truth"] = py::module_::import("json").attr("loads")(facyl::groundTruthJson(scene));
+  out["camera"] = std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
+  return out;
+}
+
+} // namespace
+
+PYBIND11_MODULE(facyl, m)
+{
+  m.doc() = "facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.\n\n"
+            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), metres; NaN rows "
+            "are missing points. Functions release the GIL while they compute.";
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+
+  py::class_<PyCylinder>(m, "Cylinder", "A fitted finite cylinder (metres).")
+    .def_property_readonly("point_on_axis", [](const PyCylinder& c) { return vector3(c.model.point_on_axis); },
+                           "(3,) float32: the base centre")
+    .def_property_readonly("axis", [](const PyCylinder& c) { return vector3(c.model.axis); },
+                           "(3,) float32: unit axis, base to top")
+    .def_property_readonly("radius", [](const PyCylinder& c) { return c.model.radius; }, "radius (m)")
+    .def_property_readonly("height", [](const PyCylinder& c) { return c.model.height; }, "|top - base| (m)")
+    .def_property_readonly("base", [](const PyCylinder& c) { return vector3(c.model.base); },
+                           "(3,) float32: centre of the lowest inlier section")
+    .def_property_readonly("top", [](const PyCylinder& c) { return vector3(c.model.top); },
+                           "(3,) float32: centre of the highest inlier section")
+    .def_property_readonly("inliers", [](const PyCylinder& c) {
+        std::vector<std::int64_t> v(c.model.inliers.begin(), c.model.inliers.end());
+        return py::array_t<std::int64_t>(static_cast<py::ssize_t>(v.size()), v.data());
+      }, "(K,) int64: row indices of the inliers in points, ascending")
+    .def_property_readonly("inlier_ratio", [](const PyCylinder& c) { return c.model.inlier_ratio; },
+                           "inliers / rows given (paper eq. 4)")
+    .def_property_readonly("confidence", [](const PyCylinder& c) { return c.model.confidence; },
+                           "share of the orientation evidence its inliers carry, in [0, 1]")
+    .def_property_readonly("rms_error", [](const PyCylinder& c) { return c.model.rms_error; },
+                           "RMS distance of the inliers to the surface (m)")
+    .def_property_readonly("angular_coverage", [](const PyCylinder& c) { return c.model.angular_coverage; },
+                           "share of the circumference with inliers")
+    .def_property_readonly("coefficients", [](const PyCylinder& c) {
+        pcl::ModelCoefficients mc;
+        c.model.toCoefficients(mc);
+        return py::array_t<float>(7, mc.values.data());
+      }, "(7,) float32: PCL's SACMODEL_CYLINDER layout (point on axis, axis direction, radius)")
+    .def("__repr__", [](const PyCylinder& c) {
+        const auto& m = c.model;
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "Cylinder(radius=%.4f, height=%.4f, axis=[%.3f, %.3f, %.3f], "
+                      "point_on_axis=[%.3f, %.3f, %.3f], inliers=%zu)",
+                      m.radius, m.height, m.axis.x(), m.axis.y(), m.axis.z(), m.point_on_axis.x(),
+                      m.point_on_axis.y(), m.point_on_axis.z(), m.inliers.size());
+        return std::string(buf);
+      });
+
+  m.def("fit_cylinders", &fitCylinders, py::arg("points"), py::arg("normals") = py::none(),
+        py::kw_only(), py::arg("radius_limits") = std::make_pair(0.01, 0.25),
+        py::arg("prior") = "uniform", py::arg("up") = py::none(), py::arg("max_cylinders") = 1,
+        py::arg("voting") = "soft-curvature", py::arg("k") = 16,
+        py::arg("distance_threshold") = py::none(), py::arg("seed") = 0,
+        R"(Fits up to max_cylinders cylinders to points (N, 3), one after another.
+
+The two-step Hough estimator of facyl_fit: normals and principal curvatures of the k nearest
+neighbours (unless normals (N, 3) are given), orientation votes weighted by curvature
+(voting="soft-curvature", paper eq. 3; "soft-normal"; "rabbani": hard votes), a circle Hough
+for position and radius, least-squares refinement.
+
+radius_limits: (min, max) in metres, default (0.01, 0.25). prior: orientation prior "uniform"
+(default), "vertical", "vertical-strong" or "horizontal" about up (default (0, 0, 1)).
+distance_threshold: inlier distance in metres (default None: estimated from the residuals).
+seed: seed of the randomized accumulator (same seed, same result). Returns a list of Cylinder,
+best first; empty when no cylinder is found. Raises ValueError/TypeError for bad input.)");
+
+  m.def("estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),
+        py::arg("k") = 16,
+        R"(Normals and principal curvatures of points (N, 3) from their k nearest neighbours
+(default 16), in one pass (facyl's NormalCurvatureEstimation). Returns (normals (N, 3),
+principal_directions (N, 3), k_max (N,), k_min (N,)) as float32: unit normals, the unit
+direction of largest normal change, and k_max >= k_min >= 0, the eigenvalues of the covariance
+of the neighbours' normals projected on the tangent plane (PCL's pc1, pc2: dimensionless,
+larger for tighter bends). NaN rows for points without a usable neighbourhood.)");
+
+  m.def("detect", &detect, py::arg("points"), py::arg("colors") = py::none(), py::kw_only(),
+        py::arg("camera") = py::none(), py::arg("up") = py::none(), py::arg("model") = "default",
+        R"(The tabletop pipeline of facyl_detect on one frame: table, objects on it, cylinders.
+
+points: an organized frame (H, W, 3) in the camera frame (x right, y down, z forward; NaN
+where the sensor has no depth), or (N, 3) with camera=(fx, fy, cx, cy) for the objects' pixel
+boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite, optional.
+model: "default" (the shipped shape classifier), "none", or a path to an .onnx with its .cfg.
+Returns a dict with the fields of facyl_detect's JSON ("table", "supports", "objects" with
+"p_cylinder", "is_cylinder", "cylinder" ..., "timing_ms"); objects also carry "indices" (rows
+of the flattened frame). Raises ValueError when no table is found.)");
+
+  m.def("simulate_cylinder", &simulateCylinder, py::kw_only(), py::arg("radius") = 0.3,
+        py::arg("height") = 1.0, py::arg("axis") = std::vector<double>{0, 0, 1},
+        py::arg("base") = std::vector<double>{0, 0, 0}, py::arg("points") = 900,
+        py::arg("lid_ratio") = 0.0, py::arg("noise") = 0.0, py::arg("occlusion") = 0.0,
+        py::arg("random_axis") = false, py::arg("seed") = 0,
+        R"(A simulated cylinder (paper III-D1): points on the lateral surface (points = |P|), lid
+outliers (lid_ratio, eq. 5), noise (relative to the radius), occlusion (eq. 6, a removed
+sector). Returns {"points": (N, 3), "normals": (N, 3), "is_lid": (N,), "truth": {...}}.)");
+
+  m.def("render_tabletop_scene", &renderTabletopScene, py::kw_only(), py::arg("seed") = 0,
+        py::arg("layout") = "spread", py::arg("sensor") = "kinect",
+        R"(A simulated RGB-D tabletop frame (facyl_synth): layout "spread" or "cluttered", sensor
+"kinect" or "stereo". Returns {"points": (480, 640, 3) float32 (NaN without depth), "colors":
+(480, 640, 3) uint8, "object_id": (480, 640) uint16 (0 background, 1 table, 2+ objects),
+"truth": the ground truth (dict), "camera": [fx, fy, cx, cy]}.)");
+
+  m.def("_time_fit_in_cpp", &timeFitInCpp, py::arg("points"), py::arg("repeats") = 50,
+        py::arg("k") = 16,
+        "Median ms of fit_cylinders' C++ work (default settings) repeated inside C++: the "
+        "reference for the binding's overhead.");
+  m.attr("__version__") = "0.1.0";
+}
