@@ -273,6 +273,29 @@ TEST(CylinderClassifier, BadModelsGiveErrorsThatNameTheFile)
   writeFile("badcfg.cfg", "channels depth\nsize 64\nfusion 1 2\n");
   EXPECT_NE(message(writeFile("badcfg.onnx", onnx)).find("badcfg.cfg: line 3 (fusion)"),
             std::string::npos);
+  // Caffe: the description first, then both network files are named when missing or bad.
+  const auto caffe_message = [&](const std::string& prototxt, const std::string& model,
+                                 const std::string& description) {
+    try {
+      c.loadCaffe(prototxt, model, description);
+    }
+    catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string paper_cfg = writeFile("paper.cfg", "channels rgb\nsize 227\n");
+  EXPECT_NE(caffe_message("/nonexistent/deploy.prototxt", "/nonexistent/squeezenet.caffemodel",
+                          paper_cfg)
+              .find("/nonexistent/deploy.prototxt: no such file"),
+            std::string::npos);
+  EXPECT_NE(caffe_message("a", "b", "/nonexistent/paper.cfg").find("paper.cfg: no such file"),
+            std::string::npos);
+  const std::string prototxt = writeFile("deploy.prototxt", "this is not a prototxt {");
+  const std::string weights = writeFile("weights.caffemodel", "garbage");
+  EXPECT_NE(caffe_message(prototxt, weights, paper_cfg).find("cannot read them as a Caffe network"),
+            std::string::npos);
+  EXPECT_FALSE(c.loaded());
   // Unloaded: a clear logic error, not a crash.
   EXPECT_THROW(c.cylinderProbability(facyl::ObjectView{}), std::logic_error);
 }
