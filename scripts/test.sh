@@ -4,7 +4,8 @@
 # find_package(facyl)).
 #   --sanitize  also build in build-sanitize/ with AddressSanitizer + UndefinedBehaviorSanitizer
 #               and run the suite there (all tests but the benchmark smoke test and the
-#               Python module's, which an uninstrumented interpreter cannot load)
+#               Python module's, which an uninstrumented interpreter cannot load, and the
+#               viewer's: VTK under xvfb, not checked under the sanitizers)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sanitize=0
@@ -31,5 +32,5 @@ if [ "$sanitize" -eq 1 ]; then
   cmake --build build-sanitize -j"$(nproc)"
   ASAN_OPTIONS=alloc_dealloc_mismatch=0:detect_leaks=1:abort_on_error=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" -E "facyl_bench_quick|python_bindings"
+    ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" -E "facyl_bench_quick|python_bindings|viewer_screenshots"
 fi

@@ -1,0 +1,726 @@
+/*
+ * facyl_viewer: a pcl_viewer-style 3-D viewer of scenes and their cylinders
+ * (pcl::visualization::PCLVisualizer). The cloud in its colours, the table outline, accepted
+ * cylinders as finite green meshes from base to top, rejected objects as red boxes, a label
+ * per object; optionally PCL's SACMODEL_CYLINDER on the same clusters in a second viewport,
+ * or one object's orientation accumulators for the three voting modes. --screenshot renders
+ * and exits (under xvfb-run without a screen).
+ */
+#include "cli.h"
+#include "json_value.h"
+#include "pcd_input.h"
+#include "pcl_baseline.h"
+#include "recognizer_options.h"
+
+#include <facyl/features/local_geometry.h>
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+#include <facyl/sample_consensus_alt/orientation_accumulator.h>
+
+#include <pcl/PolygonMesh.h>
+#include <pcl/common/common.h>
+#include <pcl/common/point_tests.h>
+#include <pcl/console/print.h>
+#include <pcl/conversions.h>
+#include <pcl/visualization/pcl_visualizer.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+
+constexpr int kDefaultWidth = 1024, kDefaultHeight = 768;
+constexpr int kMeshSegments = 36;
+constexpr std::size_t kOrientations = 450; // the paper's N_d
+constexpr float kPclMinInlierRatio = 0.5f; // PCL's fit is drawn as a cylinder from this on
+
+void
+printHelp(const char* self)
+{
+  std::printf(
+    "Usage: %s [options] SCENE.pcd...\n"
+    "Shows each cloud with its table and cylinders (green: accepted, finite from base to top;\n"
+    "red boxes: objects that are not cylinders; a label per object).\n"
+    "  --detect              run the recognizer (default unless --detections)\n"
+    "  --detections F.jsonl  show facyl_detect's output instead (one JSON line per scene,\n"
+    "                        matched by \"file\", else by order)\n"
+    "  --compare-pcl         a second viewport: PCL SACSegmentationFromNormals +\n"
+    "                        SACMODEL_CYLINDER on the same clusters and normals, both times\n"
+    "                        (PCL's cylinder drawn when it holds half of the object's points)\n"
+    "  --accumulator ID      object ID's orientation accumulator (%zu cells, uniform) for the\n"
+    "                        voting modes rabbani, soft-normal, soft-curvature side by side:\n"
+    "                        cells coloured by votes, the chosen axis, normals (white) and\n"
+    "                        principal-curvature directions (yellow)\n"
+    "  --screenshot OUT.png  render the first scene to OUT.png and exit (needs an X display:\n"
+    "                        run under xvfb-run without a screen)\n"
+    "  --size W,H            window / screenshot size (default %d,%d)\n"
+    "  --model M             shape classifier for --detect: default | none | PATH.onnx\n"
+    "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
+    "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
+    "l labels.\n"
+    "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage.\n",
+    self, kOrientations, kDefaultWidth, kDefaultHeight);
+}
+
+// ------------------------------------------------------------------------------- scene
+
+/** One object as the viewer draws it. */
+struct ViewObject {
+  bool is_cylinder{false};
+  bool fitted{false};
+  facyl::CylinderModel cylinder;
+  Eigen::Vector3f box_min{Eigen::Vector3f::Zero()}, box_max{Eigen::Vector3f::Zero()};
+  Eigen::Vector3f centroid{Eigen::Vector3f::Zero()};
+  float p_cylinder{std::numeric_limits<float>::quiet_NaN()};
+  pcl::Indices indices; ///< empty for --detections
+};
+
+struct Scene {
+  std::string file;
+  Cloud::Ptr cloud;
+  std::vector<ViewObject> objects;
+  std::vector<Eigen::Vector3f> table_outline;
+  double facyl_ms{0.0}; ///< the recognizer's fitting time (--detect)
+};
+
+struct Settings {
+  std::vector<std::string> files;
+  bool detect{true};
+  std::string detections;
+  bool compare_pcl{false};
+  long long accumulator{-1};
+  std::string screenshot;
+  int width{kDefaultWidth}, height{kDefaultHeight};
+  facyl::ShapeClassifier::Ptr classifier;
+};
+
+/** The file as an XYZRGBA cloud (grey without colour). \throws std::runtime_error. */
+Cloud::Ptr
+loadCloud(const std::string& file)
+{
+  pcl::PCLPointCloud2 blob;
+  facyl_cli::Viewpoint viewpoint;
+  const std::string why = facyl_cli::readPcd(file, blob, &viewpoint);
+  if (!why.empty())
+    throw std::runtime_error(why);
+  Cloud::Ptr cloud(new Cloud);
+  pcl::fromPCLPointCloud2(blob, *cloud);
+  if (!facyl_cli::hasField(blob, "rgb") && !facyl_cli::hasField(blob, "rgba"))
+    for (auto& p : *cloud)
+      p.r = p.g = p.b = 160, p.a = 255;
+  cloud->sensor_origin_ = viewpoint.origin;
+  cloud->sensor_orientation_ = viewpoint.orientation;
+  if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))
+    throw std::runtime_error("the cloud has no finite point");
+  return cloud;
+}
+
+void
+boxOf(const Cloud& cloud, const pcl::Indices& indices, ViewObject& o)
+{
+  o.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  o.box_max = -o.box_min;
+  for (const auto i : indices) {
+    const Eigen::Vector3f p = cloud[static_cast<std::size_t>(i)].getVector3fMap();
+    o.box_min = o.box_min.cwiseMin(p);
+    o.box_max = o.box_max.cwiseMax(p);
+  }
+}
+
+std::vector<Eigen::Vector3f>
+tableOutline(const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec)
+{
+  std::vector<Eigen::Vector3f> outline;
+  const auto& supports = rec.getSupports();
+  const auto& t = rec.getTableCoefficients().values;
+  if (supports.empty() || t.size() != 4)
+    return outline;
+  // The support whose plane is the table's.
+  const Eigen::Vector4f table(t[0], t[1], t[2], t[3]);
+  const auto best = std::min_element(supports.begin(), supports.end(), [&](const auto& a, const auto& b) {
+    return (a.plane - table).norm() < (b.plane - table).norm();
+  });
+  for (const auto& q : best->polygon)
+    outline.push_back(best->frame * Eigen::Vector3f(q.x(), q.y(), 0.f));
+  return outline;
+}
+
+/** --detect: the recognizer's objects. */
+void
+detectObjects(const Settings& s, Scene& scene)
+{
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setClassifier(s.classifier);
+  rec.setInputCloud(scene.cloud);
+  std::vector<facyl::RecognizedObject> objects;
+  if (!rec.recognize(objects))
+    throw std::runtime_error("no table found");
+  scene.facyl_ms = rec.getTiming().fitting + rec.getTiming().classification;
+  scene.table_outline = tableOutline(rec);
+  for (const auto& r : objects) {
+    ViewObject o;
+    o.is_cylinder = r.is_cylinder;
+    o.fitted = r.evidence.fitted;
+    o.cylinder = r.cylinder;
+    o.centroid = r.cluster.centroid;
+    o.p_cylinder = r.evidence.p_cylinder;
+    o.indices = r.cluster.indices.indices;
+    boxOf(*scene.cloud, o.indices, o);
+    scene.objects.push_back(std::move(o));
+  }
+}
+
+Eigen::Vector3f
+jsonVector(const facyl_cli::JsonValue* v)
+{
+  if (!v || v->items.size() != 3)
+    throw std::runtime_error("a vector of 3 numbers is missing");
+  return Eigen::Vector3f(static_cast<float>(v->items[0].number), static_cast<float>(v->items[1].number),
+                         static_cast<float>(v->items[2].number));
+}
+
+/** --detections: the objects of facyl_detect's line for the scene. */
+void
+objectsFromJson(const facyl_cli::JsonValue& line, Scene& scene)
+{
+  if (const auto* error = line.get("error"))
+    throw std::runtime_error("the detections say: " + error->text);
+  const auto* objects = line.get("objects");
+  if (!objects)
+    throw std::runtime_error("the detections line has no \"objects\"");
+  for (const auto& j : objects->items) {
+    ViewObject o;
+    o.centroid = jsonVector(j.get("centroid"));
+    const auto* is = j.get("is_cylinder");
+    o.is_cylinder = is && is->boolean;
+    const auto* p = j.get("p_cylinder");
+    if (p && p->type == facyl_cli::JsonValue::Type::Number)
+      o.p_cylinder = static_cast<float>(p->number);
+    const auto* c = j.get("cylinder");
+    if (c && c->type == facyl_cli::JsonValue::Type::Object) {
+      o.fitted = true;
+      o.cylinder.point_on_axis = jsonVector(c->get("point_on_axis"));
+      o.cylinder.axis = jsonVector(c->get("axis")).normalized();
+      o.cylinder.radius = static_cast<float>(c->get("radius") ? c->get("radius")->number : 0.0);
+      o.cylinder.height = static_cast<float>(c->get("height") ? c->get("height")->number : 0.0);
+      o.cylinder.base = o.cylinder.point_on_axis;
+      o.cylinder.top = o.cylinder.base + o.cylinder.height * o.cylinder.axis;
+    }
+    o.box_min = o.centroid - Eigen::Vector3f::Constant(0.03f);
+    o.box_max = o.centroid + Eigen::Vector3f::Constant(0.03f);
+    scene.objects.push_back(std::move(o));
+  }
+}
+
+/** The lines of a --detections file, by "file" (and in order). */
+std::vector<facyl_cli::JsonValue>
+readDetections(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in)
+    throw std::invalid_argument("--detections: cannot read " + path);
+  std::vector<facyl_cli::JsonValue> lines;
+  std::string text;
+  int number = 0;
+  while (std::getline(in, text)) {
+    ++number;
+    if (text.find_first_not_of(" \t\r") == std::string::npos)
+      continue;
+    try {
+      lines.push_back(facyl_cli::JsonReader::parse(text));
+    }
+    catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--detections: " + path + " line " + std::to_string(number) +
+                                  ": " + e.what());
+    }
+  }
+  return lines;
+}
+
+const facyl_cli::JsonValue*
+detectionFor(const std::vector<facyl_cli::JsonValue>& lines, const std::string& file, std::size_t k)
+{
+  for (const auto& l : lines)
+    if (const auto* f = l.get("file"); f && f->text == file)
+      return &l;
+  return k < lines.size() ? &lines[k] : nullptr;
+}
+
+// ----------------------------------------------------------------------------- drawing
+
+/** A closed finite cylinder from \a m.base to \a m.top, \a segments around. */
+pcl::PolygonMesh
+cylinderMesh(const facyl::CylinderModel& m, int segments)
+{
+  Eigen::Vector3f a = m.top - m.base;
+  if (!(a.norm() > 1e-6f))
+    a = m.axis * std::max(m.height, 1e-3f);
+  const Eigen::Vector3f axis = a.normalized();
+  Eigen::Vector3f u = axis.unitOrthogonal(), v = axis.cross(u);
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int k = 0; k < segments; ++k) {
+      const float t = 2.f * static_cast<float>(M_PI) * static_cast<float>(k) / static_cast<float>(segments);
+      const Eigen::Vector3f p = m.base + (ring ? a : Eigen::Vector3f::Zero()) +
+                                m.radius * (std::cos(t) * u + std::sin(t) * v);
+      vertices.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    }
+  vertices.push_back(pcl::PointXYZ(m.base.x(), m.base.y(), m.base.z()));
+  const Eigen::Vector3f top = m.base + a;
+  vertices.push_back(pcl::PointXYZ(top.x(), top.y(), top.z()));
+  pcl::PolygonMesh mesh;
+  pcl::toPCLPointCloud2(vertices, mesh.cloud);
+  const pcl::index_t n = segments;
+  for (pcl::index_t k = 0; k < n; ++k) {
+    const pcl::index_t k1 = (k + 1) % n;
+    for (pcl::Indices face : {pcl::Indices{k, k1, n + k1, n + k}, pcl::Indices{2 * n, k1, k},
+                              pcl::Indices{2 * n + 1, n + k, n + k1}}) {
+      pcl::Vertices v;
+      v.vertices = std::move(face); // side, bottom, lid
+      mesh.polygons.push_back(std::move(v));
+    }
+  }
+  return mesh;
+}
+
+std::string
+labelOf(const ViewObject& o, std::size_t id)
+{
+  char buf[160];
+  const std::string p = std::isfinite(o.p_cylinder) ? " p=" + std::to_string(o.p_cylinder).substr(0, 4) : "";
+  if (o.is_cylinder)
+    std::snprintf(buf, sizeof buf, "#%zu r=%.1fmm h=%.1fmm%s", id, o.cylinder.radius * 1e3f,
+                  o.cylinder.height * 1e3f, p.c_str());
+  else
+    std::snprintf(buf, sizeof buf, "#%zu not a cylinder%s", id, p.c_str());
+  return buf;
+}
+
+/** Which layers are shown. */
+struct Layers {
+  bool table{true}, cylinders{true}, boxes{true}, labels{true};
+};
+
+void
+drawCylinder(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderModel& m,
+             const std::string& id, int viewport, double r, double g, double b)
+{
+  // Meshes live with the clouds in PCLVisualizer: their properties are point-cloud ones.
+  viewer.addPolygonMesh(cylinderMesh(m, kMeshSegments), id, viewport);
+  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, r, g, b, id, viewport);
+  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY, 0.85, id, viewport);
+}
+
+void
+drawObjects(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const Layers& layers,
+            const std::string& tag, int viewport)
+{
+  for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+    const ViewObject& o = scene.objects[k];
+    const std::string id = tag + std::to_string(k);
+    if (o.is_cylinder && layers.cylinders)
+      drawCylinder(viewer, o.cylinder, id + "_cyl", viewport, 0.1, 0.9, 0.2);
+    if (!o.is_cylinder && layers.boxes) {
+      viewer.addCube(o.box_min.x(), o.box_max.x(), o.box_min.y(), o.box_max.y(), o.box_min.z(),
+                     o.box_max.z(), 1.0, 0.1, 0.1, id + "_box", viewport);
+      viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
+                                         pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME,
+                                         id + "_box", viewport);
+    }
+    if (layers.labels) {
+      const Eigen::Vector3f at = o.is_cylinder ? Eigen::Vector3f(o.cylinder.top) : Eigen::Vector3f(o.box_min);
+      viewer.addText3D(labelOf(o, k), pcl::PointXYZ(at.x(), at.y(), at.z()), 0.008,
+                       o.is_cylinder ? 0.6 : 1.0, o.is_cylinder ? 1.0 : 0.5, 0.6, id + "_label",
+                       viewport);
+    }
+  }
+}
+
+void
+drawTable(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const std::string& tag,
+          int viewport)
+{
+  if (scene.table_outline.size() < 3)
+    return;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr polygon(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& p : scene.table_outline)
+    polygon->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  viewer.addPolygon<pcl::PointXYZ>(polygon, 0.2, 0.5, 1.0, tag + "table", viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3, tag + "table", viewport);
+}
+
+/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does. */
+void
+sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int viewport)
+{
+  const Eigen::Vector3f o = cloud.sensor_origin_.head<3>();
+  const Eigen::Matrix3f r = cloud.sensor_orientation_.toRotationMatrix();
+  const Eigen::Vector3f look = o + r.col(2), up = -r.col(1);
+  viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(), up.z(), viewport);
+  viewer.setCameraFieldOfView(49.0 * M_PI / 180.0, viewport); // a Kinect's vertical field of view
+  viewer.setCameraClipDistances(0.01, 50.0, viewport);
+}
+
+// ------------------------------------------------------------------------ PCL comparison
+
+/** PCL's SACMODEL_CYLINDER on every object's points, with facyl's normals. \return its ms. */
+double
+pclObjects(const Scene& scene, Scene& pcl_scene)
+{
+  pcl_scene.file = scene.file;
+  pcl_scene.cloud = scene.cloud;
+  pcl_scene.table_outline = scene.table_outline;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const ViewObject& o : scene.objects) {
+    ViewObject q = o;
+    q.is_cylinder = false;
+    q.p_cylinder = std::numeric_limits<float>::quiet_NaN();
+    pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
+    for (const auto i : o.indices) {
+      const auto& p = (*scene.cloud)[static_cast<std::size_t>(i)];
+      points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+    }
+    if (points->size() >= 20) {
+      pcl::PointCloud<facyl::NormalCurvature> cues;
+      facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+      ne.setInputCloud(points);
+      ne.setKSearch(16);
+      ne.compute(cues);
+      pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+      pcl::copyPointCloud(cues, *normals);
+      facyl_cli::PclCylinderOptions options;
+      options.distance_threshold = 0.005f;
+      options.radius_min = 0.01f;
+      options.radius_max = 0.25f;
+      const auto fits = facyl_cli::fitPclCylinders<pcl::PointXYZ>(points, normals, options);
+      if (!fits.empty() && fits.front().inlier_ratio >= kPclMinInlierRatio) {
+        q.is_cylinder = true;
+        q.cylinder = fits.front();
+      }
+    }
+    pcl_scene.objects.push_back(std::move(q));
+  }
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --------------------------------------------------------------------------- accumulator
+
+/** One object's orientation accumulators, one viewport per voting mode. */
+void
+drawAccumulators(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, std::size_t id,
+                 const int viewports[3])
+{
+  const ViewObject& o = scene.objects.at(id);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto i : o.indices) {
+    const auto& p = (*scene.cloud)[static_cast<std::size_t>(i)];
+    points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  }
+  pcl::PointCloud<facyl::NormalCurvature>::Ptr cues(new pcl::PointCloud<facyl::NormalCurvature>);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(points);
+  ne.setKSearch(16);
+  ne.compute(*cues);
+  facyl::VotingCues voting;
+  voting.resize(std::count_if(cues->begin(), cues->end(),
+                              [](const auto& c) { return std::isfinite(c.normal_x); }));
+  Eigen::Index n = 0;
+  for (const auto& c : *cues) {
+    if (!std::isfinite(c.normal_x))
+      continue;
+    voting.nx(n) = c.normal_x, voting.ny(n) = c.normal_y, voting.nz(n) = c.normal_z;
+    voting.cx(n) = c.principal_curvature_x, voting.cy(n) = c.principal_curvature_y,
+    voting.cz(n) = c.principal_curvature_z;
+    voting.weight(n) = facyl::curvatureAnisotropy(c.pc1, c.pc2);
+    ++n;
+  }
+  const auto acc = facyl::OrientationAccumulator::sample(
+    facyl::GaussianMixture::fromPrior(facyl::OrientationPrior::Uniform), kOrientations, 0);
+  const float radius = 0.6f * (o.box_max - o.box_min).maxCoeff() + 0.02f;
+  const char* names[] = {"rabbani", "soft-normal", "soft-curvature"};
+  const facyl::VotingMode modes[] = {facyl::VotingMode::Rabbani, facyl::VotingMode::SoftNormal,
+                                     facyl::VotingMode::SoftCurvature};
+  for (int m = 0; m < 3; ++m) {
+    Eigen::VectorXf votes;
+    facyl::castVotes(acc.directions(), voting, modes[m], 2, std::sin(acc.cellRadius()), votes);
+    const float top = std::max(votes.maxCoeff(), 1e-9f);
+    pcl::PointCloud<pcl::PointXYZRGB>::Ptr cells(new pcl::PointCloud<pcl::PointXYZRGB>);
+    for (Eigen::Index k = 0; k < votes.size(); ++k)
+      for (const float sign : {1.f, -1.f}) {
+        const Eigen::Vector3f d = o.centroid + sign * radius * acc.directions().col(k);
+        pcl::PointXYZRGB q(static_cast<std::uint8_t>(255 * votes(k) / top), 40,
+                           static_cast<std::uint8_t>(255 * (1 - votes(k) / top)));
+        q.x = d.x(), q.y = d.y(), q.z = d.z();
+        cells->push_back(q);
+      }
+    const std::string tag = std::string("acc_") + names[m];
+    viewer.addPointCloud<pcl::PointXYZRGB>(cells, tag, viewports[m]);
+    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_POINT_SIZE, 6, tag, viewports[m]);
+    Eigen::Index best = 0;
+    votes.maxCoeff(&best);
+    const Eigen::Vector3f a = acc.directions().col(best) * radius * 1.3f;
+    viewer.addLine(pcl::PointXYZ(o.centroid.x() - a.x(), o.centroid.y() - a.y(), o.centroid.z() - a.z()),
+                   pcl::PointXYZ(o.centroid.x() + a.x(), o.centroid.y() + a.y(), o.centroid.z() + a.z()),
+                   0.1, 1.0, 0.2, tag + "_axis", viewports[m]);
+    viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 4, tag + "_axis", viewports[m]);
+    viewer.addPointCloud<pcl::PointXYZ>(points, tag + "_points", viewports[m]);
+    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+    pcl::copyPointCloud(*cues, *normals);
+    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, normals, 10, 0.01f, tag + "_normals", viewports[m]);
+    pcl::PointCloud<pcl::Normal>::Ptr directions(new pcl::PointCloud<pcl::Normal>);
+    for (const auto& c : *cues)
+      directions->push_back(pcl::Normal(c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z));
+    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, directions, 10, 0.01f, tag + "_dirs", viewports[m]);
+    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, 1.0, 0.9, 0.1, tag + "_dirs", viewports[m]);
+    viewer.addText(std::string(names[m]) + " voting", 10, 10, 14, 1, 1, 1, tag + "_title", viewports[m]);
+  }
+}
+
+// ---------------------------------------------------------------------------- the viewer
+
+class Viewer {
+public:
+  explicit Viewer(const Settings& s) : s_(s), viewer_("facyl_viewer")
+  {
+    viewer_.setSize(s.width, s.height);
+    viewer_.setBackgroundColor(0.05, 0.05, 0.08);
+    viewer_.setShowFPS(false);
+    viewer_.registerKeyboardCallback(
+      [this](const pcl::visualization::KeyboardEvent& e) { onKey(e); });
+  }
+  /** Loads and draws scene \a k. \return false (with a message) when it cannot be shown. */
+  bool
+  show(std::size_t k)
+  {
+    current_ = k;
+    viewer_.removeAllPointClouds();
+    viewer_.removeAllShapes();
+    focus_ = 0;
+    try {
+      scene_ = load(s_.files[k]);
+    }
+    catch (const std::exception& e) {
+      std::fprintf(stderr, "facyl_viewer: %s: %s\n", s_.files[k].c_str(), e.what());
+      return false;
+    }
+    draw();
+    return true;
+  }
+  void
+  screenshot(const std::string& path)
+  {
+    viewer_.spinOnce(1, true);
+    viewer_.saveScreenshot(path);
+  }
+  void
+  run()
+  {
+    while (!viewer_.wasStopped())
+      viewer_.spinOnce(50);
+  }
+
+private:
+  Scene
+  load(const std::string& file) const
+  {
+    Scene scene;
+    scene.file = file;
+    scene.cloud = loadCloud(file);
+    if (!s_.detections.empty()) {
+      const auto* line = detectionFor(detections_(), file, current_);
+      if (!line)
+        throw std::runtime_error("no line for it in " + s_.detections);
+      objectsFromJson(*line, scene);
+    }
+    else
+      detectObjects(s_, scene);
+    return scene;
+  }
+  const std::vector<facyl_cli::JsonValue>&
+  detections_() const
+  {
+    if (!lines_loaded_) {
+      lines_ = readDetections(s_.detections);
+      lines_loaded_ = true;
+    }
+    return lines_;
+  }
+  void
+  draw()
+  {
+    pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(scene_.cloud);
+    if (s_.accumulator >= 0) {
+      if (static_cast<std::size_t>(s_.accumulator) >= scene_.objects.size() ||
+          scene_.objects[static_cast<std::size_t>(s_.accumulator)].indices.empty()) {
+        std::fprintf(stderr, "facyl_viewer: --accumulator %lld: the scene has %zu objects (with "
+                             "points: --detect)\n", s_.accumulator, scene_.objects.size());
+        return;
+      }
+      int vp[3];
+      for (int m = 0; m < 3; ++m) {
+        viewer_.createViewPort(m / 3.0, 0.0, (m + 1) / 3.0, 1.0, vp[m]);
+        viewer_.setBackgroundColor(0.05, 0.05, 0.08, vp[m]);
+      }
+      drawAccumulators(viewer_, scene_, static_cast<std::size_t>(s_.accumulator), vp);
+      viewer_.resetCamera();
+      return;
+    }
+    int left = 0, right = 0;
+    if (s_.compare_pcl) {
+      viewer_.createViewPort(0.0, 0.0, 0.5, 1.0, left);
+      viewer_.createViewPort(0.5, 0.0, 1.0, 1.0, right);
+    }
+    viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud", left);
+    if (layers_.table)
+      drawTable(viewer_, scene_, "f_", left);
+    drawObjects(viewer_, scene_, layers_, "f_", left);
+    sensorCamera(viewer_, *scene_.cloud, left);
+    if (s_.compare_pcl) {
+      Scene pcl_scene;
+      const double pcl_ms = pclObjects(scene_, pcl_scene);
+      viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud_pcl", right);
+      drawObjects(viewer_, pcl_scene, layers_, "p_", right);
+      sensorCamera(viewer_, *scene_.cloud, right);
+      char text[200];
+      std::snprintf(text, sizeof text, "facyl: %.1f ms (classification + fitting)", scene_.facyl_ms);
+      viewer_.addText(text, 10, 10, 16, 1, 1, 1, "title_f", left);
+      std::snprintf(text, sizeof text, "PCL SACMODEL_CYLINDER: %.1f ms (normals + RANSAC)", pcl_ms);
+      viewer_.addText(text, 10, 10, 16, 1, 1, 1, "title_p", right);
+    }
+    viewer_.addText(scene_.file, 10, s_.height - 24, 14, 0.8, 0.8, 0.8, "file", left);
+  }
+  void
+  onKey(const pcl::visualization::KeyboardEvent& e)
+  {
+    if (!e.keyDown())
+      return;
+    const std::string key = e.getKeySym();
+    if ((key == "n" || key == "p") && s_.files.size() > 1) {
+      const std::size_t n = s_.files.size();
+      show(key == "n" ? (current_ + 1) % n : (current_ + n - 1) % n);
+      return;
+    }
+    if (key == "o" && !scene_.objects.empty()) {
+      focus_ = (focus_ + 1) % scene_.objects.size();
+      const ViewObject& o = scene_.objects[focus_];
+      std::printf("%s object %zu: %s, centroid (%.3f, %.3f, %.3f)", scene_.file.c_str(), focus_,
+                  labelOf(o, focus_).c_str(), o.centroid.x(), o.centroid.y(), o.centroid.z());
+      if (o.fitted)
+        std::printf(", axis (%.3f, %.3f, %.3f), base (%.3f, %.3f, %.3f)", o.cylinder.axis.x(),
+                    o.cylinder.axis.y(), o.cylinder.axis.z(), o.cylinder.base.x(),
+                    o.cylinder.base.y(), o.cylinder.base.z());
+      std::printf("\n");
+      std::fflush(stdout);
+      viewer_.setCameraPosition(o.centroid.x(), o.centroid.y(), o.centroid.z() - 0.5, o.centroid.x(),
+                                o.centroid.y(), o.centroid.z(), 0, -1, 0);
+      return;
+    }
+    bool* layer = key == "t" ? &layers_.table
+                  : key == "c" ? &layers_.cylinders
+                  : key == "b" ? &layers_.boxes
+                  : key == "l" ? &layers_.labels
+                               : nullptr;
+    if (layer) {
+      *layer = !*layer;
+      viewer_.removeAllShapes();
+      viewer_.removeAllPointClouds();
+      draw();
+    }
+  }
+
+  const Settings& s_;
+  pcl::visualization::PCLVisualizer viewer_;
+  Scene scene_;
+  Layers layers_;
+  std::size_t current_{0}, focus_{0};
+  mutable std::vector<facyl_cli::JsonValue> lines_;
+  mutable bool lines_loaded_{false};
+};
+
+Settings
+parseSettings(int argc, char** argv)
+{
+  const facyl_cli::Arguments args(argc, argv,
+                                  {"--detections", "--accumulator", "--screenshot", "--size", "--model"},
+                                  {"--detect", "--compare-pcl"});
+  Settings s;
+  s.files = args.positional();
+  if (s.files.empty())
+    throw std::invalid_argument("give at least one scene (see -h)");
+  s.detections = args.text("--detections", "");
+  if (!s.detections.empty() && args.has("--detect"))
+    throw std::invalid_argument("--detect and --detections exclude each other");
+  s.detect = s.detections.empty();
+  s.compare_pcl = args.has("--compare-pcl");
+  s.accumulator = args.integer("--accumulator", -1, -1, 100000);
+  if ((s.compare_pcl || s.accumulator >= 0) && !s.detect)
+    throw std::invalid_argument("--compare-pcl and --accumulator need the objects' points: use --detect");
+  if (s.compare_pcl && s.accumulator >= 0)
+    throw std::invalid_argument("--compare-pcl and --accumulator exclude each other");
+  s.screenshot = args.text("--screenshot", "");
+  const auto size = facyl_cli::pairOption(args, "--size", kDefaultWidth, kDefaultHeight);
+  if (!(size.first >= 64 && size.second >= 64 && size.first <= 8192 && size.second <= 8192))
+    throw std::invalid_argument("--size: expected W,H with 64 <= W, H <= 8192");
+  s.width = static_cast<int>(size.first);
+  s.height = static_cast<int>(size.second);
+  if (s.detect)
+    s.classifier = facyl_cli::classifierFromOptions(args);
+  return s;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (facyl_cli::wantsHelp(argc, argv)) {
+    printHelp(argv[0]);
+    return 0;
+  }
+  Settings s;
+  try {
+    s = parseSettings(argc, argv);
+  }
+  catch (const std::exception& e) {
+    std::fprintf(stderr, "facyl_viewer: %s\n", e.what());
+    return 2;
+  }
+  const char* display = std::getenv("DISPLAY");
+  if (!display || !*display) {
+    std::fprintf(stderr, "facyl_viewer: no X display (DISPLAY is not set)%s\n",
+                 s.screenshot.empty() ? "; on a machine without a screen, render with "
+                                        "--screenshot OUT.png under xvfb-run"
+                                      : "; run it under xvfb-run (Debian: apt-get install xvfb)");
+    return 1;
+  }
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  try {
+    Viewer viewer(s);
+    if (!s.screenshot.empty()) {
+      if (!viewer.show(0))
+        return 1;
+      viewer.screenshot(s.screenshot);
+      std::printf("{\"file\":%s,\"screenshot\":%s}\n", facyl_cli::quote(s.files[0]).c_str(),
+                  facyl_cli::quote(s.screenshot).c_str());
+      return 0;
+    }
+    bool any = false;
+    for (std::size_t k = 0; k < s.files.size() && !any; ++k)
+      any = viewer.show(k);
+    if (!any)
+      return 1;
+    viewer.run();
+  }
+  catch (const std::exception& e) {
+    std::fprintf(stderr, "facyl_viewer: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
