@@ -11,6 +11,7 @@
  *   OUT/objects.csv
  */
 #include "cli.h"
+#include "cylinder_fit.h"
 #include "recognizer_options.h"
 #include "scene_options.h"
 
@@ -22,6 +23,7 @@
 #include <facyl/simulation/tabletop_scene.h>
 
 #include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 
@@ -221,13 +223,8 @@ facyl::CylinderEvidence
 uwEvidence(const pcl::PointCloud<pcl::PointXYZRGB>& cloud)
 {
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto& p : cloud)
-    xyz->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-  pcl::PointCloud<facyl::NormalCurvature>::Ptr cues(new pcl::PointCloud<facyl::NormalCurvature>);
-  facyl::NormalCurvatureEstimation<pcl::PointXYZ, facyl::NormalCurvature> est;
-  est.setInputCloud(xyz);
-  est.setKSearch(16);
-  est.compute(*cues);
+  pcl::copyPointCloud(cloud, *xyz);
+  const auto cues = facyl_cli::estimateFitCues(xyz, 16, 0, nullptr);
   facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
   hough.setInputCloud(xyz);
   hough.setInputNormals(cues);

@@ -2,6 +2,7 @@
  * facyl_fit: fit cylinders to PCD files; one JSON object per file on stdout.
  */
 #include "cli.h"
+#include "cylinder_fit.h"
 #include "pcd_input.h"
 #include "pcl_baseline.h"
 
@@ -58,15 +59,9 @@ printHelp(const char* self)
       self, default_orientations, default_accumulators, default_max_cylinders, default_k);
 }
 
-struct Settings {
+struct Settings : facyl_cli::HoughSettings {
   std::string method{default_method};
-  facyl::HoughCylinderParameters params;
-  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
-  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
-  std::size_t orientations{default_orientations};
-  std::size_t accumulators{default_accumulators};
   int k{default_k};
-  std::uint64_t seed{0};
   unsigned threads{0};
 };
 
@@ -124,17 +119,12 @@ processFile(const std::string& file, const Settings& s, bool& ok)
 
   // Normals and curvatures (the file's normals when it has them).
   pcl::StopWatch normals_watch;
-  Cues::Ptr cues(new Cues);
-  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
-  ne.setInputCloud(cloud);
-  ne.setKSearch(s.k);
-  ne.setNumberOfThreads(s.threads);
+  pcl::PointCloud<pcl::Normal>::Ptr given;
   if (hasField(blob, "normal_x") && hasField(blob, "normal_y") && hasField(blob, "normal_z")) {
-    pcl::PointCloud<pcl::Normal>::Ptr given(new pcl::PointCloud<pcl::Normal>);
+    given.reset(new pcl::PointCloud<pcl::Normal>);
     pcl::fromPCLPointCloud2(blob, *given);
-    ne.setInputNormals(given);
   }
-  ne.compute(*cues);
+  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.k, s.threads, given);
   if (cues->size() != cloud->size())
     return errorObject(file, "normal estimation failed (too few points for k = " +
                                  std::to_string(s.k) + "?)");
@@ -150,18 +140,8 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   if (s.method == "pcl-ransac") {
     models = fitPclRansac(cloud, *cues, s);
   }
-  else {
-    facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
-    hough.setParameters(s.params);
-    hough.setOrientationPrior(s.prior);
-    hough.setUpDirection(s.up);
-    hough.setNumberOfOrientations(s.orientations);
-    hough.setNumberOfAccumulators(s.accumulators);
-    hough.setSeed(s.seed);
-    hough.setInputCloud(cloud);
-    hough.setInputNormals(cues);
-    hough.segment(models); // false with no cylinder: an empty list, not an error
-  }
+  else
+    models = facyl_cli::houghFit(cloud, cues, s);
   const double fit_ms = fit_watch.getTime();
 
   using facyl_cli::number;

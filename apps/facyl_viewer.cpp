@@ -7,6 +7,7 @@
  * and exits (under xvfb-run without a screen).
  */
 #include "cli.h"
+#include "cylinder_fit.h"
 #include "json_value.h"
 #include "pcd_input.h"
 #include "pcl_baseline.h"
@@ -20,6 +21,7 @@
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/common/common.h>
+#include <pcl/common/io.h>
 #include <pcl/common/point_tests.h>
 #include <pcl/console/print.h>
 #include <pcl/conversions.h>
@@ -383,18 +385,11 @@ pclObjects(const Scene& scene, Scene& pcl_scene)
     q.is_cylinder = false;
     q.p_cylinder = std::numeric_limits<float>::quiet_NaN();
     pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
-    for (const auto i : o.indices) {
-      const auto& p = (*scene.cloud)[static_cast<std::size_t>(i)];
-      points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-    }
+    pcl::copyPointCloud(*scene.cloud, o.indices, *points);
     if (points->size() >= 20) {
-      pcl::PointCloud<facyl::NormalCurvature> cues;
-      facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
-      ne.setInputCloud(points);
-      ne.setKSearch(16);
-      ne.compute(cues);
+      const auto cues = facyl_cli::estimateFitCues(points, 16, 0, nullptr);
       pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-      pcl::copyPointCloud(cues, *normals);
+      pcl::copyPointCloud(*cues, *normals);
       facyl_cli::PclCylinderOptions options;
       options.distance_threshold = 0.005f;
       options.radius_min = 0.01f;
@@ -419,15 +414,8 @@ drawAccumulators(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, 
 {
   const ViewObject& o = scene.objects.at(id);
   pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto i : o.indices) {
-    const auto& p = (*scene.cloud)[static_cast<std::size_t>(i)];
-    points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
-  }
-  pcl::PointCloud<facyl::NormalCurvature>::Ptr cues(new pcl::PointCloud<facyl::NormalCurvature>);
-  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
-  ne.setInputCloud(points);
-  ne.setKSearch(16);
-  ne.compute(*cues);
+  pcl::copyPointCloud(*scene.cloud, o.indices, *points);
+  const auto cues = facyl_cli::estimateFitCues(points, 16, 0, nullptr);
   facyl::VotingCues voting;
   voting.resize(std::count_if(cues->begin(), cues->end(),
                               [](const auto& c) { return std::isfinite(c.normal_x); }));

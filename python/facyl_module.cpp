@@ -3,6 +3,8 @@
  * computes. Every input is checked here, before C++ sees it: ValueError / TypeError with the
  * argument's name, never a crash.
  */
+#include "../apps/cylinder_fit.h"
+
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
@@ -127,17 +129,6 @@ cylinderDict(const facyl::CylinderModel& m)
 
 // ------------------------------------------------------------------- normals, curvatures
 
-Cues::Ptr
-estimateCues(const Cloud::ConstPtr& cloud, int k)
-{
-  Cues::Ptr cues(new Cues);
-  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
-  ne.setInputCloud(cloud);
-  ne.setKSearch(k);
-  ne.compute(*cues);
-  return cues;
-}
-
 void
 checkK(int k, std::size_t points)
 {
@@ -157,7 +148,7 @@ estimateNormalsCurvatures(const py::object& points, int k)
   Cues::Ptr cues;
   {
     py::gil_scoped_release release;
-    cues = estimateCues(cloud, k);
+    cues = facyl_cli::estimateFitCues(cloud, k, 0, nullptr);
   }
   const auto n = static_cast<py::ssize_t>(cloud->size());
   py::array_t<float> normals({n, py::ssize_t(3)}), directions({n, py::ssize_t(3)}), k_max(n),
@@ -184,12 +175,9 @@ estimateNormalsCurvatures(const py::object& points, int k)
 
 // ------------------------------------------------------------------------------- fitting
 
-struct FitSettings {
-  facyl::HoughCylinderParameters params;
-  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
-  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
+/** facyl_fit's settings (its defaults but the radius limits) and k. */
+struct FitSettings : facyl_cli::HoughSettings {
   int k{16};
-  std::uint64_t seed{0};
 };
 
 FitSettings
@@ -229,30 +217,15 @@ fitSettings(const std::pair<double, double>& radius_limits, const std::string& p
   return s;
 }
 
-/** The fit of facyl_fit (same estimator, same settings): cues estimated unless \a normals. */
+/** The fit of facyl_fit (apps/cylinder_fit.h): cues estimated unless \a normals. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
          const FitSettings& s)
 {
-  Cues::Ptr cues(new Cues);
-  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
-  ne.setInputCloud(cloud);
-  ne.setKSearch(s.k);
-  if (normals)
-    ne.setInputNormals(normals);
-  ne.compute(*cues);
-  std::vector<facyl::CylinderModel> models;
+  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.k, 0, normals);
   if (cues->size() != cloud->size())
-    return models;
-  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
-  hough.setParameters(s.params);
-  hough.setOrientationPrior(s.prior);
-  hough.setUpDirection(s.up);
-  hough.setSeed(s.seed);
-  hough.setInputCloud(cloud);
-  hough.setInputNormals(cues);
-  hough.segment(models);
-  return models;
+    return {};
+  return facyl_cli::houghFit(cloud, cues, s);
 }
 
 pcl::PointCloud<pcl::Normal>::Ptr

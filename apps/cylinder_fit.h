@@ -1,0 +1,65 @@
+/*
+ * facyl: the fit that facyl_fit runs, shared with the Python module (facyl.fit_cylinders gives
+ * facyl_fit's result for the same settings): normals and curvatures, then the Hough estimator.
+ */
+#pragma once
+
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <vector>
+
+namespace facyl_cli {
+
+/** The estimator's settings as the tools expose them. */
+struct HoughSettings {
+  facyl::HoughCylinderParameters params;
+  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
+  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
+  std::size_t orientations{450};
+  std::size_t accumulators{1};
+  std::uint64_t seed{0};
+};
+
+/** Normals and curvatures of \a cloud from its \a k nearest neighbours (\a normals, when
+ * given, instead of the estimated normals); \a threads 0: all cores. The result has the
+ * cloud's size unless the estimation failed. */
+inline pcl::PointCloud<facyl::NormalCurvature>::Ptr
+estimateFitCues(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud, int k, unsigned threads,
+                const pcl::PointCloud<pcl::Normal>::ConstPtr& normals)
+{
+  pcl::PointCloud<facyl::NormalCurvature>::Ptr cues(new pcl::PointCloud<facyl::NormalCurvature>);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(k);
+  ne.setNumberOfThreads(threads);
+  if (normals)
+    ne.setInputNormals(normals);
+  ne.compute(*cues);
+  return cues;
+}
+
+/** HoughCylinderEstimation of \a cloud with \a cues and \a s; an empty list when no cylinder
+ * is found. */
+inline std::vector<facyl::CylinderModel>
+houghFit(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+         const pcl::PointCloud<facyl::NormalCurvature>::ConstPtr& cues, const HoughSettings& s)
+{
+  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
+  hough.setParameters(s.params);
+  hough.setOrientationPrior(s.prior);
+  hough.setUpDirection(s.up);
+  hough.setNumberOfOrientations(s.orientations);
+  hough.setNumberOfAccumulators(s.accumulators);
+  hough.setSeed(s.seed);
+  hough.setInputCloud(cloud);
+  hough.setInputNormals(cues);
+  std::vector<facyl::CylinderModel> models;
+  hough.segment(models); // false with no cylinder: an empty list, not an error
+  return models;
+}
+
+} // namespace facyl_cli
