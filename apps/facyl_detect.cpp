@@ -41,6 +41,7 @@ printHelp(const char* self)
     "                         <stem>-<k>.png when scenes share a name, k from 1)\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
+    "  --verbose              what each step found, on stderr\n"
     "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad "
     "usage.\n",
     self, facyl_cli::recognizerOptionsHelp());
@@ -124,6 +125,7 @@ struct Settings {
   std::string overlay, clusters_dir;
   int repeat{1};
   bool many{false};
+  bool verbose{false}; ///< --verbose: PCL's debug messages (what the segmentation found)
   facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
 };
 
@@ -356,7 +358,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
                       {"--camera", "--overlay", "--save-clusters", "--repeat"}),
-    facyl_cli::recognizerSwitches());
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose"}));
   files = args.positional();
   if (files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
@@ -378,6 +380,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.overlay = args.text("--overlay", "");
   s.clusters_dir = args.text("--save-clusters", "");
   s.repeat = static_cast<int>(args.integer("--repeat", 1, 1, 1000));
+  s.verbose = args.has("--verbose");
   s.many = files.size() > 1;
   if (!s.many && !s.overlay.empty()) {
     const auto parent = std::filesystem::path(s.overlay).parent_path();
@@ -410,7 +413,7 @@ main(int argc, char** argv)
   }
   // PCL's warnings about a file (e.g. a cloud without colour) would drown the output; the
   // errors that explain a failed scene stay.
-  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  pcl::console::setVerbosityLevel(s.verbose ? pcl::console::L_DEBUG : pcl::console::L_ERROR);
   const std::vector<std::string> names = outputNames(files);
   bool all_ok = true;
   for (std::size_t k = 0; k < files.size(); ++k) {

@@ -11,6 +11,7 @@
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/segmentation_score.h>
+#include <facyl/simulation/frame_roll.h>
 #include <facyl/simulation/tabletop_scene.h>
 
 #include <pcl/common/point_tests.h>
@@ -215,6 +216,7 @@ struct Options {
   std::string sensor{"kinect"};
   facyl::TabletopSceneParameters scene; ///< layout, sensor and image options; seed per scene
   std::string mosd, csv;
+  int roll{0}; ///< quarter turns (clockwise) of the camera about its optical axis
   facyl::TabletopRecognizerParameters params;
   facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
 };
@@ -333,6 +335,21 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
                 percentile(radius_by[k], 0.9));
 }
 
+/** \a scene as a camera rolled by \a quarter_turns would have seen it: the frame, the
+ * per-pixel ground truth and the table plane in the rolled camera's frame. */
+void
+rollScene(facyl::RenderedScene& scene, int quarter_turns)
+{
+  const int w = static_cast<int>(scene.cloud.width), h = static_cast<int>(scene.cloud.height);
+  scene.cloud = facyl::rollFrame(scene.cloud, quarter_turns);
+  auto ids = scene.object_id;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[facyl::rolledIndex(i, w, h, quarter_turns)] = scene.object_id[i];
+  scene.object_id = std::move(ids);
+  for (int t = 0; t < ((quarter_turns % 4) + 4) % 4; ++t) // (x, y) -> (-y, x)
+    scene.table_plane.head<2>() = Eigen::Vector2f(-scene.table_plane[1], scene.table_plane[0]);
+}
+
 int
 evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
 {
@@ -344,7 +361,9 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   for (std::size_t k = 0; k < opt.sim; ++k) {
     facyl::TabletopSceneParameters sp = opt.scene;
     sp.seed = opt.seed + k;
-    const facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
+    facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
+    if (opt.roll)
+      rollScene(scene, opt.roll);
     Cloud::Ptr cloud(new Cloud(scene.cloud));
     rec.setInputCloud(cloud);
     std::vector<facyl::RecognizedObject> objects;
@@ -401,10 +420,13 @@ mosdObject(std::uint32_t label)
 }
 
 bool
-loadMosd(const std::string& file, pcl::PointCloud<pcl::PointXYZRGBL>& labelled, Cloud& cloud)
+loadMosd(const std::string& file, int roll, pcl::PointCloud<pcl::PointXYZRGBL>& labelled,
+         Cloud& cloud)
 {
   if (pcl::io::loadPCDFile(file, labelled) < 0)
     return false;
+  if (roll)
+    labelled = facyl::rollFrame(labelled, roll);
   pcl::copyPointCloud(labelled, cloud);
   return true;
 }
@@ -454,7 +476,7 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
         continue;
       pcl::PointCloud<pcl::PointXYZRGBL> labelled;
       Cloud::Ptr cloud(new Cloud);
-      if (!loadMosd(file, labelled, *cloud)) {
+      if (!loadMosd(file, opt.roll, labelled, *cloud)) {
         std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s\n", file.c_str());
         status = 1;
         continue;
@@ -515,7 +537,7 @@ evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
     const std::string file = (std::filesystem::path(opt.mosd) / (scene_name + ".pcd")).string();
     pcl::PointCloud<pcl::PointXYZRGBL> labelled;
     Cloud::Ptr cloud(new Cloud);
-    if (!loadMosd(file, labelled, *cloud)) {
+    if (!loadMosd(file, opt.roll, labelled, *cloud)) {
       std::fprintf(stderr, "facyl_tabletop_eval: cannot read %s\n", file.c_str());
       status = 1;
       continue;
@@ -594,12 +616,15 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [--sim N] [--first-seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
-    "          [--resolution WxH] [--dropout P] [--mosd DIR] [--csv FILE] [recognizer options]\n"
+    "          [--resolution WxH] [--dropout P] [--mosd DIR] [--roll DEG] [--csv FILE]\n"
+    "          [recognizer options]\n"
     "Runs TabletopCylinderRecognizer on N simulated scenes (seeds S.., default 1000) and/or\n"
     "the mOSD learn scenes and prints: segmentation (objects recovered as one segment with\n"
     "IoU >= 0.5, merged, split; in simulation also for the objects touching another), cylinder\n"
     "precision/recall for both scores at several thresholds, radius and axis errors of the\n"
-    "detected cylinders, and the stage timing. --csv writes one row per object.\n%s",
+    "detected cylinders, and the stage timing. --csv writes one row per object. --roll turns\n"
+    "every frame (and its ground truth) as a camera rolled by 90, 180 or 270 degrees clockwise\n"
+    "about its optical axis would have taken it.\n%s",
     self, facyl_cli::recognizerOptionsHelp());
 }
 
@@ -612,7 +637,7 @@ parseOptions(int argc, char** argv)
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
                       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                                         {"--sim", "--first-seed", "--layout", "--sensor",
-                                         "--mosd", "--csv"})),
+                                         "--mosd", "--csv", "--roll"})),
     facyl_cli::recognizerSwitches());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
@@ -629,6 +654,10 @@ parseOptions(int argc, char** argv)
   facyl_cli::applySceneImageOptions(args, opt.scene);
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");
+  const long long roll = args.integer("--roll", 0, 0, 270);
+  if (roll % 90 != 0)
+    throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
+  opt.roll = static_cast<int>(roll / 90);
   facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
   opt.classifier = facyl_cli::classifierFromOptions(args);
   if (opt.sim == 0 && opt.mosd.empty())

@@ -279,6 +279,8 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
         if (source[static_cast<std::size_t>(k)] >= 0)
           c.points.push_back(source[static_cast<std::size_t>(k)]);
     c.support = c.points.size() * cell;
+    PCL_DEBUG("[facyl::TabletopSegmentation] region group: normal (%.3f %.3f %.3f) d %.3f, %zu "
+              "points\n", c.plane[0], c.plane[1], c.plane[2], c.plane[3], c.support);
     if (c.support >= params_.min_plane_points)
       candidates.push_back(std::move(c));
   }
@@ -477,6 +479,11 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
     // table.
     const float region = regionArea(candidates[s], support.frame);
     const float area = elevated ? region : polygonArea(support.polygon);
+    PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d %.3f, "
+              "%zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
+              s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
+              support.inliers.indices.size(), polygonArea(support.polygon), region,
+              elevated ? ", elevated" : "");
     if (support.polygon.size() >= 3 &&
         (largest || (area >= params_.min_support_area &&
                      region >= 0.25f * params_.min_support_area)))
