@@ -198,7 +198,7 @@ writeScene(std::ostream& out, const std::string& file, const Cloud& cloud,
   const auto& tc = rec.getTableCoefficients().values;
   out << "{\"file\":" << facyl_cli::quote(file) << ",\"organized\":"
       << (cloud.isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":"
-      << plane(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3]))
+      << (tc.size() == 4 ? plane(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3])) : "null")
       << ",\"found\":" << (rec.tableFound() ? "true" : "false") << "},\"supports\":[";
   for (std::size_t k = 0; k < supports.size(); ++k)
     out << (k ? "," : "") << "{\"coefficients\":" << plane(supports[k].plane)
@@ -325,7 +325,7 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   std::vector<facyl::RecognitionTiming> timings;
   for (int r = 0; r < s.repeat; ++r) {
     if (!rec.recognize(objects))
-      return fail("no table found: no large plane (see the message above)");
+      return fail("recognition failed (see the message above)");
     timings.push_back(rec.getTiming());
   }
   // Median over the repetitions, by total.

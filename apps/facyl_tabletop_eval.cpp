@@ -380,14 +380,22 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       object_counts.push_back(static_cast<double>(objects.size()));
     }
     const auto& c = rec.getTableCoefficients().values;
-    if (Eigen::Vector3f(c[0], c[1], c[2]).dot(scene.table_plane.head<3>()) < std::cos(0.1f) ||
+    if (c.size() != 4 ||
+        Eigen::Vector3f(c[0], c[1], c[2]).dot(scene.table_plane.head<3>()) < std::cos(0.1f) ||
         std::abs(c[3] - scene.table_plane[3]) > 0.03f) {
-      ++wrong_plane;
-      std::fprintf(stderr, "scene %llu: table (%.3f %.3f %.3f %.3f) is not the true one "
+      if (c.size() != 4) {
+        ++wrong_plane;
+        std::fprintf(stderr, "scene %llu: no support found\n",
+                     static_cast<unsigned long long>(sp.seed));
+      }
+      else {
+        ++wrong_plane;
+        std::fprintf(stderr, "scene %llu: table (%.3f %.3f %.3f %.3f) is not the true one "
                            "(%.3f %.3f %.3f %.3f)\n",
                    static_cast<unsigned long long>(sp.seed), c[0], c[1], c[2], c[3],
                    scene.table_plane[0], scene.table_plane[1], scene.table_plane[2],
                    scene.table_plane[3]);
+      }
     }
     const std::vector<int> truth = truthVector(*cloud, [&](std::size_t i) {
       return scene.object_id[i] >= 2 ? static_cast<int>(scene.object_id[i]) : 0;

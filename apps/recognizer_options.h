@@ -71,14 +71,17 @@ recognizerOptionsHelp()
          "                         1: off)\n"
          "Segmentation:\n"
          "  --up x,y,z             gravity's opposite in the cloud's frame: supports are then\n"
-         "                         the planes within 20 degrees of horizontal (default: the\n"
-         "                         camera is taken to be upright, image y down)\n"
-         "  --support S            standing (default: the plane most objects stand on, each\n"
+         "                         the planes within 20 degrees of horizontal (default:\n"
+         "                         unknown; the supports are the planes objects stand on,\n"
+         "                         whatever the camera's roll)\n"
+         "  --support S            standing (default: the planes most objects stand on, each\n"
          "                         object on the plane under it) | largest (the largest plane)\n"
          "  --clustering C         edge-aware (default: cut at depth jumps and concave\n"
          "                         creases, join parts seen around an occluder) | euclidean\n"
-         "  --plane-distance D     support inlier distance in m (default 0.015)\n"
-         "  --height-limits A,B    object points lie A..B m above the support (0.01,0.5)\n"
+         "  --plane-distance D     support inlier band in m (default 0: measured on each\n"
+         "                         support, 3 sigma of its points' distances by range)\n"
+         "  --height-limits A,B    object points lie A..B m above the support and above its\n"
+         "                         band (default 0,0.5)\n"
          "  --cluster-tolerance D  Euclidean clustering tolerance in m (default 0.02)\n"
          "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n";
 }
@@ -119,7 +122,7 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(
     "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1, 20));
   auto& g = p.segmentation;
-  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance, 1e-4, 1.0));
+  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance, 0.0, 1.0));
   const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
   if (!(heights.first >= -10 && heights.second <= 10))
     throw std::invalid_argument("--height-limits: expected -10 <= A < B <= 10 (m)");

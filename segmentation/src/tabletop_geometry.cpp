@@ -144,61 +144,6 @@ estimatePinhole(const Eigen::Matrix3Xf& points, const Eigen::Matrix2Xf& pixels, 
   return camera.valid() && std::isfinite(camera.cx) && std::isfinite(camera.cy);
 }
 
-// ---------------------------------------------------------------- support planes
-
-std::vector<std::vector<std::size_t>>
-groupCoplanar(const std::vector<Eigen::Vector4f>& planes, const std::vector<std::size_t>& order,
-              float angle, float distance)
-{
-  std::vector<std::vector<std::size_t>> groups;
-  const float cos_max = std::cos(angle);
-  for (const std::size_t i : order) {
-    bool joined = false;
-    for (auto& g : groups) {
-      const Eigen::Vector4f& lead = planes[g.front()];
-      if (lead.head<3>().dot(planes[i].head<3>()) >= cos_max &&
-          std::abs(lead[3] - planes[i][3]) <= distance) {
-        g.push_back(i);
-        joined = true;
-        break;
-      }
-    }
-    if (!joined)
-      groups.push_back({i});
-  }
-  return groups;
-}
-
-HeightProfile
-heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, float min_height,
-              float max_height)
-{
-  HeightProfile h;
-  if (points.cols() == 0)
-    return h;
-  std::vector<float> heights(static_cast<std::size_t>(points.cols()));
-  std::size_t in_band = 0;
-  const Eigen::Vector3f n = plane.head<3>();
-  const Eigen::Vector3f e1 = n.unitOrthogonal(), e2 = n.cross(e1);
-  Eigen::AlignedBox2f box;
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    const float z = n.dot(points.col(i)) + plane[3];
-    heights[static_cast<std::size_t>(i)] = z;
-    in_band += z >= min_height && z <= max_height;
-    box.extend(Eigen::Vector2f(e1.dot(points.col(i)), e2.dot(points.col(i))));
-  }
-  h.extent = box.diagonal().norm();
-  const auto at = [&heights](double q) {
-    const auto k = static_cast<std::size_t>(q * static_cast<double>(heights.size() - 1));
-    std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k), heights.end());
-    return heights[k];
-  };
-  h.base = at(0.02);
-  h.top = at(0.98);
-  h.in_band = static_cast<float>(in_band) / static_cast<float>(heights.size());
-  return h;
-}
-
 Eigen::Affine3f
 sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation)
 {

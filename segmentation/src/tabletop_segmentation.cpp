@@ -12,8 +12,10 @@ std::string
 validate(const TabletopSegmentationParameters& p)
 {
   std::ostringstream why;
-  if (!(p.plane_distance > 0.f))
-    why << "plane distance " << p.plane_distance << " must be > 0";
+  if (!(p.plane_distance >= 0.f) || !std::isfinite(p.plane_distance))
+    why << "plane distance " << p.plane_distance << " must be >= 0 (0: measured)";
+  else if (!(p.band_factor >= 1.f && p.band_factor <= 10.f))
+    why << "band factor " << p.band_factor << " must be in [1, 10]";
   else if (!(p.plane_angle > 0.f && p.plane_angle < 1.58f))
     why << "plane angle " << p.plane_angle << " must be in (0, pi/2]";
   else if (p.min_plane_points < 3)
@@ -37,6 +39,8 @@ validate(const TabletopSegmentationParameters& p)
     why << "max_support_tilt " << p.max_support_tilt << " must be in (0, pi/2]";
   else if (!(p.min_support_area >= 0.f) || !std::isfinite(p.min_support_area))
     why << "min_support_area must be >= 0";
+  else if (!(p.min_shelf_area >= 0.f) || !std::isfinite(p.min_shelf_area))
+    why << "min_shelf_area must be >= 0";
   else if (!(p.contact_height > 0.f) || !std::isfinite(p.contact_height))
     why << "contact_height must be > 0";
   else if (const std::string o = validate(p.objects); !o.empty())

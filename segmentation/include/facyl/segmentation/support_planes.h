@@ -7,9 +7,105 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace facyl {
+
+/** \brief How far the points of a support lie from its plane, by their range from the
+ * sensor: the noise and bias measured on the support itself. Depth noise of triangulating
+ * sensors (structured light, stereo) grows with range^2, a time-of-flight sensor's more
+ * slowly, and a real table is not quite a plane (a sensor's bias bends it, more with range and
+ * towards the image border): no fixed band holds for every camera, so each support carries
+ * its own.
+ *
+ * sigma(range) is a robust scale (1.4826 x the median |residual|, about the plane: bias
+ * counts) in bins of range, non-decreasing with range; it is interpolated between bins,
+ * constant below the nearest and grows with range^2 beyond the farthest (the fastest growth
+ * of common sensors). A band made by fixedBand() has one half-width everywhere. */
+struct DepthBand {
+  std::vector<float> ranges; ///< bin centres (m from the sensor), ascending; empty: fixed
+  std::vector<float> sigmas; ///< the residuals' robust scale in each bin (m)
+  float factor{3.f};         ///< half-width = factor x sigma
+  float fixed{0.f};          ///< > 0: the half-width at every range
+
+  /** \brief The residuals' robust scale at \a range (m); the fixed half-width / factor for
+   * a fixed band. */
+  float
+  sigma(float range) const;
+  /** \brief Half-width of the band at \a range: a point is on the support when its
+   * distance from the plane is at most this. */
+  float
+  halfWidth(float range) const
+  {
+    return fixed > 0.f ? fixed : factor * sigma(range);
+  }
+};
+
+/** \brief A band of the same half-width \a half_width (> 0) at every range. */
+DepthBand
+fixedBand(float half_width);
+
+/** \brief The DepthBand of signed \a residuals (distances from a plane) measured at \a
+ * ranges (at most 4000 of them, evenly): up to 8 bins of equal counts (at least 150 samples
+ * each), each with 1.4826 x the
+ * median |residual| (at least \a min_sigma), made non-decreasing with range. Pairs with a
+ * non-finite value are skipped. With no finite pair, a fixed band of factor x min_sigma. */
+DepthBand
+estimateDepthBand(const std::vector<float>& ranges, const std::vector<float>& residuals,
+                  float factor, float min_sigma);
+
+/** \brief Settings of refinePlaneRegion. */
+struct PlaneRegionSettings {
+  float band_factor{3.f}; ///< half-width of the band in sigmas (DepthBand::factor)
+  float fixed_band{0.f};  ///< > 0: the band's half-width, not measured
+  /** Numerical floor of the measured sigma (m): keeps a noise-free (simulated) plane's band
+   * above float rounding. */
+  float min_sigma{1e-4f};
+  /** Normals of region cells lie within this angle of the plane's (rad): 3 x the median
+   * angle of the seed's normals, at least min_angle; a seed whose normals spread more than
+   * max_angle is not a plane (a dome, the top of a can). */
+  float min_angle{0.05f};
+  float max_angle{0.25f};
+  int iterations{4}; ///< at most this many refits
+};
+
+/** \brief A plane, its band and the cells that lie on it. */
+struct PlaneRegion {
+  Eigen::Vector4f plane{Eigen::Vector4f::Zero()}; ///< unit normal towards the viewpoint
+  DepthBand band;
+  float max_angle{0.f};              ///< the normal tolerance used (rad)
+  std::vector<std::uint8_t> member;  ///< per cell: 1 on the plane
+  std::size_t members{0};
+};
+
+/** \brief Grows a seed region into a whole support plane, with a band measured from the data
+ * (robust to depth noise and bias: regions of a noisy or slightly bent table found apart are
+ * one plane at the end). From the \a seed cells: fit the plane, measure its band on the
+ * cells' raw \a samples and the spread of their normals; then take as members every cell
+ * within the band whose normal agrees, refit (least squares, cells weighted by 1 /
+ * sigma(range)^2) and re-measure the band (at most twice the seed's: a region does not run
+ * away into a neighbouring surface); repeat until the members stop changing.
+ * \param cells    3 x n positions (block means of an image grid, or sampled points)
+ * \param normals  3 x n unit normals of the cells (non-finite: never a member)
+ * \param samples  3 x n one raw measurement per cell, for the band (non-finite: the cell's
+ *                 position is used)
+ * \param seed     per cell, 1 for the cells of the seed region
+ * \param viewpoint the sensor origin: ranges are measured from it, normals point to its side
+ * \param excluded  per cell, 1 for cells that are never members (those of other planes);
+ *                  nullptr: none
+ * \return false when the region does not span a plane or its normals spread too much. */
+bool
+refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
+                  const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
+                  const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& settings,
+                  PlaneRegion& region, const std::vector<std::uint8_t>* excluded = nullptr);
+
+/** \brief Least-squares plane through the columns of \a points with \a weights (>= 0), unit
+ * normal pointing to \a viewpoint's side. \return false when they do not span a plane. */
+bool
+fitWeightedPlane(const Eigen::Matrix3Xf& points, const Eigen::VectorXf& weights,
+                 const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane);
 
 /** \brief Groups planes (a, b, c, d; unit normals on the same side, e.g. towards the sensor)
  * that are one plane: normals within \a angle (rad) and offsets within \a distance. Planes are
@@ -32,6 +128,13 @@ struct HeightProfile {
 HeightProfile
 heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, float min_height,
               float max_height);
+
+/** \brief HeightProfile of \a points over \a plane whose object band starts, for each point,
+ * at the larger of \a min_height and the plane's \a band at the point's range from \a
+ * viewpoint (the points clearly above the support), and ends at \a max_height. */
+HeightProfile
+heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, const DepthBand& band,
+              const Eigen::Vector3f& viewpoint, float min_height, float max_height);
 
 /** \brief A cluster stands on a plane when it reaches down to it (base <= contact) and is
  * whole inside the object band, a box max_height high and wide (top below max_height -

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/segmentation/object_segmentation.h>
+#include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 
 #include <pcl/ModelCoefficients.h>
@@ -23,13 +24,25 @@ namespace facyl {
 
 /** \brief Settings of TabletopSegmentation (lengths in cloud units, metres for sensors). */
 struct TabletopSegmentationParameters {
-  float plane_distance{0.015f};   ///< table inlier distance, > 0
-  float plane_angle{0.05f};       ///< organized: normal deviation inside the plane (rad), > 0
+  /** Half-width of a support's inlier band (m), >= 0. 0 (default): measured on each support
+   * from its own points, as band_factor x the robust scale of their distances from the plane
+   * at each range from the sensor (see DepthBand): the noise and bias of the sensor at hand,
+   * growing with range. > 0: this band at every range (the behaviour of earlier versions,
+   * 0.015 there). */
+  float plane_distance{0.f};
+  float band_factor{3.f};         ///< measured bands: half-width in robust sigmas, in [1, 10]
+  /** Organized: regions of the plane search grow between neighbours whose normals differ by
+   * less than this (rad, > 0); a seed setting, the support's own normal tolerance is measured
+   * (see PlaneRegionSettings). */
+  float plane_angle{0.05f};
   /** A plane needs this many points (full resolution) to be found; supports must also be
    * min_support_area large. */
   std::size_t min_plane_points{1000};
-  float min_height{0.01f};        ///< objects: signed height above the support in
-  float max_height{0.5f};         ///< [min_height, max_height], min < max
+  /** Objects are the points between min_height and max_height above their support, and above
+   * its band (the points clearly off the support at their range; see plane_distance):
+   * min_height (m, default 0) only raises the band's lower end. min < max. */
+  float min_height{0.f};
+  float max_height{0.5f};
   /** How the object points are split into objects:
    * - EdgeAware (default): organized clouds are cut at depth discontinuities and concave
    *   creases, then fragments, enclosed parts and parts seen on both sides of an occluder are
@@ -54,10 +67,16 @@ struct TabletopSegmentationParameters {
    * - LargestPlane: the plane with the most points is the table (the paper's choice). */
   enum class Support { LargestPlane, ObjectsStanding } support{Support::ObjectsStanding};
   float max_support_tilt{0.35f};  ///< rad, with an up direction: support normal vs up
-  /** Supports are at least this large (m^2, the convex hull of their points): smaller planes
-   * are faces of objects (a box top), and their points stay object points. */
-  float min_support_area{0.1f};
-  /** A cluster stands on a support when it reaches down to within this height of it. */
+  /** Supports are at least this large (m^2, the convex hull of their points; a stool or a
+   * chair-arm tablet shows 0.05 m^2): smaller planes are faces of objects, and their points
+   * stay object points. */
+  float min_support_area{0.04f};
+  /** A plane inside the object band of a larger parallel support (a shelf, a box top) is a
+   * support only when the region found on it is at least this large (m^2): smaller ones are
+   * the tops of objects standing on the larger support. */
+  float min_shelf_area{0.1f};
+  /** A cluster stands on a support when it reaches down to within this height of the
+   * support's band (m): the lowest visible points of an object are above its contact. */
   float contact_height{0.03f};
   /** Organized: the plane search works on blocks of step x step pixels, in [0, 16]; 0
    * (default): the image width / 160 (4 at VGA), so that the search sees the same angular
@@ -70,6 +89,11 @@ struct TabletopSegmentationParameters {
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
 std::string
 validate(const TabletopSegmentationParameters& params);
+
+/** \brief The distance threshold (m, scaled by depth^2 inside PCL) with which
+ * pcl::OrganizedMultiPlaneSegmentation grows the seed regions of the plane search when
+ * plane_distance is 0: it only makes seeds; each support's band is measured on it afterwards. */
+constexpr float kSeedDistance = 0.015f;
 
 /** \brief The sensor pose of \a cloud (sensor_origin_, sensor_orientation_), checked against an
  * even sample of its points (see plausibleSensorPose). */
@@ -143,7 +167,10 @@ struct SupportPlane {
   /** z = the plane's normal (up), origin = centre of its points; maps plane coordinates to
    * the cloud's. */
   Eigen::Affine3f frame{Eigen::Affine3f::Identity()};
-  pcl::PointIndices inliers;            ///< points within plane_distance (full resolution)
+  pcl::PointIndices inliers;            ///< points within the band (full resolution)
+  /** Distance from the plane that its points keep, by range from the sensor: the support's
+   * measured noise and bias (or the fixed plane_distance). */
+  DepthBand band;
   std::vector<Eigen::Vector2f> polygon; ///< convex hull of the inliers, plane coordinates
   std::size_t objects{0};               ///< clusters assigned to it
   std::size_t standing_points{0};       ///< points of the clusters standing on it
@@ -154,16 +181,24 @@ struct SupportPlane {
  * Candidate planes: organized clouds (at least 16 blocks wide and high) use
  * pcl::IntegralImageNormalEstimation and pcl::OrganizedMultiPlaneSegmentation on a grid of
  * blocks of plane_step pixels (each cell the mean of its pixels with depth, so missing pixels
- * do not break the normals), coplanar regions are joined; unorganized clouds (and narrower
- * organized ones: a LiDAR's few rings) use pcl::RandomSample, pcl::NormalEstimation and repeated
- * pcl::SACSegmentationFromNormals (SACMODEL_NORMAL_PLANE). Each candidate is refitted on its
- * points. Objects are the points within [min_height, max_height] above a candidate and on no
- * candidate, clustered (see Clustering). A cluster belongs to the nearest candidate under it
- * when at least min_hull_share of its points lie over that candidate's convex hull (the prism
- * test of pcl::ExtractPolygonalPrismData, per cluster, so objects at the border of the visible
- * table stay whole); clusters that hold up another candidate (table legs) are not objects. The
- * table is the candidate with the most object points standing on it; when nothing stands on any
- * candidate, the largest one (tableFound() is then false).
+ * do not break the normals) for seed regions; unorganized clouds (and narrower organized ones:
+ * a LiDAR's few rings) use pcl::RandomSample, pcl::NormalEstimation and repeated
+ * pcl::SACSegmentation for seeds. Each seed grows into a whole plane with its own band
+ * (refinePlaneRegion: the noise and bias measured on it, by range; regions of one noisy or
+ * slightly bent table are one plane). Objects are the points between the band and max_height
+ * above a candidate and on no candidate, clustered (see Clustering). A cluster belongs to the
+ * nearest candidate under it when at least min_hull_share of its points lie over that
+ * candidate's convex hull (the prism test of pcl::ExtractPolygonalPrismData, per cluster, so
+ * objects at the border of the visible table stay whole); clusters that hold up another
+ * candidate (table legs) are not objects.
+ *
+ * Which family of parallel planes holds the supports is decided by the objects standing on
+ * them (the family with the most object points standing on its planes), so that any camera
+ * roll works without an up direction; an upright camera (supports facing the top of the image)
+ * only breaks ties. The table is the candidate of that family with the most object points
+ * standing on it; when nothing stands on any, the largest one (tableFound() is then false). A
+ * frame without any support (a wall, a close-up) still gets its objects: the compact segments
+ * off the large planes, with support -1, tableFound() false and empty table coefficients.
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
@@ -171,9 +206,9 @@ struct SupportPlane {
  * std::vector<facyl::TabletopCluster> clusters;
  * if (seg.segment(clusters)) { seg.getTableCoefficients(); seg.getSupports(); ... }
  * \endcode
- * Bad input (no cloud, no finite point, no plane, invalid parameters) is reported with
- * PCL_ERROR and makes segment() return false with empty outputs. segment() is not reentrant on
- * one object; distinct objects may run concurrently.
+ * Bad input (no cloud, no finite point, invalid parameters) is reported with PCL_ERROR and
+ * makes segment() return false with empty outputs. segment() is not reentrant on one object;
+ * distinct objects may run concurrently.
  */
 template <typename PointT>
 class TabletopSegmentation : public pcl::PCLBase<PointT> {
@@ -249,7 +284,7 @@ public:
     return up_;
   }
 
-  /** \brief Runs the segmentation. \return false (with PCL_ERROR) if no plane was found. */
+  /** \brief Runs the segmentation. \return false (with PCL_ERROR) on bad input. */
   bool
   segment(std::vector<TabletopCluster>& clusters);
 
@@ -259,7 +294,8 @@ public:
   void
   transformResults(const Eigen::Affine3f& t, std::vector<TabletopCluster>& clusters);
 
-  /** \brief Supports of the last run that hold objects, and the table (always there). */
+  /** \brief Supports of the last run that hold objects, and the table (there unless the
+   * frame showed no support at all). */
   const std::vector<SupportPlane>&
   getSupports() const
   {
@@ -272,19 +308,21 @@ public:
   {
     return focal_;
   }
-  /** \brief Index of the table in getSupports(). */
+  /** \brief Index of the table in getSupports() (0 when there is none). */
   std::size_t
   getTableIndex() const
   {
     return table_;
   }
-  /** \brief False when no object stands on any plane: the table is then the largest plane. */
+  /** \brief False when no object stands on any plane: the table is then the largest plane,
+   * or there is none (getSupports() empty). */
   bool
   tableFound() const
   {
     return table_found_;
   }
-  /** \brief Table plane (a, b, c, d), unit normal towards the sensor (SACMODEL_PLANE layout). */
+  /** \brief Table plane (a, b, c, d), unit normal towards the sensor (SACMODEL_PLANE layout),
+   * in the cloud's frame; no values when the frame showed no support. */
   const pcl::ModelCoefficients&
   getTableCoefficients() const
   {
@@ -311,16 +349,29 @@ public:
   }
 
 private:
-  /** A candidate plane: coefficients and the points that found it (grid or sample). */
+  /** A candidate plane: coefficients, band and the points of the region found on it. */
   struct Candidate {
-    Eigen::Vector4f plane;
-    pcl::Indices points; ///< input indices
+    Eigen::Vector4f plane{Eigen::Vector4f::Zero()};
+    DepthBand band;
+    pcl::Indices points;    ///< input indices, one per cell of the region (grid or sample)
     std::size_t support{0}; ///< full-resolution points it stands for
   };
-  /** Where a cluster goes among a family of supports. */
+  /** A point above some candidate: the candidates it lies on and above (bit masks). */
+  struct Above {
+    pcl::index_t index;
+    std::uint8_t on, above;
+  };
+  /** Where a cluster goes among the supports. */
   struct Placement {
     int support{-1};      ///< index into supports_, -1: none (not over one, or a leg)
     bool standing{false}; ///< reaches down to it and is whole in its object band
+  };
+  /** The supports and objects of one family of parallel candidates. */
+  struct Trial {
+    std::vector<SupportPlane> supports;
+    std::vector<TabletopCluster> clusters;
+    std::size_t table{0};
+    std::size_t standing{0}; ///< object points standing on the supports
   };
 
   /** The block size of the plane search on organized input (see plane_step). */
@@ -333,28 +384,66 @@ private:
   /** segment() on a cloud in the sensor's frame (identity sensor pose). */
   bool
   segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
-  bool
+  /** The plane-search grid of an organized input: each cell the mean of the pixels of its
+   * block with depth near the first one's; \a source: each cell's first pixel (-1: none). */
+  void
+  planeGrid(pcl::PointCloud<pcl::PointXYZ>& grid, std::vector<pcl::index_t>& source) const;
+  void
   findPlanesOrganized(std::vector<Candidate>& candidates);
-  bool
+  void
   findPlanesUnorganized(std::vector<Candidate>& candidates);
-  /** Least-squares refit; supports are large and (with an up direction) horizontal. */
+  /** How seeds grow into planes: the band measured, or plane_distance. */
+  PlaneRegionSettings
+  regionSettings() const;
+  /** Grows \a seed (cells of \a cells) into a candidate; cells already \a taken by earlier
+   * candidates stay with them, the new ones are marked. \a source maps cells to input
+   * indices, \a cell_points is the number of pixels a cell stands for.
+   * \return false when the region is not a plane of min_plane_points. */
+  bool
+  growCandidate(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
+                const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
+                const std::vector<pcl::index_t>& source, std::size_t cell_points,
+                std::vector<std::uint8_t>& taken, Candidate& out) const;
+  /** Supports span a plane that does not pass by the sensor, are not a part of a larger
+   * candidate, and (with an up direction) are horizontal. */
   void
   keepSupportCandidates(std::vector<Candidate>& candidates) const;
-  /** One pass over the points: each candidate's inliers; the candidates large enough are
-   * the supports; the object band above them. */
+  /** One pass over the points: each candidate's inliers (in \a all) and the points above
+   * some candidate. */
   void
-  classifyPoints(const std::vector<Candidate>& candidates, pcl::Indices& band);
-  /** The candidates (indices) of the family of parallel planes that holds the supports. */
-  std::vector<std::size_t>
-  supportFamily(const std::vector<Candidate>& candidates,
-                const std::vector<SupportPlane>& all) const;
+  classifyPoints(const std::vector<Candidate>& candidates, std::vector<SupportPlane>& all,
+                 std::vector<Above>& above) const;
+  /** Families of parallel candidates, those an upright camera would see facing up first,
+   * each by its number of points; at most three. \a agreed: the first one also has the most
+   * points. */
+  std::vector<std::vector<std::size_t>>
+  rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all,
+               bool& agreed) const;
+  /** The supports of \a family (large enough, see min_support_area) and the objects on
+   * them. \a stride 1: at full resolution (the family's planes are moved out of \a all);
+   * larger: only the standing points counted, on every stride-th pixel and row (to compare
+   * families). */
+  Trial
+  tryFamily(const std::vector<std::size_t>& family, const std::vector<Candidate>& candidates,
+            std::vector<SupportPlane>& all, const std::vector<Above>& above, int stride);
+  /** The pixel stride of the coarse trials of families (1 for point sets). */
+  int
+  coarseStride() const;
   /** Area of the convex hull of the points that found \a c, in \a frame's plane. */
   float
   regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;
-  /** Convex hull of a support's points, in its plane's coordinates: on organized clouds
-   * those near the region found as candidate \a c (every point when nullptr). */
+  /** Convex hull of a support's \a inliers, in the coordinates of its plane's \a frame: on
+   * organized clouds those near the region found as candidate \a c (every point when
+   * nullptr). */
   std::vector<Eigen::Vector2f>
-  supportHull(const SupportPlane& support, const Candidate* c) const;
+  supportHull(const Eigen::Affine3f& frame, const pcl::Indices& inliers, const Candidate* c) const;
+  /** The object points split into clusters (see Clustering). */
+  void
+  cluster(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  /** cluster() on a grid of every \a stride-th pixel and row of an organized input (\a objects
+   * on that grid): the clusters hold those pixels only. */
+  void
+  clusterCoarse(const pcl::Indices& objects, int stride, std::vector<pcl::Indices>& out) const;
   void
   clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   void
@@ -364,12 +453,20 @@ private:
    * organized frame; each point takes its pixel's segment. */
   void
   segmentProjected(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
-  /** The support of a cluster (points \a pts) among the supports of \a family. */
+  /** The support of a cluster (points \a pts) among supports_. */
   Placement
-  place(const Eigen::Matrix3Xf& pts, const std::vector<std::size_t>& family) const;
-  /** Each cluster to the support under it; the table; supports without objects dropped. */
+  place(const Eigen::Matrix3Xf& pts) const;
+  /** Each cluster to the support under it; the table; supports without objects dropped.
+   * \a scale: the points each point of \a groups stands for (coarse trials, which keep no
+   * clusters). */
   void
-  chooseSupports(std::vector<pcl::Indices>& groups, std::vector<TabletopCluster>& clusters);
+  assignClusters(std::vector<pcl::Indices>& groups, Trial& trial, std::size_t scale);
+  /** Makes \a trial the result: supports, table, its coefficients and hull. */
+  void
+  adopt(Trial trial, std::vector<TabletopCluster>& clusters);
+  /** No support in view: the compact segments of the frame are its objects (support -1). */
+  void
+  segmentWithoutSupport(std::vector<TabletopCluster>& clusters);
   TabletopCluster
   makeCluster(pcl::Indices indices, int support) const;
   void

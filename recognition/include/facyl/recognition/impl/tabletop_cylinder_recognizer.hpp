@@ -143,12 +143,17 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
   const std::vector<float> p_network = classifyClusters(clusters);
   int frame_of = -1;
   for (std::size_t k = 0; k < clusters.size(); ++k) {
-    // The prior is set in the frame of the support the object stands on.
-    if (clusters[k].support != frame_of) {
+    // The prior is set in the frame of the support the object stands on; without one, in
+    // the frame of an upright camera (z up: against the image's rows).
+    if (clusters[k].support != frame_of || k == 0) {
       frame_of = clusters[k].support;
-      const auto& support = segmentation_.getSupports()[static_cast<std::size_t>(frame_of)];
+      Eigen::Matrix3f frame;
+      if (frame_of >= 0)
+        frame = segmentation_.getSupports()[static_cast<std::size_t>(frame_of)].frame.linear();
+      else
+        frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
       for (auto& hough : estimators_)
-        hough.setReferenceFrame(support.frame.linear());
+        hough.setReferenceFrame(frame);
     }
     const std::size_t first = objects.size();
     recognizeCluster(std::move(clusters[k]), p_network[k], objects);

@@ -24,12 +24,18 @@
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 namespace facyl {
+
+/** How many times more standing points another family of supports needs than the one an
+ * upright camera would choose (see segmentInSensorFrame). */
+constexpr float kFamilyMargin = 1.5f;
 
 template <typename PointT>
 void
@@ -133,34 +139,63 @@ template <typename PointT>
 bool
 TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>& clusters)
 {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const auto ms = [](Clock::time_point a) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+  };
   std::vector<Candidate> candidates;
   if (searchedAsImage())
     findPlanesOrganized(candidates);
   else
     findPlanesUnorganized(candidates);
   keepSupportCandidates(candidates);
-  if (candidates.empty()) {
-    PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane with at least %zu points "
-              "found%s.\n",
-              params_.min_plane_points,
-              up_.isZero() ? "" : " within max_support_tilt of the up direction");
-    reset();
-    return false;
+  const double t_planes = ms(t0);
+  std::vector<SupportPlane> all;
+  std::vector<Above> above;
+  classifyPoints(candidates, all, above);
+  const double t_points = ms(t0);
+  // The family of supports is the one most objects stand on: no camera roll is assumed.
+  // Several families: each is judged on a coarse grid of its object points (a clustering at
+  // full resolution costs several milliseconds), and only the one most objects stand on is
+  // segmented at full resolution. The first in rankFamilies' order (an upright camera's
+  // choice) is kept unless another holds clearly more (kFamilyMargin times): with few objects
+  // in view, the faces of a box can hold as many as the table.
+  bool agreed = false;
+  const auto families = rankFamilies(candidates, all, agreed);
+  std::size_t chosen = 0, tried = 0;
+  if (families.size() > 1) {
+    std::size_t most = 0;
+    for (std::size_t f = 0; f < families.size(); ++f) {
+      const Trial coarse = tryFamily(families[f], candidates, all, above, coarseStride());
+      tried += !coarse.supports.empty();
+      PCL_DEBUG("[facyl::TabletopSegmentation] family %zu (%zu planes, first (%.3f %.3f %.3f)): "
+                "%zu supports, %zu points standing (coarse)\n",
+                f, families[f].size(), candidates[families[f].front()].plane[0],
+                candidates[families[f].front()].plane[1], candidates[families[f].front()].plane[2],
+                coarse.supports.size(), coarse.standing);
+      if (!coarse.supports.empty() &&
+          (tried == 1 || static_cast<float>(coarse.standing) > kFamilyMargin * static_cast<float>(most)))
+        chosen = f, most = coarse.standing;
+    }
   }
-  pcl::Indices band;
-  classifyPoints(candidates, band);
-  if (supports_.empty()) {
-    PCL_ERROR("[facyl::TabletopSegmentation::segment] No plane of at least %g m^2 found.\n",
-              params_.min_support_area);
-    reset();
-    return false;
+  std::optional<Trial> best;
+  if (!families.empty()) {
+    Trial trial = tryFamily(families[chosen], candidates, all, above, 1);
+    if (!trial.supports.empty())
+      best = std::move(trial);
   }
-  std::vector<pcl::Indices> groups;
-  if (searchedAsImage())
-    clusterOrganized(band, groups);
-  else
-    clusterUnorganized(band, groups);
-  chooseSupports(groups, clusters);
+  PCL_DEBUG("[facyl::TabletopSegmentation] %.2f ms: planes %.2f, points %.2f, family %zu of "
+            "%zu (%zu with supports)\n",
+            ms(t0), t_planes, t_points - t_planes, chosen, families.size(), tried);
+  if (best)
+    adopt(std::move(*best), clusters);
+  else {
+    PCL_DEBUG("[facyl::TabletopSegmentation] no support in view: %zu candidate planes, none "
+              "of at least %g m^2\n",
+              candidates.size(), static_cast<double>(params_.min_support_area));
+    segmentWithoutSupport(clusters);
+  }
   // Largest first, like pcl::EuclideanClusterExtraction.
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
@@ -188,8 +223,20 @@ TabletopSegmentation<PointT>::searchedAsImage() const
 }
 
 template <typename PointT>
-bool
-TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candidates)
+PlaneRegionSettings
+TabletopSegmentation<PointT>::regionSettings() const
+{
+  PlaneRegionSettings s;
+  s.band_factor = params_.band_factor;
+  s.fixed_band = params_.plane_distance;
+  s.min_angle = params_.plane_angle;
+  return s;
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::planeGrid(pcl::PointCloud<pcl::PointXYZ>& small,
+                                        std::vector<pcl::index_t>& source) const
 {
   const int step = planeStep();
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
@@ -203,14 +250,13 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
   // depth near the first one's: real sensors lose several percent of their pixels (a single
   // pixel per cell would spread NaN normals) and active stereo is noisy (the mean of up to
   // step^2 pixels is less so); the depth test keeps objects' edges sharp.
-  pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
-  small->width = static_cast<std::uint32_t>((w + step - 1) / step);
-  small->height = static_cast<std::uint32_t>((h + step - 1) / step);
-  small->is_dense = false;
+  small.width = static_cast<std::uint32_t>((w + step - 1) / step);
+  small.height = static_cast<std::uint32_t>((h + step - 1) / step);
+  small.is_dense = false;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  small->points.assign(static_cast<std::size_t>(small->width) * small->height,
-                       pcl::PointXYZ(nan, nan, nan));
-  std::vector<pcl::index_t> source(small->size(), -1);
+  small.points.assign(static_cast<std::size_t>(small.width) * small.height,
+                      pcl::PointXYZ(nan, nan, nan));
+  source.assign(small.size(), -1);
   for (int v0 = 0, k = 0; v0 < h; v0 += step)
     for (int u0 = 0; u0 < w; u0 += step, ++k) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
@@ -232,8 +278,52 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
           ++n;
         }
       if (n > 0)
-        (*small)[k].getVector3fMap() = sum / static_cast<float>(n);
+        small[k].getVector3fMap() = sum / static_cast<float>(n);
     }
+}
+
+template <typename PointT>
+bool
+TabletopSegmentation<PointT>::growCandidate(const Eigen::Matrix3Xf& cells,
+                                            const Eigen::Matrix3Xf& normals,
+                                            const Eigen::Matrix3Xf& samples,
+                                            const std::vector<std::uint8_t>& seed,
+                                            const std::vector<pcl::index_t>& source,
+                                            std::size_t cell_points,
+                                            std::vector<std::uint8_t>& taken,
+                                            Candidate& out) const
+{
+  PlaneRegion region;
+  if (!refinePlaneRegion(cells, normals, samples, seed, input_->sensor_origin_.head(3),
+                         regionSettings(), region, &taken))
+    return false;
+  out.plane = region.plane;
+  out.band = region.band;
+  out.points.clear();
+  for (std::size_t k = 0; k < region.member.size(); ++k)
+    if (region.member[k] && source[k] >= 0)
+      out.points.push_back(source[k]);
+  out.support = out.points.size() * cell_points;
+  PCL_DEBUG("[facyl::TabletopSegmentation] plane (%.3f %.3f %.3f) d %.3f: %zu points, band "
+            "+-%.1f mm at 1 m, normals within %.1f deg\n",
+            out.plane[0], out.plane[1], out.plane[2], out.plane[3], out.support,
+            1e3 * out.band.halfWidth(1.f), region.max_angle * 180.f / static_cast<float>(M_PI));
+  if (out.support < params_.min_plane_points)
+    return false;
+  for (std::size_t k = 0; k < region.member.size(); ++k)
+    taken[k] = taken[k] || region.member[k];
+  return true;
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candidates)
+{
+  pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
+  std::vector<pcl::index_t> source;
+  planeGrid(*small, source);
+  const int step = planeStep();
+  const int w = static_cast<int>(input_->width);
   focal_ = camera_.valid() ? camera_.fx : estimateFocalLength(*small) * static_cast<float>(step);
   image_down_ = imageDownDirection(*small, input_->sensor_origin_.head(3));
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
@@ -245,50 +335,63 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
   ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
   ne.setInputCloud(small);
   ne.compute(*normals);
-
-  pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
-  const std::size_t cell = static_cast<std::size_t>(step * step);
-  mps.setMinInliers(static_cast<unsigned>(std::max<std::size_t>(10, params_.min_plane_points / cell / 4)));
-  mps.setAngularThreshold(params_.plane_angle);
-  mps.setDistanceThreshold(params_.plane_distance);
-  mps.setInputNormals(normals);
-  mps.setInputCloud(small);
-  std::vector<pcl::ModelCoefficients> coefficients;
-  std::vector<pcl::PointIndices> inliers;
-  mps.segment(coefficients, inliers);
-  // Regions on one plane are one candidate (objects cut a table into several regions).
-  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  std::vector<Eigen::Vector4f> planes;
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < inliers.size(); ++i) {
-    const auto& c = coefficients[i].values;
-    planes.push_back(c.size() == 4 ? orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), viewpoint)
-                                   : Eigen::Vector4f::Zero());
-    if (c.size() == 4 && planes.back().allFinite())
-      order.push_back(i);
+  // The cells as columns, with their normals and one raw pixel each (for the bands).
+  const auto n = static_cast<Eigen::Index>(small->size());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  Eigen::Matrix3Xf cells(3, n), cell_normals(3, n), samples(3, n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    cells.col(k) = (*small)[kk].getVector3fMap();
+    cell_normals.col(k) = (*normals)[kk].getNormalVector3fMap();
+    samples.col(k) = source[kk] >= 0 ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
+                                     : Eigen::Vector3f::Constant(nan);
   }
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return inliers[a].indices.size() > inliers[b].indices.size();
+  // Seeds: pcl::OrganizedMultiPlaneSegmentation's regions, largest first. Its thresholds only
+  // make seeds (the band of each plane is measured afterwards); on a frame too noisy for any
+  // seed of the least plane size they are relaxed, twice at most.
+  const std::size_t cell = static_cast<std::size_t>(step * step);
+  const std::size_t min_cells = std::max<std::size_t>(10, params_.min_plane_points / cell / 4);
+  std::vector<pcl::PointIndices> inliers;
+  float relax = 1.f;
+  for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
+    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
+    mps.setMinInliers(static_cast<unsigned>(min_cells));
+    mps.setAngularThreshold(std::min(0.5f, relax * params_.plane_angle));
+    mps.setDistanceThreshold(relax * (params_.plane_distance > 0.f ? params_.plane_distance
+                                                                   : kSeedDistance));
+    mps.setMaximumCurvature(relax * relax * 0.001);
+    mps.setInputNormals(normals);
+    mps.setInputCloud(small);
+    std::vector<pcl::ModelCoefficients> coefficients;
+    inliers.clear();
+    mps.segment(coefficients, inliers);
+    if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
+          return r.indices.size() * cell >= params_.min_plane_points;
+        }))
+      break;
+  }
+  std::sort(inliers.begin(), inliers.end(), [](const auto& a, const auto& b) {
+    return a.indices.size() > b.indices.size();
   });
-  for (const auto& group :
-       groupCoplanar(planes, order, params_.plane_angle, params_.plane_distance)) {
+  std::vector<std::uint8_t> taken(small->size(), 0);
+  for (const auto& r : inliers) {
+    // A seed mostly on a plane found already is a part of it (a noisy table's regions).
+    std::size_t on_earlier = 0;
+    for (const auto k : r.indices)
+      on_earlier += taken[static_cast<std::size_t>(k)];
+    if (2 * on_earlier >= r.indices.size() || candidates.size() >= 2 * params_.max_planes + 4)
+      continue;
+    std::vector<std::uint8_t> seed(small->size(), 0);
+    for (const auto k : r.indices)
+      seed[static_cast<std::size_t>(k)] = 1;
     Candidate c;
-    c.plane = planes[group.front()];
-    for (const std::size_t r : group)
-      for (const auto k : inliers[r].indices)
-        if (source[static_cast<std::size_t>(k)] >= 0)
-          c.points.push_back(source[static_cast<std::size_t>(k)]);
-    c.support = c.points.size() * cell;
-    PCL_DEBUG("[facyl::TabletopSegmentation] region group: normal (%.3f %.3f %.3f) d %.3f, %zu "
-              "points\n", c.plane[0], c.plane[1], c.plane[2], c.plane[3], c.support);
-    if (c.support >= params_.min_plane_points)
+    if (growCandidate(cells, cell_normals, samples, seed, source, cell, taken, c))
       candidates.push_back(std::move(c));
   }
-  return !candidates.empty();
 }
 
 template <typename PointT>
-bool
+void
 TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& candidates)
 {
   // Plane search on a uniform random sample of the points, with normals: like the pixels of an
@@ -306,7 +409,7 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   pcl::Indices sampled;
   sample.filter(sampled);
   if (sampled.size() < 10)
-    return false;
+    return;
   typename PointCloud::Ptr coarse(new PointCloud);
   pcl::copyPointCloud(*input_, sampled, *coarse);
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
@@ -316,20 +419,39 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   ne.setSearchMethod(tree);
   ne.setKSearch(12);
   ne.compute(*normals);
-  // Planes one after another, each on what the previous ones left: RANSAC on positions
+  const auto n = static_cast<Eigen::Index>(sampled.size());
+  Eigen::Matrix3Xf cells(3, n), cell_normals(3, n);
+  std::vector<float> ranges(sampled.size());
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    cells.col(k) = (*coarse)[kk].getVector3fMap();
+    cell_normals.col(k) = (*normals)[kk].getNormalVector3fMap();
+    ranges[kk] = (cells.col(k) - viewpoint).norm();
+  }
+  // RANSAC's seed threshold: 2 % of the typical range (the bands are measured afterwards).
+  std::nth_element(ranges.begin(), ranges.begin() + n / 2, ranges.end());
+  const float seed_distance =
+    params_.plane_distance > 0.f ? params_.plane_distance : 0.02f * ranges[static_cast<std::size_t>(n / 2)];
+  // Planes one after another, each seeded on what the previous ones left: RANSAC on positions
   // (cheap), then the inliers whose normal agrees with the plane's.
   pcl::SACSegmentation<PointT> sac;
   sac.setOptimizeCoefficients(true);
   sac.setModelType(pcl::SACMODEL_PLANE);
   sac.setMethodType(pcl::SAC_RANSAC);
-  sac.setDistanceThreshold(params_.plane_distance);
+  sac.setDistanceThreshold(seed_distance);
   sac.setMaxIterations(200);
   sac.setInputCloud(coarse);
   const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
   const float cos_normal = std::cos(0.3f);
-  pcl::IndicesPtr remaining(new pcl::Indices(sampled.size()));
-  std::iota(remaining->begin(), remaining->end(), 0);
-  for (std::size_t k = 0; k < params_.max_planes && remaining->size() >= 10; ++k) {
+  std::vector<std::uint8_t> taken(sampled.size(), 0);
+  for (std::size_t k = 0; k < params_.max_planes; ++k) {
+    pcl::IndicesPtr remaining(new pcl::Indices);
+    for (std::size_t i = 0; i < sampled.size(); ++i)
+      if (!taken[i])
+        remaining->push_back(static_cast<pcl::index_t>(i));
+    if (remaining->size() < 10)
+      break;
     sac.setIndices(remaining);
     pcl::PointIndices inliers;
     pcl::ModelCoefficients coefficients;
@@ -337,26 +459,23 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
     if (coefficients.values.size() != 4)
       break;
     const auto& c = coefficients.values;
-    Candidate cand;
-    cand.plane = orientPlane(Eigen::Vector4f(c[0], c[1], c[2], c[3]), input_->sensor_origin_.head(3));
-    std::vector<std::uint8_t> taken(sampled.size(), 0);
-    for (const auto i : inliers.indices) {
-      taken[static_cast<std::size_t>(i)] = 1;
-      const auto& n = (*normals)[static_cast<std::size_t>(i)];
-      if (std::abs(Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).dot(cand.plane.template head<3>())) >= cos_normal)
-        cand.points.push_back(sampled[static_cast<std::size_t>(i)]);
-    }
-    cand.support = static_cast<std::size_t>(static_cast<double>(cand.points.size()) * scale);
-    if (cand.support < params_.min_plane_points)
+    const Eigen::Vector3f normal = Eigen::Vector3f(c[0], c[1], c[2]).normalized();
+    std::vector<std::uint8_t> seed(sampled.size(), 0);
+    std::size_t seeded = 0;
+    for (const auto i : inliers.indices)
+      if (std::abs(cell_normals.col(i).dot(normal)) >= cos_normal)
+        seed[static_cast<std::size_t>(i)] = 1, ++seeded;
+    if (static_cast<double>(seeded) * scale < static_cast<double>(params_.min_plane_points))
       break;
-    candidates.push_back(std::move(cand));
-    pcl::IndicesPtr left(new pcl::Indices);
-    for (const auto i : *remaining)
-      if (!taken[static_cast<std::size_t>(i)])
-        left->push_back(i);
-    remaining = left;
+    const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
+    Candidate cand;
+    const std::size_t before = std::count(taken.begin(), taken.end(), 1);
+    if (growCandidate(cells, cell_normals, cells, seed, sampled, cell_points, taken, cand))
+      candidates.push_back(std::move(cand));
+    if (static_cast<std::size_t>(std::count(taken.begin(), taken.end(), 1)) == before)
+      for (const auto i : inliers.indices) // not a plane: its seed is not searched again
+        taken[static_cast<std::size_t>(i)] = 1;
   }
-  return !candidates.empty();
 }
 
 template <typename PointT>
@@ -364,36 +483,32 @@ void
 TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& candidates) const
 {
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  // A support spans a plane (collinear points, e.g. one image row of a far surface, do not)
-  // that does not pass by the sensor (it would be seen edge-on).
-  std::vector<Candidate> planar;
-  for (auto& c : candidates) {
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.points.size()));
-    for (std::size_t k = 0; k < c.points.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.points[k]].getVector3fMap();
-    Eigen::Vector4f refined;
-    if (!fitPlane(pts, viewpoint, refined) ||
-        refined.template head<3>().dot(viewpoint) + refined[3] < 0.05f)
-      continue;
-    c.plane = refined;
-    planar.push_back(std::move(c));
-  }
-  candidates.swap(planar);
+  // A support does not pass by the sensor (it would be seen edge-on).
+  candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                  [&](const Candidate& c) {
+                                    return c.plane.template head<3>().dot(viewpoint) + c.plane[3] <
+                                           0.05f;
+                                  }),
+                   candidates.end());
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.support > b.support; });
-  // A region lying on a larger candidate (a part of the same table seen through a sensor's
-  // slight bend) is a part of it, not another support.
+  // A region lying on a larger candidate, within its band (a part of the same table seen
+  // through a sensor's bend), is a part of it, not another support.
   std::vector<Candidate> distinct;
   for (auto& c : candidates) {
     const bool part = std::any_of(distinct.begin(), distinct.end(), [&](const Candidate& big) {
       if (big.plane.template head<3>().dot(c.plane.template head<3>()) < std::cos(0.2f))
         return false;
-      std::vector<float> h;
-      for (const auto i : c.points)
-        h.push_back(std::abs(big.plane.template head<3>().dot((*input_)[i].getVector3fMap()) +
-                             big.plane[3]));
-      std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
-      return h[h.size() / 2] < 2.f * params_.plane_distance;
+      std::vector<float> h, r;
+      for (const auto i : c.points) {
+        const Eigen::Vector3f p = (*input_)[i].getVector3fMap();
+        h.push_back(std::abs(big.plane.template head<3>().dot(p) + big.plane[3]));
+        r.push_back((p - viewpoint).norm());
+      }
+      const auto mid = static_cast<std::ptrdiff_t>(h.size() / 2);
+      std::nth_element(h.begin(), h.begin() + mid, h.end());
+      std::nth_element(r.begin(), r.begin() + mid, r.end());
+      return h[h.size() / 2] < big.band.halfWidth(r[r.size() / 2]);
     });
     if (!part)
       distinct.push_back(std::move(c));
@@ -420,91 +535,71 @@ TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& cand
 template <typename PointT>
 void
 TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candidates,
-                                             pcl::Indices& band)
+                                             std::vector<SupportPlane>& all,
+                                             std::vector<Above>& above) const
 {
   // One pass: each candidate's points, and the points above some candidate (in its object
-  // band) with the candidates they lie on and above.
+  // band) with the candidates they lie on and above. Bands by range, tabulated every 5 mm.
   const std::size_t n = candidates.size(); // <= 8
-  std::vector<SupportPlane> all(n);
-  struct Above {
-    pcl::index_t index;
-    std::uint8_t on, above;
-  };
-  std::vector<Above> above_band;
-  for (std::size_t s = 0; s < n; ++s)
+  all.assign(n, SupportPlane{});
+  above.clear();
+  if (n == 0)
+    return;
+  constexpr float bin = 0.005f;
+  constexpr std::size_t bins = 2400; // 12 m
+  std::vector<float> half(n * bins);
+  for (std::size_t s = 0; s < n; ++s) {
+    for (std::size_t b = 0; b < bins; ++b)
+      half[s * bins + b] = candidates[s].band.halfWidth((static_cast<float>(b) + 0.5f) * bin);
     all[s].inliers.indices.reserve(candidates[s].support + candidates[s].support / 2);
+  }
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  const float floor = params_.min_height, top = params_.max_height;
   for (const auto i : *indices_) {
     const auto& p = (*input_)[i];
     if (!pcl::isFinite(p))
       continue;
-    std::uint8_t on = 0, above = 0;
+    const Eigen::Vector3f q = p.getVector3fMap();
+    const float range = (q - viewpoint).norm();
+    const auto b = static_cast<std::size_t>(range / bin);
+    std::uint8_t on = 0, over = 0;
     for (std::size_t s = 0; s < n; ++s) {
-      const Eigen::Vector4f& q = candidates[s].plane;
-      const float h = q.template head<3>().dot(p.getVector3fMap()) + q[3];
-      if (std::abs(h) < params_.plane_distance) {
+      const Eigen::Vector4f& c = candidates[s].plane;
+      const float h = c.template head<3>().dot(q) + c[3];
+      const float w = b < bins ? half[s * bins + b] : candidates[s].band.halfWidth(range);
+      if (std::abs(h) <= w) {
         on |= static_cast<std::uint8_t>(1u << s);
         all[s].inliers.indices.push_back(i);
       }
-      else if (h >= params_.min_height && h <= params_.max_height)
-        above |= static_cast<std::uint8_t>(1u << s);
+      else if (h > std::max(floor, w) && h <= top)
+        over |= static_cast<std::uint8_t>(1u << s);
     }
-    if (above)
-      above_band.push_back({i, on, above});
+    if (over)
+      above.push_back({i, on, over});
   }
-  // Supports: the planes of one family of parallel planes (a table, the floor under it, a
-  // shelf) that are large (a smaller plane is an object's face: its points stay objects).
-  const bool largest = params_.support == TabletopSegmentationParameters::Support::LargestPlane;
-  const std::vector<std::size_t> family = largest ? std::vector<std::size_t>{0}
-                                                  : supportFamily(candidates, all);
-  std::uint8_t kept = 0;
-  for (const std::size_t s : family) {
-    SupportPlane& support = all[s];
-    support.plane = candidates[s].plane;
+  for (std::size_t s = 0; s < n; ++s) {
+    all[s].plane = candidates[s].plane;
+    all[s].band = candidates[s].band;
+    all[s].inliers.header = input_->header;
     Eigen::Vector3f centre = Eigen::Vector3f::Zero();
     for (const auto i : candidates[s].points)
       centre += (*input_)[i].getVector3fMap();
-    support.frame =
-      planeFrame(candidates[s].plane, centre / static_cast<float>(candidates[s].points.size()));
-    support.inliers.header = input_->header;
-    support.polygon = supportHull(support, &candidates[s]);
-    // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
-    // by the region found on it: its infinite plane slices through the objects around it.
-    bool elevated = false;
-    for (const std::size_t t : family) {
-      const float height = candidates[t].plane[3] - candidates[s].plane[3];
-      elevated = elevated || (t != s && candidates[t].support > candidates[s].support &&
-                              height >= params_.min_height && height <= params_.max_height);
-    }
-    // Its own region must be sizeable too: a small region's infinite plane can cross a
-    // table.
-    const float region = regionArea(candidates[s], support.frame);
-    const float area = elevated ? region : polygonArea(support.polygon);
-    PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d %.3f, "
-              "%zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
-              s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
-              support.inliers.indices.size(), polygonArea(support.polygon), region,
-              elevated ? ", elevated" : "");
-    if (support.polygon.size() >= 3 &&
-        (largest || (area >= params_.min_support_area &&
-                     region >= 0.25f * params_.min_support_area)))
-      kept |= static_cast<std::uint8_t>(1u << s);
+    all[s].frame = planeFrame(candidates[s].plane,
+                              centre / static_cast<float>(std::max<std::size_t>(1, candidates[s].points.size())));
   }
-  for (const std::size_t s : family)
-    if (kept & (1u << s)) {
-      extents_.push_back(supportHull(all[s], nullptr));
-      supports_.push_back(std::move(all[s]));
-    }
-  for (const Above& a : above_band)
-    if ((a.above & kept) && !(a.on & kept))
-      band.push_back(a.index);
 }
 
 template <typename PointT>
-std::vector<std::size_t>
-TabletopSegmentation<PointT>::supportFamily(const std::vector<Candidate>& candidates,
-                                            const std::vector<SupportPlane>& all) const
+std::vector<std::vector<std::size_t>>
+TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candidates,
+                                           const std::vector<SupportPlane>& all,
+                                           bool& agreed) const
 {
-  // Families of parallel candidates.
+  agreed = true;
+  if (candidates.empty())
+    return {};
+  if (params_.support == TabletopSegmentationParameters::Support::LargestPlane)
+    return {{0}};
   std::vector<Eigen::Vector4f> normals;
   std::vector<std::size_t> order;
   for (std::size_t s = 0; s < candidates.size(); ++s) {
@@ -513,29 +608,109 @@ TabletopSegmentation<PointT>::supportFamily(const std::vector<Candidate>& candid
     order.push_back(s); // largest first
   }
   // Supports are level: a table, the floor under it and a shelf are parallel within degrees.
-  const auto families =
-    groupCoplanar(normals, order, 0.1f, std::numeric_limits<float>::infinity());
-  // With an up direction every candidate is horizontal already. Without one, the camera is
-  // taken to be upright: supports face the top of the image (their normal points against the
-  // image's down direction, measured on organized clouds); walls and ceilings do not. When no
-  // family does (a camera looking straight down, or rolled; unorganized clouds), any may. Then
-  // the family with most points wins.
+  auto families = groupCoplanar(normals, order, 0.1f, std::numeric_limits<float>::infinity());
+  // An upright camera's supports face the top of the image (their normal points against the
+  // image's down direction, measured on organized clouds); walls and ceilings do not. Those
+  // come first (the order breaks ties), then the family with most points.
   const auto faces_up = [&](const std::vector<std::size_t>& f) {
     return !up_.isZero() ||
            candidates[f.front()].plane.template head<3>().dot(image_down_) <= -0.1f;
   };
-  const bool any_faces_up = std::any_of(families.begin(), families.end(), faces_up);
-  std::size_t best = 0, best_points = 0;
-  for (std::size_t f = 0; f < families.size(); ++f) {
-    if (any_faces_up && !faces_up(families[f]))
+  const auto points = [&](const std::vector<std::size_t>& f) {
+    std::size_t sum = 0;
+    for (const std::size_t s : f)
+      sum += all[s].inliers.indices.size();
+    return sum;
+  };
+  std::stable_sort(families.begin(), families.end(), [&](const auto& a, const auto& b) {
+    const bool ua = faces_up(a), ub = faces_up(b);
+    return ua != ub ? ua : points(a) > points(b);
+  });
+  agreed = std::all_of(families.begin(), families.end(), [&](const auto& f) {
+    return points(f) <= points(families.front());
+  });
+  if (families.size() > 3)
+    families.resize(3);
+  return families;
+}
+
+template <typename PointT>
+int
+TabletopSegmentation<PointT>::coarseStride() const
+{
+  return searchedAsImage() ? 2 * planeStep() : 1;
+}
+
+template <typename PointT>
+typename TabletopSegmentation<PointT>::Trial
+TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
+                                        const std::vector<Candidate>& candidates,
+                                        std::vector<SupportPlane>& all,
+                                        const std::vector<Above>& above, int stride)
+{
+  const bool largest = params_.support == TabletopSegmentationParameters::Support::LargestPlane;
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  supports_.clear();
+  extents_.clear();
+  std::uint8_t kept = 0;
+  for (const std::size_t s : family) {
+    SupportPlane support;
+    support.plane = all[s].plane;
+    support.band = all[s].band;
+    support.frame = all[s].frame;
+    support.polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
+    // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
+    // by the region found on it: its infinite plane slices through the objects around it.
+    const float range = (support.frame.translation() - viewpoint).norm();
+    bool elevated = false;
+    for (const std::size_t t : family) {
+      const float height = candidates[t].plane[3] - candidates[s].plane[3];
+      elevated = elevated || (t != s && candidates[t].support > candidates[s].support &&
+                              height > candidates[t].band.halfWidth(range) &&
+                              height <= params_.max_height);
+    }
+    // Its own region must be sizeable too: a small region's infinite plane can cross a
+    // table.
+    const float region = regionArea(candidates[s], support.frame);
+    const float hull = polygonArea(support.polygon);
+    if (stride == 1)
+      PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d "
+                "%.3f, %zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
+                s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
+                all[s].inliers.indices.size(), hull, region, elevated ? ", elevated" : "");
+    const bool large = elevated ? region >= params_.min_shelf_area
+                                : hull >= params_.min_support_area &&
+                                    region >= 0.25f * params_.min_support_area;
+    if (support.polygon.size() < 3 || !(largest || large))
       continue;
-    std::size_t points = 0;
-    for (const std::size_t s : families[f])
-      points += all[s].inliers.indices.size();
-    if (points > best_points)
-      best = f, best_points = points;
+    kept |= static_cast<std::uint8_t>(1u << s);
+    extents_.push_back(supportHull(support.frame, all[s].inliers.indices, nullptr));
+    if (stride == 1)
+      support.inliers = std::move(all[s].inliers); // the final trial: a candidate is in one family
+    else
+      support.inliers.indices.resize(all[s].inliers.indices.size()); // only the count is used
+    supports_.push_back(std::move(support));
   }
-  return families.empty() ? std::vector<std::size_t>{} : families[best];
+  Trial trial;
+  if (supports_.empty())
+    return trial;
+  pcl::Indices band;
+  const auto w = static_cast<pcl::index_t>(input_->width);
+  for (const Above& a : above)
+    if ((a.above & kept) && !(a.on & kept) &&
+        (stride == 1 || ((a.index % w) % stride == 0 && (a.index / w) % stride == 0)))
+      band.push_back(a.index);
+  std::vector<pcl::Indices> groups;
+  if (stride == 1)
+    cluster(band, groups);
+  else
+    clusterCoarse(band, stride, groups);
+  assignClusters(groups, trial, static_cast<std::size_t>(stride * stride));
+  PCL_DEBUG("[facyl::TabletopSegmentation] stride %d: %zu supports, %zu object points, %zu "
+            "groups, %zu clusters, %zu standing\n",
+            stride, trial.supports.size(), band.size(), groups.size(), trial.clusters.size(),
+            trial.standing);
+  return trial;
 }
 
 template <typename PointT>
@@ -551,10 +726,10 @@ TabletopSegmentation<PointT>::regionArea(const Candidate& c, const Eigen::Affine
 
 template <typename PointT>
 std::vector<Eigen::Vector2f>
-TabletopSegmentation<PointT>::supportHull(const SupportPlane& s, const Candidate* c) const
+TabletopSegmentation<PointT>::supportHull(const Eigen::Affine3f& frame, const pcl::Indices& idx,
+                                          const Candidate* c) const
 {
-  const Eigen::Affine3f to_plane = s.frame.inverse();
-  const auto& idx = s.inliers.indices;
+  const Eigen::Affine3f to_plane = frame.inverse();
   const auto flat = [&](pcl::index_t i) {
     return Eigen::Vector2f((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
   };
@@ -616,24 +791,24 @@ TabletopSegmentation<PointT>::supportHull(const SupportPlane& s, const Candidate
 
 template <typename PointT>
 typename TabletopSegmentation<PointT>::Placement
-TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts,
-                                    const std::vector<std::size_t>& family) const
+TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts) const
 {
   const auto& p = params_;
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
   Placement out;
   std::vector<HeightProfile> profiles(supports_.size());
-  std::vector<float> over(supports_.size(), 0.f);
-  for (const std::size_t s : family) {
-    profiles[s] = heightProfile(pts, supports_[s].plane, p.min_height, p.max_height);
+  for (std::size_t s = 0; s < supports_.size(); ++s) {
+    profiles[s] = heightProfile(pts, supports_[s].plane, supports_[s].band, viewpoint,
+                                p.min_height, p.max_height);
     const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
     std::size_t in_hull = 0;
     for (Eigen::Index k = 0; k < pts.cols(); ++k)
       in_hull += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).template head<2>(),
                                 supports_[s].polygon);
-    over[s] = static_cast<float>(in_hull) / static_cast<float>(pts.cols());
+    const float over = static_cast<float>(in_hull) / static_cast<float>(pts.cols());
     // The nearest support under the cluster: most of it in its band and over its hull (the
     // prism test of pcl::ExtractPolygonalPrismData, per cluster).
-    if (profiles[s].in_band < 0.5f || over[s] < p.min_hull_share)
+    if (profiles[s].in_band < 0.5f || over < p.min_hull_share)
       continue;
     if (out.support < 0 || profiles[s].base < profiles[static_cast<std::size_t>(out.support)].base)
       out.support = static_cast<int>(s);
@@ -643,7 +818,7 @@ TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts,
   // Under a higher support (its legs, or what stands under it) is furniture, not an object
   // on the lower one. "Under" takes every point of the higher plane: seen at a grazing angle, a
   // table's region may miss its edges.
-  for (const std::size_t s : family) {
+  for (std::size_t s = 0; s < supports_.size(); ++s) {
     if (static_cast<int>(s) == out.support || !(profiles[s].top < 0.f))
       continue;
     const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
@@ -656,63 +831,69 @@ TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts,
       return out;
     }
   }
-  out.standing =
-    standsOn(profiles[static_cast<std::size_t>(out.support)], p.contact_height, p.max_height, 0.02f);
+  // Standing: it reaches down to the support's band (at its range) within contact_height.
+  const SupportPlane& support = supports_[static_cast<std::size_t>(out.support)];
+  const float range = (Eigen::Vector3f(pts.rowwise().mean()) - viewpoint).norm();
+  out.standing = standsOn(profiles[static_cast<std::size_t>(out.support)],
+                          p.contact_height + support.band.halfWidth(range), p.max_height, 0.02f);
   return out;
 }
 
 template <typename PointT>
 void
-TabletopSegmentation<PointT>::chooseSupports(std::vector<pcl::Indices>& groups,
-                                             std::vector<TabletopCluster>& clusters)
+TabletopSegmentation<PointT>::assignClusters(std::vector<pcl::Indices>& groups, Trial& trial,
+                                             std::size_t scale)
 {
   const auto& p = params_;
-  // The clusters' points (at most 400 of each, evenly: enough for the height and hull tests).
-  std::vector<std::size_t> kept;
-  std::vector<Eigen::Matrix3Xf> points;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    if (groups[g].size() < p.min_cluster_size || groups[g].size() > p.max_cluster_size)
+  for (auto& group : groups) {
+    if (group.size() * scale < p.min_cluster_size || group.size() * scale > p.max_cluster_size)
       continue;
-    const std::size_t stride = std::max<std::size_t>(1, groups[g].size() / 400);
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>((groups[g].size() + stride - 1) / stride));
-    for (std::size_t k = 0, c = 0; k < groups[g].size(); k += stride, ++c)
-      pts.col(static_cast<Eigen::Index>(c)) = (*input_)[groups[g][k]].getVector3fMap();
-    kept.push_back(g);
-    points.push_back(std::move(pts));
-  }
-  std::vector<std::size_t> family(supports_.size());
-  std::iota(family.begin(), family.end(), 0);
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    const Placement pl = place(points[k], family);
+    // At most 400 of its points, evenly: enough for the height and hull tests.
+    const std::size_t stride = std::max<std::size_t>(1, group.size() / 400);
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>((group.size() + stride - 1) / stride));
+    for (std::size_t k = 0, c = 0; k < group.size(); k += stride, ++c)
+      pts.col(static_cast<Eigen::Index>(c)) = (*input_)[group[k]].getVector3fMap();
+    const Placement pl = place(pts);
     if (pl.support < 0)
       continue;
     SupportPlane& support = supports_[static_cast<std::size_t>(pl.support)];
     ++support.objects;
     if (pl.standing)
-      support.standing_points += groups[kept[k]].size();
-    clusters.push_back(makeCluster(std::move(groups[kept[k]]), pl.support));
+      support.standing_points += group.size() * scale;
+    if (scale == 1)
+      trial.clusters.push_back(makeCluster(std::move(group), pl.support));
   }
   // The table: the most object points standing on it; else the largest support.
-  table_ = family.front();
-  for (const std::size_t s : family)
-    if (supports_[s].standing_points > supports_[table_].standing_points ||
-        (supports_[s].standing_points == supports_[table_].standing_points &&
-         supports_[s].inliers.indices.size() > supports_[table_].inliers.indices.size()))
-      table_ = s;
-  table_found_ = supports_[table_].standing_points > 0;
+  std::size_t table = 0;
+  for (std::size_t s = 0; s < supports_.size(); ++s) {
+    trial.standing += supports_[s].standing_points;
+    if (supports_[s].standing_points > supports_[table].standing_points ||
+        (supports_[s].standing_points == supports_[table].standing_points &&
+         supports_[s].inliers.indices.size() > supports_[table].inliers.indices.size()))
+      table = s;
+  }
   // Keep the supports that hold objects, and the table.
   std::vector<int> new_index(supports_.size(), -1);
-  std::vector<SupportPlane> used;
   for (std::size_t s = 0; s < supports_.size(); ++s)
-    if (supports_[s].objects > 0 || s == table_) {
-      new_index[s] = static_cast<int>(used.size());
-      used.push_back(std::move(supports_[s]));
+    if (supports_[s].objects > 0 || s == table) {
+      new_index[s] = static_cast<int>(trial.supports.size());
+      trial.supports.push_back(std::move(supports_[s]));
     }
-  table_ = static_cast<std::size_t>(new_index[table_]);
-  supports_ = std::move(used);
-  extents_.clear();
-  for (auto& c : clusters)
+  trial.table = static_cast<std::size_t>(new_index[table]);
+  for (auto& c : trial.clusters)
     c.support = new_index[static_cast<std::size_t>(c.support)];
+  supports_.clear();
+  extents_.clear();
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::adopt(Trial trial, std::vector<TabletopCluster>& clusters)
+{
+  supports_ = std::move(trial.supports);
+  table_ = trial.table;
+  table_found_ = supports_[table_].standing_points > 0;
+  clusters = std::move(trial.clusters);
   const SupportPlane& table = supports_[table_];
   table_coefficients_.header = input_->header;
   table_coefficients_.values = {table.plane[0], table.plane[1], table.plane[2], table.plane[3]};
@@ -721,6 +902,30 @@ TabletopSegmentation<PointT>::chooseSupports(std::vector<pcl::Indices>& groups,
     PointT q;
     q.getVector3fMap() = table.frame * Eigen::Vector3f(v.x(), v.y(), 0.f);
     hull_->push_back(q);
+  }
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::segmentWithoutSupport(std::vector<TabletopCluster>& clusters)
+{
+  // Every point may belong to an object; objects are the segments of the frame that fit in
+  // the object box (max_height in each direction): walls, floors and furniture do not.
+  pcl::Indices points;
+  for (const auto i : *indices_)
+    if (pcl::isFinite((*input_)[i]))
+      points.push_back(i);
+  std::vector<pcl::Indices> groups;
+  cluster(points, groups);
+  const float max_extent = std::sqrt(3.f) * params_.max_height;
+  for (auto& g : groups) {
+    if (g.size() < params_.min_cluster_size || g.size() > params_.max_cluster_size)
+      continue;
+    Eigen::AlignedBox3f box;
+    for (const auto i : g)
+      box.extend((*input_)[i].getVector3fMap());
+    if (box.diagonal().norm() <= max_extent)
+      clusters.push_back(makeCluster(std::move(g), -1));
   }
 }
 
@@ -740,6 +945,17 @@ TabletopSegmentation<PointT>::makeCluster(pcl::Indices indices, int support) con
   c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
                                 : projectedBox(pts, camera_);
   return c;
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::cluster(const pcl::Indices& objects,
+                                      std::vector<pcl::Indices>& out) const
+{
+  if (searchedAsImage())
+    clusterOrganized(objects, out);
+  else
+    clusterUnorganized(objects, out);
 }
 
 template <typename PointT>
@@ -781,6 +997,67 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   out.clear();
   for (auto& g : groups)
     out.push_back(std::move(g.indices));
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int stride,
+                                            std::vector<pcl::Indices>& out) const
+{
+  if (!searchedAsImage() || stride <= 1) {
+    cluster(objects, out);
+    return;
+  }
+  // The object points on every stride-th pixel of every stride-th row (\a objects holds only
+  // those), as an organized cloud of that grid, segmented like the full frame.
+  const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
+  const int cw = (w + stride - 1) / stride, ch = (h + stride - 1) / stride;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  pcl::PointCloud<pcl::PointXYZ> coarse;
+  coarse.width = static_cast<std::uint32_t>(cw);
+  coarse.height = static_cast<std::uint32_t>(ch);
+  coarse.is_dense = false;
+  coarse.points.assign(static_cast<std::size_t>(cw) * ch, pcl::PointXYZ(nan, nan, nan));
+  std::vector<std::uint8_t> has_depth(coarse.size());
+  for (int v = 0; v < ch; ++v)
+    for (int u = 0; u < cw; ++u)
+      has_depth[static_cast<std::size_t>(v) * cw + u] =
+        pcl::isFinite((*input_)[static_cast<std::size_t>(v * stride) * w + u * stride]);
+  const auto coarse_index = [&](pcl::index_t i) {
+    return static_cast<std::size_t>((i / w) / stride) * cw + static_cast<std::size_t>((i % w) / stride);
+  };
+  for (const auto i : objects)
+    coarse[coarse_index(i)].getVector3fMap() = (*input_)[i].getVector3fMap();
+  std::vector<pcl::Indices> groups;
+  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
+    ObjectSegmentationParameters op = params_.objects;
+    op.min_fragment = std::max<std::size_t>(1, op.min_fragment / static_cast<std::size_t>(stride * stride));
+    op.bridge_occlusions = false; // a count of standing points needs no joined occluded parts
+    groups = segmentObjectsOrganized(coarse, has_depth, focal_ / static_cast<float>(stride),
+                                     input_->sensor_origin_.head(3), op);
+  }
+  else {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(coarse));
+    pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
+      new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
+    comparator->setInputCloud(cloud);
+    comparator->setDistanceThreshold(params_.cluster_tolerance, false);
+    pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
+    components.setInputCloud(cloud);
+    pcl::PointCloud<pcl::Label> labels;
+    std::vector<pcl::PointIndices> found;
+    components.segment(labels, found);
+    for (auto& g : found)
+      groups.push_back(std::move(g.indices));
+  }
+  out.clear();
+  for (const auto& g : groups) {
+    pcl::Indices full;
+    full.reserve(g.size());
+    for (const auto k : g)
+      full.push_back(static_cast<pcl::index_t>(((k / cw) * stride) * w + (k % cw) * stride));
+    out.push_back(std::move(full));
+  }
 }
 
 template <typename PointT>
