@@ -4,7 +4,8 @@
  * For each scene PREFIX_NNNN (or PREFIX when --count is 1) it writes PREFIX.pcd (organized
  * XYZRGBA, NaN where the sensor gives no depth), PREFIX_ids.png (16-bit object id per pixel:
  * 0 background, 1 table, 2+ objects), PREFIX_class.png (8-bit class per pixel, see --help), PREFIX_rgb.png and
- * PREFIX.json (ground truth), and prints one JSON line per scene.
+ * PREFIX.json (ground truth), and prints one JSON line per scene. Scenery (far
+ * furniture, robots) has ids 1000+ and class 7.
  */
 #include "cli.h"
 #include "scene_options.h"
@@ -30,19 +31,25 @@ printHelp(const char* self)
     "  --layout L         spread (default: objects apart on a large table) | cluttered\n"
     "                     (touching, stacked and leaning objects; small, round or large\n"
     "                     tables with legs over a floor, sometimes a wall; wider camera poses)\n"
+    "                     | realistic (cluttered, plus curved table tops, glossy, dark and\n"
+    "                     transparent surfaces, far furniture, sometimes a robot arm,\n"
+    "                     cameras 15-85 degrees above the table, any roll in 30%%)\n"
     "  --sensor S         kinect (default: structured light, disparity quantised to 1/8 px)\n"
     "                     | stereo (RealSense D4xx-like: speckled holes, fattened edges,\n"
-    "                     colour/depth misregistration)\n"
+    "                     colour/depth misregistration) | random (a structured-light,\n"
+    "                     active-stereo or time-of-flight sensor drawn per scene: noise, bias,\n"
+    "                     holes, edges, response to materials; see docs/simulation.md)\n"
     "  --seed S           seed of the first scene (default 0); scene k uses S + k\n"
     "  --count N          number of scenes (default 1)\n"
     "  --objects MIN,MAX  objects per scene (default 3,10; cluttered 4,10)\n"
     "  --cylinder-share P probability that an object is a cylinder (default 0.5)\n"
     "  --lying-share P    probability that a can or tube lies (default 0.25)\n"
-    "  --noise K          axial depth noise sigma = K z^2 (default: the sensor's)\n"
-    "  --no-quantisation  no disparity quantisation\n"
+    "  --noise K          axial depth noise sigma = K z^2 (default: the sensor's; not with\n"
+    "                     --sensor random)\n"
+    "  --no-quantisation  no disparity quantisation (not with --sensor random)\n"
     "%s"
     "Class codes in PREFIX_class.png: 0 background, 1 table, 2 cylinder, 3 box, 4 sphere,\n"
-    "5 cone, 6 bowl.\n",
+    "5 cone, 6 bowl, 7 scenery (far furniture, robots: ids 1000+ in PREFIX_ids.png).\n",
     self, facyl_cli::sceneImageOptionsHelp());
 }
 } // namespace
@@ -67,13 +74,13 @@ main(int argc, char** argv)
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
     prefix = args.positional()[0];
-    const std::string layout = args.text("--layout", "spread");
-    if (layout == "cluttered")
-      p = facyl::clutteredSceneParameters();
-    else if (layout != "spread")
-      throw std::invalid_argument("--layout must be spread or cluttered");
+    if (!facyl::parseLayoutPreset(args.text("--layout", "spread"), p))
+      throw std::invalid_argument("--layout must be spread, cluttered or realistic");
     if (!facyl::parseSensorPreset(args.text("--sensor", "kinect"), p.sensor, p.camera))
-      throw std::invalid_argument("--sensor must be kinect or stereo");
+      throw std::invalid_argument("--sensor must be kinect, stereo or random");
+    if (p.sensor.randomize && (args.has("--noise") || args.has("--no-quantisation")))
+      throw std::invalid_argument("--noise and --no-quantisation cannot be combined with "
+                                  "--sensor random (its settings are drawn per scene)");
     p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
     count = static_cast<std::size_t>(args.integer("--count", 1, 1, 100000));
     const std::string objects = args.text(

@@ -65,7 +65,12 @@ percentile(std::vector<double> v, double q)
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
 }
 
-/** Per point: object id (> 0) of the objects scored, 0 for the rest, -1 without depth. */
+/** Truth label of the points on scenery (simulated far furniture and robots): neither an
+ * object nor the background; output objects mostly on it are not scored. */
+constexpr int kSceneryLabel = -2;
+
+/** Per point: object id (> 0) of the objects scored, 0 for the rest, kSceneryLabel on
+ * scenery, -1 without depth. */
 template <typename LabelOf>
 std::vector<int>
 truthVector(const Cloud& cloud, LabelOf label_of)
@@ -77,17 +82,25 @@ truthVector(const Cloud& cloud, LabelOf label_of)
 }
 
 /** Maps each output object to the ground-truth label most of its points carry and fills the
- * rows' detection fields; output objects matching no row go to \a stray. */
-void
+ * rows' detection fields; output objects matching no row go to \a stray, except those with at
+ * least half their points on scenery (like unlabelled far objects in real data, they are
+ * neither true nor false detections). \return the number of those ignored. */
+std::size_t
 matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vector<int>& truth,
              std::map<int, Row>& rows, std::vector<Stray>& stray)
 {
   std::map<int, std::size_t> best_size;
+  std::size_t on_scenery = 0;
   for (std::size_t k = 0; k < objects.size(); ++k) {
     const auto& o = objects[k];
     std::map<int, std::size_t> votes;
     for (const auto i : o.cluster.indices.indices)
       ++votes[truth[static_cast<std::size_t>(i)]];
+    const auto scenery = votes.find(kSceneryLabel);
+    if (scenery != votes.end() && 2 * scenery->second >= o.cluster.indices.indices.size()) {
+      ++on_scenery;
+      continue;
+    }
     int label = -1;
     std::size_t most = 0;
     for (const auto& [l, c] : votes)
@@ -109,6 +122,7 @@ matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vec
     r.evidence = o.evidence;
     r.radius = o.evidence.fitted ? o.cylinder.radius : NAN;
   }
+  return on_scenery;
 }
 
 /** Segmentation outcome of every row (output objects as segments). */
@@ -212,7 +226,7 @@ struct Options {
   Eigen::Vector3f up{Eigen::Vector3f::Zero()};
   std::size_t sim{0};
   std::uint64_t seed{1000};
-  bool cluttered{false};
+  std::string layout{"spread"};
   std::string sensor{"kinect"};
   facyl::TabletopSceneParameters scene; ///< layout, sensor and image options; seed per scene
   std::string mosd, csv;
@@ -280,20 +294,27 @@ simulatedRows(const facyl::RenderedScene& scene, std::uint64_t seed, std::size_t
 
 void
 reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
-                const Options& opt, std::size_t failures, std::size_t wrong_plane)
+                const Options& opt, std::size_t failures, std::size_t wrong_plane,
+                std::size_t on_scenery)
 {
   std::size_t cylinders = 0, touching = 0;
   for (const Row& r : all)
     cylinders += r.positive, touching += r.touching;
-  std::printf("## Simulated scenes: %zu (%s layout, %s sensor, %dx%d, %.1f%% dropout, seeds "
+  char dropout[32] = "dropout drawn per scene";
+  if (!opt.scene.sensor.randomize)
+    std::snprintf(dropout, sizeof dropout, "%.1f%% dropout", 100.0 * opt.scene.sensor.dropout);
+  std::printf("## Simulated scenes: %zu (%s layout, %s sensor, %dx%d, %s, seeds "
               "%llu..%llu), %zu objects with >= %zu visible pixels (%zu cylinders, %zu touching "
               "another object); %zu scenes failed (no table), %zu with a wrong support plane\n",
-              opt.sim, opt.cluttered ? "cluttered" : "spread", opt.sensor.c_str(),
-              opt.scene.camera.width, opt.scene.camera.height, 100.0 * opt.scene.sensor.dropout,
+              opt.sim, opt.layout.c_str(), opt.sensor.c_str(),
+              opt.scene.camera.width, opt.scene.camera.height, dropout,
               static_cast<unsigned long long>(opt.seed),
               static_cast<unsigned long long>(opt.seed + opt.sim - 1), all.size(),
               opt.params.segmentation.min_cluster_size, cylinders, touching, failures,
               wrong_plane);
+  if (on_scenery > 0)
+    std::printf("Output objects on scenery (far furniture, robots), not scored: %zu\n",
+                on_scenery);
   segmentationHeader("Segmentation (output objects as segments):");
   segmentationLine(all, "all", [](const Row&) { return true; });
   segmentationLine(all, "touching another", [](const Row& r) { return r.touching; });
@@ -346,6 +367,10 @@ rollScene(facyl::RenderedScene& scene, int quarter_turns)
   for (std::size_t i = 0; i < ids.size(); ++i)
     ids[facyl::rolledIndex(i, w, h, quarter_turns)] = scene.object_id[i];
   scene.object_id = std::move(ids);
+  auto classes = scene.pixel_class;
+  for (std::size_t i = 0; i < classes.size(); ++i)
+    classes[facyl::rolledIndex(i, w, h, quarter_turns)] = scene.pixel_class[i];
+  scene.pixel_class = std::move(classes);
   for (int t = 0; t < ((quarter_turns % 4) + 4) % 4; ++t) // (x, y) -> (-y, x)
     scene.table_plane.head<2>() = Eigen::Vector2f(-scene.table_plane[1], scene.table_plane[0]);
 }
@@ -357,7 +382,7 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<Stray> stray;
   std::vector<facyl::RecognitionTiming> timing;
   std::vector<double> object_counts;
-  std::size_t failures = 0, wrong_plane = 0;
+  std::size_t failures = 0, wrong_plane = 0, on_scenery = 0;
   for (std::size_t k = 0; k < opt.sim; ++k) {
     facyl::TabletopSceneParameters sp = opt.scene;
     sp.seed = opt.seed + k;
@@ -398,9 +423,11 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       }
     }
     const std::vector<int> truth = truthVector(*cloud, [&](std::size_t i) {
+      if (scene.pixel_class[i] == facyl::SceneClass::Scenery)
+        return kSceneryLabel;
       return scene.object_id[i] >= 2 ? static_cast<int>(scene.object_id[i]) : 0;
     });
-    matchObjects(objects, truth, rows, stray);
+    on_scenery += matchObjects(objects, truth, rows, stray);
     scoreRows(objects, truth, rows);
     for (auto& [id, r] : rows) {
       if (r.positive && r.evidence.fitted) {
@@ -412,8 +439,9 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       all.push_back(r);
     }
   }
-  csv.write(opt.cluttered ? "sim-cluttered-" + opt.sensor : "sim-" + opt.sensor, all);
-  reportSimulated(all, stray, opt, failures, wrong_plane);
+  csv.write(opt.layout == "spread" ? "sim-" + opt.sensor : "sim-" + opt.layout + "-" + opt.sensor,
+            all);
+  reportSimulated(all, stray, opt, failures, wrong_plane, on_scenery);
   timingReport(timing, object_counts);
   return 0;
 }
@@ -623,16 +651,18 @@ void
 printHelp(const char* self)
 {
   std::printf(
-    "Usage: %s [--sim N] [--first-seed S] [--layout spread|cluttered] [--sensor kinect|stereo]\n"
+    "Usage: %s [--sim N] [--first-seed S] [--layout spread|cluttered|realistic]\n"
+    "          [--sensor kinect|stereo|random]\n"
     "          [--resolution WxH] [--dropout P] [--mosd DIR] [--roll DEG] [--csv FILE]\n"
     "          [recognizer options]\n"
     "Runs TabletopCylinderRecognizer on N simulated scenes (seeds S.., default 1000) and/or\n"
     "the mOSD learn scenes and prints: segmentation (objects recovered as one segment with\n"
     "IoU >= 0.5, merged, split; in simulation also for the objects touching another), cylinder\n"
     "precision/recall for both scores at several thresholds, radius and axis errors of the\n"
-    "detected cylinders, and the stage timing. --csv writes one row per object. --roll turns\n"
-    "every frame (and its ground truth) as a camera rolled by 90, 180 or 270 degrees clockwise\n"
-    "about its optical axis would have taken it.\n%s",
+    "detected cylinders, and the stage timing. Output objects mostly on simulated scenery (far\n"
+    "furniture, robots of --layout realistic) are neither true nor false detections. --csv\n"
+    "writes one row per object. --roll turns every frame (and its ground truth) as a camera\n"
+    "rolled by 90, 180 or 270 degrees clockwise about its optical axis would have taken it.\n%s",
     self, facyl_cli::recognizerOptionsHelp());
 }
 
@@ -651,14 +681,12 @@ parseOptions(int argc, char** argv)
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
   opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0, 100000));
   opt.seed = static_cast<std::uint64_t>(args.integer("--first-seed", 1000, 0, facyl_cli::kMaxSeed));
-  const std::string layout = args.text("--layout", "spread");
-  if (layout != "spread" && layout != "cluttered")
-    throw std::invalid_argument("--layout must be spread or cluttered");
-  opt.cluttered = layout == "cluttered";
+  opt.layout = args.text("--layout", "spread");
+  if (!facyl::parseLayoutPreset(opt.layout, opt.scene))
+    throw std::invalid_argument("--layout must be spread, cluttered or realistic");
   opt.sensor = args.text("--sensor", "kinect");
-  opt.scene = opt.cluttered ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
   if (!facyl::parseSensorPreset(opt.sensor, opt.scene.sensor, opt.scene.camera))
-    throw std::invalid_argument("--sensor must be kinect or stereo");
+    throw std::invalid_argument("--sensor must be kinect, stereo or random");
   facyl_cli::applySceneImageOptions(args, opt.scene);
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");

@@ -29,10 +29,11 @@ sceneImageOptionsHelp()
   return "  --resolution WxH   image size in pixels, 64..4096 each (default: the sensor's, 640x480);\n"
          "                     the field of view is kept\n"
          "  --dropout P        share of pixels missing at random, in [0, 0.5] (default: the\n"
-         "                     sensor's, 0.002)\n";
+         "                     sensor's, 0.002; not with --sensor random)\n";
 }
 
-/** Reads --resolution and --dropout into \a p (the sensor preset already applied).
+/** Reads --resolution and --dropout into \a p (the sensor preset already applied; a random
+ * sensor scales the resolution's camera and refuses --dropout).
  * \throws std::invalid_argument for a malformed or out-of-range value. */
 inline void
 applySceneImageOptions(const Arguments& args, facyl::TabletopSceneParameters& p)
@@ -55,6 +56,9 @@ applySceneImageOptions(const Arguments& args, facyl::TabletopSceneParameters& p)
     c.width = w;
     c.height = h;
   }
+  if (p.sensor.randomize && args.has("--dropout"))
+    throw std::invalid_argument("--dropout cannot be combined with --sensor random (its "
+                                "dropout is drawn per scene)");
   p.sensor.dropout = static_cast<float>(args.number("--dropout", p.sensor.dropout, 0.0, 0.5));
 }
 

@@ -1,9 +1,11 @@
 /*
  * facyl: fast cylinder detection for PCL.
- * Depth sensor models applied to a ray-cast image: structured light and active stereo.
+ * Depth sensor models applied to a ray-cast image: structured light, active stereo and
+ * time of flight, with their response to materials (docs/simulation.md).
  */
 #include <facyl/simulation/random.h>
 #include <facyl/simulation/scene_rendering.h>
+#include <facyl/simulation/sensor_effects.h>
 
 #include <algorithm>
 #include <cmath>
@@ -49,6 +51,12 @@ parseSensorPreset(const std::string& name, DepthSensorModel& sensor, CameraIntri
     sensor = DepthSensorModel::activeStereo();
     camera = CameraIntrinsics{};
     camera.fx = camera.fy = 615.f;
+    return true;
+  }
+  if (name == "random") {
+    sensor = DepthSensorModel::structuredLight();
+    sensor.randomize = true;
+    camera = CameraIntrinsics{};
     return true;
   }
   return false;
@@ -112,6 +120,92 @@ foregroundBeside(const RayCastImage& image, int u, int v, float z, float edge_ju
   return best;
 }
 
+/** The depth of the 4-neighbour farthest from z, if it differs by more than edge_jump * z,
+ * or NaN: the other side of a depth edge. */
+float
+acrossJump(const RayCastImage& image, int u, int v, float z, float edge_jump)
+{
+  float best = std::numeric_limits<float>::quiet_NaN(), gap = edge_jump * z;
+  for (const auto& [du, dv] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+    const int uu = u + du, vv = v + dv;
+    if (uu < 0 || vv < 0 || uu >= image.width || vv >= image.height)
+      continue;
+    const float zn = image.depth[static_cast<std::size_t>(vv) * image.width + uu];
+    if (std::isfinite(zn) && std::abs(zn - z) > gap) {
+      gap = std::abs(zn - z);
+      best = zn;
+    }
+  }
+  return best;
+}
+
+/** A flying pixel (time of flight: the pixel mixes the returns of both sides of a depth edge):
+ * with probability flying_pixels, \a z moves to a random point between itself and the other
+ * side. \return false if the pixel does not fly. */
+bool
+flyingDepth(const RayCastImage& image, int u, int v, const DepthSensorModel& sensor,
+            Random& rng, float& z)
+{
+  if (!(sensor.flying_pixels > 0.f) || !rng.chance(sensor.flying_pixels))
+    return false;
+  const float other = acrossJump(image, u, v, z, sensor.edge_jump);
+  if (!std::isfinite(other))
+    return false;
+  z += static_cast<float>(rng.unit()) * (other - z);
+  return true;
+}
+
+SurfaceMaterial
+materialAt(const RayCastImage& image, std::size_t idx)
+{
+  return image.material.empty() ? SurfaceMaterial{} : image.material[idx];
+}
+
+/** Blobs of missing depth on surfaces of weak return (weakReturnDropout), each kept within the
+ * surface (pixel id) it starts on; empty when every surface returns fully. */
+std::vector<std::uint8_t>
+weakReturnMask(const RayCastImage& image, const DepthSensorModel& sensor, Random& rng)
+{
+  constexpr float kRadius = 2.5f; // mean blob radius (px); radii are kRadius * U(0.6, 1.4)
+  constexpr float kMeanArea = 3.14159265f * kRadius * kRadius * 1.0533f; // pi E[r^2]
+  const int w = image.width, h = image.height;
+  std::vector<std::uint8_t> mask;
+  if (image.material.empty())
+    return mask;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const std::size_t idx = static_cast<std::size_t>(v) * w + u;
+      if (!std::isfinite(image.depth[idx]))
+        continue;
+      const float p = weakReturnDropout(sensor, diffuseReturn(image.material[idx]));
+      if (!(p > 0.f))
+        continue;
+      // Blob centres at the rate that covers a share p of a uniform surface:
+      // 1 - exp(-rate * area) = p.
+      const float rate = -std::log(1.f - std::min(p, 0.95f)) / kMeanArea;
+      if (!rng.chance(rate))
+        continue;
+      if (mask.empty())
+        mask.assign(static_cast<std::size_t>(w) * h, 0);
+      const float r = kRadius * rng.uniform(0.6f, 1.4f);
+      const int ri = static_cast<int>(std::ceil(r));
+      for (int dv = -ri; dv <= ri; ++dv)
+        for (int du = -ri; du <= ri; ++du) {
+          const int uu = u + du, vv = v + dv;
+          const std::size_t k = static_cast<std::size_t>(vv) * w + uu;
+          if (uu >= 0 && vv >= 0 && uu < w && vv < h &&
+              static_cast<float>(du * du + dv * dv) <= r * r && image.id[k] == image.id[idx])
+            mask[k] = 1;
+        }
+    }
+  return mask;
+}
+
+/** Seed offset of the random numbers of the effects added after the first sensor model (weak
+ * returns, highlights, flying pixels): the pixels of the older effects draw the same numbers
+ * as before. */
+constexpr std::uint64_t kEffectsStream = 0x2545f4914f6cdd1dULL;
+
 } // namespace
 
 void
@@ -123,7 +217,9 @@ applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
   const int w = image.width, h = image.height;
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   Random rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  Random effects(seed ^ kEffectsStream);
   const std::vector<std::uint8_t> hole = holeMask(w, h, sensor, rng);
+  const std::vector<std::uint8_t> weak = weakReturnMask(image, sensor, effects);
   cloud.width = static_cast<std::uint32_t>(w);
   cloud.height = static_cast<std::uint32_t>(h);
   cloud.is_dense = false;
@@ -148,18 +244,30 @@ applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
       const float noise = rng.normal();
       const float drop = static_cast<float>(rng.unit());
       const float fatten = static_cast<float>(rng.unit());
-      if (!std::isfinite(z) || image.incidence[idx] < sensor.grazing_cos ||
+      const SurfaceMaterial material = materialAt(image, idx);
+      const float rho = diffuseReturn(material); // 1 on the reference material
+      const float cos_incidence = image.incidence[idx];
+      if (!std::isfinite(z) || rho * cos_incidence < sensor.grazing_cos ||
           drop < sensor.dropout || hole[idx])
+        continue;
+      if (!weak.empty() && weak[idx])
+        continue;
+      if (material.gloss > 0.f &&
+          effects.chance(highlightProbability(sensor, material.gloss, cos_incidence)))
         continue;
       if (sensor.edge_jump > 0.f && besideJump(image, u, v, z, sensor.edge_jump)) {
         const float front = foregroundBeside(image, u, v, z, sensor.edge_jump);
-        if (!(fatten < sensor.edge_fattening && std::isfinite(front)))
+        if (fatten < sensor.edge_fattening && std::isfinite(front))
+          z = front; // the foreground spreads over this background pixel
+        else if (!flyingDepth(image, u, v, sensor, effects, z))
           continue;
-        z = front; // the foreground spreads over this background pixel
       }
-      if (z < sensor.min_range || z > sensor.max_range)
+      if (z < sensor.min_range || z > reach(sensor, rho))
         continue;
-      z += sensor.noise_coefficient * z * z * noise;
+      z += depthBias(sensor, z, radialPosition2(camera, static_cast<float>(u),
+                                                static_cast<float>(v)),
+                     cos_incidence);
+      z += axialNoiseSigma(sensor, z, rho) * noise;
       if (sensor.disparity_step > 0.f) {
         const float disparity = sensor.baseline_focal / z;
         z = sensor.baseline_focal /

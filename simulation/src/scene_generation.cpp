@@ -2,6 +2,8 @@
  * facyl: fast cylinder detection for PCL.
  * Random tabletop scenes: table, objects (apart, touching, stacked, leaning) and camera.
  */
+#include "scene_realism.h"
+
 #include <facyl/features/polygon.h>
 #include <facyl/simulation/random.h>
 #include <facyl/simulation/tabletop_scene.h>
@@ -603,6 +605,7 @@ generateTabletopScene(const TabletopSceneParameters& params)
   }
   scene.objects = layout.objects();
   drawCamera(params, rng, scene);
+  detail::addRealism(params, scene);
   return scene;
 }
 
@@ -628,6 +631,39 @@ clutteredSceneParameters()
   p.camera_roll = {-0.15f, 0.15f};
   p.camera_target_jitter = 0.12f;
   return p;
+}
+
+TabletopSceneParameters
+realisticSceneParameters()
+{
+  TabletopSceneParameters p = clutteredSceneParameters();
+  p.wall_share = 0.15f; // more room for the far background
+  p.camera_distance = {0.55f, 1.8f};
+  p.camera_elevation = {0.26f, 1.48f}; // 15 (grazing) to 85 degrees (straight above)
+  p.any_roll_share = 0.3f;
+  p.table_sag = {-0.006f, 0.006f};
+  p.table_materials = {0.35f, 0.3f, 0.f};
+  p.floor_materials = {0.3f, 0.15f, 0.f};
+  p.object_materials = {0.3f, 0.15f, 0.08f};
+  p.min_background_items = 2;
+  p.max_background_items = 6;
+  p.background_distance = {1.5f, 4.f};
+  p.robot_share = 0.35f;
+  return p;
+}
+
+bool
+parseLayoutPreset(const std::string& name, TabletopSceneParameters& params)
+{
+  if (name == "spread")
+    params = TabletopSceneParameters{};
+  else if (name == "cluttered")
+    params = clutteredSceneParameters();
+  else if (name == "realistic")
+    params = realisticSceneParameters();
+  else
+    return false;
+  return true;
 }
 
 bool

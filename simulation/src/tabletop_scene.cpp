@@ -23,6 +23,7 @@ toString(SceneClass c)
   case SceneClass::Sphere: return "sphere";
   case SceneClass::Cone: return "cone";
   case SceneClass::Bowl: return "bowl";
+  case SceneClass::Scenery: return "scenery";
   }
   return "unknown";
 }
@@ -33,6 +34,55 @@ inside(const Range& r, float lo, float hi)
 {
   return r.min >= lo && r.max <= hi && r.min <= r.max;
 }
+
+bool
+share(float x)
+{
+  return x >= 0.f && x <= 1.f;
+}
+
+bool
+shares(const MaterialShares& m, bool transparent_allowed)
+{
+  return share(m.glossy) && share(m.dark) && share(m.transparent) &&
+         (transparent_allowed || m.transparent == 0.f);
+}
+
+/** What is wrong with the settings of \a s added for real sensors' artefacts, or "". */
+std::string
+validateArtefacts(const DepthSensorModel& s)
+{
+  if (!(std::abs(s.depth_scale_error) <= 0.05f) || !(std::abs(s.radial_depth_bias) <= 0.03f) ||
+      !(std::abs(s.incidence_bias) <= 0.01f))
+    return "sensor bias: depth_scale_error must be in [-0.05, 0.05], radial_depth_bias in "
+           "[-0.03, 0.03] m and incidence_bias in [-0.01, 0.01] m";
+  if (!(s.noise_constant >= 0.f && s.noise_constant <= 0.02f) ||
+      !(s.noise_linear >= 0.f && s.noise_linear <= 0.02f) || !share(s.flying_pixels))
+    return "sensor noise_constant and noise_linear must be in [0, 0.02], flying_pixels in [0, 1]";
+  if (!share(s.weak_return_dropout) || !share(s.see_through) ||
+      !(s.highlight_width >= 0.f && s.highlight_width <= 0.5f))
+    return "sensor weak_return_dropout and see_through must be in [0, 1], highlight_width in "
+           "[0, 0.5] rad";
+  return "";
+}
+
+/** What is wrong with the scene settings added for realism, or "". */
+std::string
+validateRealism(const TabletopSceneParameters& p)
+{
+  if (!share(p.any_roll_share) || !share(p.robot_share))
+    return "any_roll_share and robot_share must be in [0, 1]";
+  if (!inside(p.table_sag, -0.02f, 0.02f))
+    return "table_sag must be an ordered range within [-0.02, 0.02] m";
+  if (!shares(p.table_materials, false) || !shares(p.floor_materials, false) ||
+      !shares(p.object_materials, true))
+    return "material shares must be in [0, 1] (transparent: objects only)";
+  if (p.min_background_items > p.max_background_items || p.max_background_items > 20)
+    return "background items: min must be <= max <= 20";
+  if (!inside(p.background_distance, 0.5f, 20.f))
+    return "background_distance must be an ordered range within [0.5, 20] m";
+  return "";
+}
 } // namespace
 
 std::string
@@ -41,7 +91,6 @@ validate(const TabletopSceneParameters& p)
   std::ostringstream why;
   const auto& c = p.camera;
   const auto& s = p.sensor;
-  const auto share = [](float x) { return x >= 0.f && x <= 1.f; };
   if (p.min_objects > p.max_objects)
     why << "min_objects " << p.min_objects << " > max_objects " << p.max_objects;
   else if (p.max_objects > 30)
@@ -77,6 +126,8 @@ validate(const TabletopSceneParameters& p)
            std::abs(s.colour_shift_u) > 16 || std::abs(s.colour_shift_v) > 16 ||
            !(s.min_range >= 0.f) || !(s.max_range > s.min_range) || !(s.colour_noise >= 0.f))
     why << "sensor model is invalid";
+  else
+    why << validateArtefacts(s) << validateRealism(p);
   return why.str();
 }
 
@@ -92,9 +143,42 @@ cylinderTruth(const TabletopScene& scene, const SceneObject& object)
   return t;
 }
 
+float
+curvedTopHeight(const SceneObject& o, float x, float y)
+{
+  if (o.top_sag == 0.f)
+    return 0.f;
+  const float rho2 = o.cls == SceneClass::Box
+                       ? 0.25f * (o.size.x() * o.size.x() + o.size.y() * o.size.y())
+                       : o.radius * o.radius;
+  return o.top_sag * (1.f - (x * x + y * y) / rho2);
+}
+
+const SceneObject*
+TabletopScene::tableTop() const
+{
+  for (const SceneObject& f : furniture)
+    if (f.kind == "table")
+      return &f;
+  return nullptr;
+}
+
+float
+tableTopHeight(const TabletopScene& scene, float x, float y)
+{
+  const SceneObject* top = scene.tableTop();
+  if (top == nullptr || top->top_sag == 0.f)
+    return 0.f;
+  const Eigen::Vector3f local = top->pose.inverse() * Eigen::Vector3f(x, y, 0.f);
+  return curvedTopHeight(*top, local.x(), local.y());
+}
+
+namespace {
+
+/** renderTabletopScene with a sensor that is not drawn. */
 RenderedScene
-renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
-                    const DepthSensorModel& sensor, std::uint64_t seed)
+render(const TabletopScene& scene, const CameraIntrinsics& camera,
+       const DepthSensorModel& sensor, std::uint64_t seed)
 {
   TabletopSceneParameters check;
   check.camera = camera;
@@ -105,7 +189,10 @@ renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
   RenderedScene out;
   out.scene = scene;
   out.camera = camera;
+  out.sensor = sensor;
   RayCastImage image = castRays(scene, camera);
+  if (hasTransparentSurfaces(image))
+    seeThroughTransparent(image, castRaysBehindTransparent(scene, camera, image), sensor, seed);
   out.visible_pixels.assign(scene.objects.size(), 0);
   applySensorModel(image, camera, sensor, seed, out.cloud, out.visible_pixels);
   out.object_id = std::move(image.id);
@@ -118,11 +205,33 @@ renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
   return out;
 }
 
+} // namespace
+
+RenderedScene
+renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
+                    const DepthSensorModel& sensor, std::uint64_t seed)
+{
+  if (!sensor.randomize)
+    return render(scene, camera, sensor, seed);
+  const DrawnSensor drawn = drawSensor(camera, seed);
+  RenderedScene out = render(scene, drawn.camera, drawn.sensor, seed);
+  out.sensor_family = drawn.family;
+  return out;
+}
+
 RenderedScene
 simulateTabletopScene(const TabletopSceneParameters& params)
 {
-  return renderTabletopScene(generateTabletopScene(params), params.camera, params.sensor,
-                             params.seed);
+  if (!params.sensor.randomize)
+    return render(generateTabletopScene(params), params.camera, params.sensor, params.seed);
+  // The scene is made for the drawn sensor (its minimum range places the camera).
+  const DrawnSensor drawn = drawSensor(params.camera, params.seed);
+  TabletopSceneParameters p = params;
+  p.sensor = drawn.sensor;
+  p.camera = drawn.camera;
+  RenderedScene out = render(generateTabletopScene(p), p.camera, p.sensor, p.seed);
+  out.sensor_family = drawn.family;
+  return out;
 }
 
 namespace {
@@ -131,6 +240,60 @@ vec(const Eigen::Vector3f& v)
 {
   std::ostringstream s;
   s << std::setprecision(7) << "[" << v.x() << "," << v.y() << "," << v.z() << "]";
+  return s.str();
+}
+
+/** ,"key":{material} when \a m is not the reference material, else nothing. */
+std::string
+materialJson(const char* key, const SurfaceMaterial& m)
+{
+  if (m.isReference())
+    return "";
+  std::ostringstream s;
+  s << std::setprecision(7) << ",\"" << key << "\":{\"reflectance\":" << m.reflectance
+    << ",\"gloss\":" << m.gloss << ",\"transparency\":" << m.transparency << "}";
+  return s.str();
+}
+
+/** ,"scenery":[...] when the scene has scenery, else nothing. */
+std::string
+sceneryJson(const TabletopScene& scene)
+{
+  if (scene.scenery.empty())
+    return "";
+  std::ostringstream s;
+  s << ",\"scenery\":[";
+  for (std::size_t j = 0; j < scene.scenery.size(); ++j)
+    s << (j ? "," : "") << "{\"id\":" << kFirstSceneryId + j << ",\"kind\":\""
+      << scene.scenery[j].kind << "\",\"parts\":" << scene.scenery[j].parts.size() << "}";
+  s << "]";
+  return s.str();
+}
+
+/** ,"sensor":{...} when the sensor was drawn, else nothing. */
+std::string
+drawnSensorJson(const RenderedScene& r)
+{
+  if (!r.sensor_family)
+    return "";
+  const DepthSensorModel& m = r.sensor;
+  std::ostringstream s;
+  s << std::setprecision(7) << ",\"sensor\":{\"family\":\"" << toString(*r.sensor_family)
+    << "\",\"noise_coefficient\":" << m.noise_coefficient
+    << ",\"noise_constant\":" << m.noise_constant << ",\"noise_linear\":" << m.noise_linear
+    << ",\"baseline_focal\":" << m.baseline_focal << ",\"disparity_step\":" << m.disparity_step
+    << ",\"edge_jump\":" << m.edge_jump << ",\"grazing_cos\":" << m.grazing_cos
+    << ",\"dropout\":" << m.dropout << ",\"hole_rate\":" << m.hole_rate
+    << ",\"hole_radius\":" << m.hole_radius << ",\"edge_fattening\":" << m.edge_fattening
+    << ",\"flying_pixels\":" << m.flying_pixels << ",\"colour_shift\":[" << m.colour_shift_u
+    << "," << m.colour_shift_v << "],\"min_range\":" << m.min_range
+    << ",\"max_range\":" << m.max_range << ",\"colour_noise\":" << m.colour_noise
+    << ",\"depth_scale_error\":" << m.depth_scale_error
+    << ",\"radial_depth_bias\":" << m.radial_depth_bias
+    << ",\"incidence_bias\":" << m.incidence_bias
+    << ",\"weak_return_dropout\":" << m.weak_return_dropout
+    << ",\"highlight_width\":" << m.highlight_width << ",\"see_through\":" << m.see_through
+    << "}";
   return s.str();
 }
 } // namespace
@@ -155,9 +318,16 @@ groundTruthJson(const RenderedScene& r)
     s << "\"radius\":" << sc.table_radius;
   else
     s << "\"width\":" << sc.table_width << ",\"depth\":" << sc.table_depth;
-  s << ",\"height\":" << sc.table_height << ",\"legs\":" << (sc.furniture.size() > 1 ? "true" : "false")
-    << "},\"wall\":" << (sc.wall ? "true" : "false") << ",";
-  s << "\"pixel_ids\":\"0 background (floor, wall), 1 table, 2+i object i\",\"objects\":[";
+  s << ",\"height\":" << sc.table_height
+    << ",\"legs\":" << (sc.furniture.size() > 1 ? "true" : "false");
+  if (const SceneObject* top = sc.tableTop()) {
+    if (top->top_sag != 0.f)
+      s << ",\"sag\":" << top->top_sag;
+    s << materialJson("material", top->material);
+  }
+  s << "},\"wall\":" << (sc.wall ? "true" : "false") << ",";
+  s << "\"pixel_ids\":\"0 background (floor, wall), 1 table, 2+i object i"
+    << (sc.scenery.empty() ? "" : ", 1000+j scenery item j") << "\",\"objects\":[";
   const Eigen::Isometry3f world_to_camera = t.inverse();
   for (std::size_t i = 0; i < r.scene.objects.size(); ++i) {
     const SceneObject& o = r.scene.objects[i];
@@ -187,9 +357,10 @@ groundTruthJson(const RenderedScene& r)
     } else if (o.cls == SceneClass::Cone) {
       s << ",\"height\":" << o.height;
     }
-    s << "}";
+    s << materialJson("material", o.material) << "}";
   }
-  s << "]}";
+  s << "]" << materialJson("floor_material", sc.floor_material) << sceneryJson(sc)
+    << drawnSensorJson(r) << "}";
   return s.str();
 }
 
