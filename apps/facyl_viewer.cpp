@@ -163,7 +163,7 @@ detectObjects(const Settings& s, Scene& scene)
   rec.setInputCloud(scene.cloud);
   std::vector<facyl::RecognizedObject> objects;
   if (!rec.recognize(objects))
-    throw std::runtime_error("no table found");
+    throw std::runtime_error("recognition failed (see the message above)");
   scene.facyl_ms = rec.getTiming().fitting + rec.getTiming().classification;
   scene.table_outline = tableOutline(rec);
   for (const auto& r : objects) {

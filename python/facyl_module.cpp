@@ -417,7 +417,7 @@ detect(const py::object& points, const py::object& colors,
     ok = rec.recognize(objects);
   }
   if (!ok)
-    throw py::value_error("detect: no table found (no plane with objects on it)");
+    throw py::value_error("detect: recognition failed (see the message printed above)");
   py::dict out;
   const auto& t = rec.getTableCoefficients().values;
   py::dict table;
@@ -623,7 +623,9 @@ boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite, op
 model: "default" (the shipped shape classifier), "none", or a path to an .onnx with its .cfg.
 Returns a dict with the fields of facyl_detect's JSON ("table", "supports", "objects" with
 "p_cylinder", "is_cylinder", "cylinder" ..., "timing_ms"); objects also carry "indices" (rows
-of the flattened frame). Raises ValueError when no table is found.)");
+of the flattened frame). A frame without any support is not an error: "table" then has
+"found" False and no coefficients, "supports" is empty and the objects have support -1.
+Raises ValueError for bad input.)");
 
   m.def("simulate_cylinder", &simulateCylinder, py::kw_only(), py::arg("radius") = 0.3,
         py::arg("height") = 1.0, py::arg("axis") = std::vector<double>{0, 0, 1},

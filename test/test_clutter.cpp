@@ -549,14 +549,19 @@ TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
       EXPECT_GT(std::abs(seg.getTableCoefficients().values[3] - s.table_plane[3]), 0.05f) << what;
     }
   }
-  // An up direction that no plane matches: no support.
+  // An up direction that no plane matches: no support, not an error; the objects are still
+  // segmented (without a support).
   const facyl::RenderedScene s = render(scene, views[0].first, {0.f, 0.f, 0.04f});
   Cloud::Ptr cloud(new Cloud(s.cloud));
   facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
   seg.setInputCloud(cloud);
   seg.setUpDirection(Eigen::Vector3f(1.f, 0.f, 0.f));
   std::vector<facyl::TabletopCluster> clusters;
-  EXPECT_FALSE(seg.segment(clusters));
+  EXPECT_TRUE(seg.segment(clusters));
+  EXPECT_FALSE(seg.tableFound());
+  EXPECT_TRUE(seg.getSupports().empty());
+  for (const auto& c : clusters)
+    EXPECT_EQ(c.support, -1);
 }
 
 // ---------------------------------------------------------------- recognition

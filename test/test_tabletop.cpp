@@ -345,13 +345,18 @@ TEST(TabletopSegmentation, ReportsBadInput)
     p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
   seg.setInputCloud(nan);
   EXPECT_FALSE(seg.segment(clusters));
-  // A lone cylinder: no plane.
+  // A lone cylinder: no support, which is not an error (see FramesWithoutSupport).
   facyl::CylinderSimulationParameters cp;
+  cp.radius = 0.04f;
+  cp.height = 0.12f;
   const auto cyl = facyl::simulateCylinder(cp);
   pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
   pcl::copyPointCloud(cyl.cloud, *xyz);
   seg.setInputCloud(xyz);
-  EXPECT_FALSE(seg.segment(clusters));
+  EXPECT_TRUE(seg.segment(clusters));
+  EXPECT_FALSE(seg.tableFound());
+  EXPECT_TRUE(seg.getSupports().empty());
+  EXPECT_TRUE(seg.getTableCoefficients().values.empty());
   facyl::TabletopSegmentationParameters bad;
   bad.min_height = 0.5f;
   bad.max_height = 0.1f;

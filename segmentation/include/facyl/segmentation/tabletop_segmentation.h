@@ -420,12 +420,13 @@ private:
   rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all,
                bool& agreed) const;
   /** The supports of \a family (large enough, see min_support_area) and the objects on
-   * them. \a stride 1: at full resolution (the family's planes are moved out of \a all);
-   * larger: only the standing points counted, on every stride-th pixel and row (to compare
-   * families). */
+   * them, on every \a stride-th pixel and row of an organized input (1: all; larger: only the
+   * standing points are counted, to compare families). \a final: the result (the family's
+   * planes are moved out of \a all). */
   Trial
   tryFamily(const std::vector<std::size_t>& family, const std::vector<Candidate>& candidates,
-            std::vector<SupportPlane>& all, const std::vector<Above>& above, int stride);
+            std::vector<SupportPlane>& all, const std::vector<Above>& above, int stride,
+            bool final);
   /** The pixel stride of the coarse trials of families (1 for point sets). */
   int
   coarseStride() const;

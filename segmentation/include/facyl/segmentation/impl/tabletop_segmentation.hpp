@@ -167,7 +167,7 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   if (families.size() > 1) {
     std::size_t most = 0;
     for (std::size_t f = 0; f < families.size(); ++f) {
-      const Trial coarse = tryFamily(families[f], candidates, all, above, coarseStride());
+      const Trial coarse = tryFamily(families[f], candidates, all, above, coarseStride(), false);
       tried += !coarse.supports.empty();
       PCL_DEBUG("[facyl::TabletopSegmentation] family %zu (%zu planes, first (%.3f %.3f %.3f)): "
                 "%zu supports, %zu points standing (coarse)\n",
@@ -181,7 +181,7 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   }
   std::optional<Trial> best;
   if (!families.empty()) {
-    Trial trial = tryFamily(families[chosen], candidates, all, above, 1);
+    Trial trial = tryFamily(families[chosen], candidates, all, above, 1, true);
     if (!trial.supports.empty())
       best = std::move(trial);
   }
@@ -469,12 +469,10 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
       break;
     const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
     Candidate cand;
-    const std::size_t before = std::count(taken.begin(), taken.end(), 1);
     if (growCandidate(cells, cell_normals, cells, seed, sampled, cell_points, taken, cand))
       candidates.push_back(std::move(cand));
-    if (static_cast<std::size_t>(std::count(taken.begin(), taken.end(), 1)) == before)
-      for (const auto i : inliers.indices) // not a plane: its seed is not searched again
-        taken[static_cast<std::size_t>(i)] = 1;
+    for (const auto i : inliers.indices) // the next search looks elsewhere
+      taken[static_cast<std::size_t>(i)] = 1;
   }
 }
 
@@ -646,7 +644,8 @@ typename TabletopSegmentation<PointT>::Trial
 TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
                                         const std::vector<Candidate>& candidates,
                                         std::vector<SupportPlane>& all,
-                                        const std::vector<Above>& above, int stride)
+                                        const std::vector<Above>& above, int stride,
+                                        bool final)
 {
   const bool largest = params_.support == TabletopSegmentationParameters::Support::LargestPlane;
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
@@ -673,7 +672,7 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     // table.
     const float region = regionArea(candidates[s], support.frame);
     const float hull = polygonArea(support.polygon);
-    if (stride == 1)
+    if (final)
       PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d "
                 "%.3f, %zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
                 s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
@@ -685,8 +684,8 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
       continue;
     kept |= static_cast<std::uint8_t>(1u << s);
     extents_.push_back(supportHull(support.frame, all[s].inliers.indices, nullptr));
-    if (stride == 1)
-      support.inliers = std::move(all[s].inliers); // the final trial: a candidate is in one family
+    if (final)
+      support.inliers = std::move(all[s].inliers); // a candidate is in one family only
     else
       support.inliers.indices.resize(all[s].inliers.indices.size()); // only the count is used
     supports_.push_back(std::move(support));
