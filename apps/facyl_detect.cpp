@@ -171,6 +171,7 @@ writeObject(std::ostream& out, std::size_t id, const facyl::RecognizedObject& o)
       << ",\"inlier_ratio\":" << facyl_cli::number(e.inlier_ratio)
       << ",\"surface_ratio\":" << facyl_cli::number(e.surface_ratio)
       << ",\"curvature_ratio\":" << optional(e.curvature_ratio)
+      << ",\"taper\":" << optional(e.taper) << ",\"arc_gap\":" << optional(e.arc_gap)
       << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
   if (e.fitted)
     out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)

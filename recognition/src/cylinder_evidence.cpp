@@ -371,4 +371,22 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   return e;
 }
 
+float
+shareInside(const CylinderModel& model, const Eigen::Matrix3Xf& points, float radial_factor,
+            float axial_margin)
+{
+  if (points.cols() == 0 || !(model.radius > 0.f))
+    return 0.f;
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float h = (model.top - model.base).dot(a);
+  const float reach = radial_factor * model.radius;
+  std::size_t inside = 0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f d = points.col(i) - model.base;
+    const float t = d.dot(a);
+    inside += (d - t * a).norm() <= reach && t >= -axial_margin && t <= h + axial_margin;
+  }
+  return static_cast<float>(inside) / static_cast<float>(points.cols());
+}
+
 } // namespace facyl

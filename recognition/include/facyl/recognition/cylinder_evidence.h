@@ -214,4 +214,12 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
               const ExplainSettings& settings, float radial_margin, float axial_margin,
               float margin, std::vector<Explained>* explained = nullptr);
 
+/** \brief Share of \a points (3 x n) inside the volume of \a model: within \a radial_factor x
+ * radius of its axis and between base and top grown by \a axial_margin (m). The inside of an
+ * open container (a cup, a bowl) seen through its opening lies inside the cylinder fitted to
+ * its outer wall; an object behind or beside it does not. 0 for no points. */
+float
+shareInside(const CylinderModel& model, const Eigen::Matrix3Xf& points, float radial_factor,
+            float axial_margin);
+
 } // namespace facyl

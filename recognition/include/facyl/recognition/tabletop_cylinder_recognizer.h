@@ -216,6 +216,13 @@ private:
    * p_network (split parts: of their own view), p_cylinder (fused) and the decision. */
   void
   applyClassifier(std::vector<RecognizedObject>& objects, std::size_t first, float p_cluster);
+  /** Sets the estimators' prior frame to that of support \a support (-1: none). */
+  void
+  usePriorFrameOf(int support);
+  /** Joins each object lying inside the cylinder fitted to another (the inside of an open
+   * container, cut off at its rim) to that one, and recognizes the joined objects again. */
+  void
+  joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */
   FitInput
   prepareFit(const TabletopCluster& cluster);

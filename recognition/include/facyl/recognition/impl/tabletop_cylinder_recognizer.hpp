@@ -141,27 +141,145 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
   cues_estimation_.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
   const std::vector<float> p_network = classifyClusters(clusters);
-  int frame_of = -1;
   for (std::size_t k = 0; k < clusters.size(); ++k) {
-    // The prior is set in the frame of the support the object stands on; without one, in
-    // the frame of an upright camera (z up: against the image's rows).
-    if (clusters[k].support != frame_of || k == 0) {
-      frame_of = clusters[k].support;
-      Eigen::Matrix3f frame;
-      if (frame_of >= 0)
-        frame = segmentation_.getSupports()[static_cast<std::size_t>(frame_of)].frame.linear();
-      else
-        frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
-      for (auto& hough : estimators_)
-        hough.setReferenceFrame(frame);
-    }
+    usePriorFrameOf(clusters[k].support);
     const std::size_t first = objects.size();
     recognizeCluster(std::move(clusters[k]), p_network[k], objects);
     if (classifier_)
       applyClassifier(objects, first, p_network[k]);
   }
+  joinContainerInsides(objects);
   timing_.total = ms(t0, Clock::now());
   return true;
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::usePriorFrameOf(int support)
+{
+  // The frame of the support the object stands on; without one, that of an upright camera
+  // (z up: against the image's rows).
+  Eigen::Matrix3f frame;
+  if (support >= 0)
+    frame = segmentation_.getSupports()[static_cast<std::size_t>(support)].frame.linear();
+  else
+    frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
+  for (auto& hough : estimators_)
+    hough.setReferenceFrame(frame);
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedObject>& objects)
+{
+  // The inside of an open container (a cup, a bowl) seen through its opening is cut off its
+  // outside at the near rim, a depth jump: an object lying within the cylinder fitted to
+  // another's outer wall (most of it within the rim, which may be wider than the wall fitted
+  // below it, and a good part within the wall's radius: an object beside or behind is not),
+  // up to a radius above its top (a bowl's rim rises above that wall), and facing the axis
+  // (concave, unlike an object stacked on a lid) is
+  // that container's inside. The two are joined and judged again as one object (a bowl,
+  // whole, no longer looks like a can). Organized clouds only: the normals come from the
+  // pixel grid.
+  constexpr float kRim = 1.3f, kInside = 0.6f, kWithinWall = 0.4f, kFacingAxis = 0.6f;
+  if (!input_->isOrganized())
+    return;
+  const auto w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  /** A point of the object and its normal from the pixel grid (NaN when unknown). */
+  const auto pointAndNormal = [&](pcl::index_t i, Eigen::Vector3f& p, Eigen::Vector3f& n) {
+    const int u = static_cast<int>(i % w), v = static_cast<int>(i / w), s = 2;
+    p = (*input_)[i].getVector3fMap();
+    n = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    if (u < s || v < s || u + s >= w || v + s >= h)
+      return;
+    const auto at = [&](int du, int dv) {
+      return Eigen::Vector3f((*input_)[static_cast<std::size_t>((v + dv) * w + u + du)].getVector3fMap());
+    };
+    const Eigen::Vector3f m = (at(s, 0) - at(-s, 0)).cross(at(0, s) - at(0, -s));
+    if (m.allFinite() && m.norm() > 0.f)
+      n = m.dot(viewpoint - p) >= 0.f ? Eigen::Vector3f(m.normalized()) : Eigen::Vector3f(-m.normalized());
+  };
+  const auto isInside = [&](const CylinderModel& c, const RecognizedObject& o) {
+    const Eigen::Vector3f axis = c.axis.normalized();
+    const float height = (c.top - c.base).dot(axis);
+    const auto& idx = o.cluster.indices.indices;
+    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
+    std::size_t n = 0, inside = 0, within_wall = 0, facing = 0, sided = 0;
+    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
+      Eigen::Vector3f p, q;
+      pointAndNormal(idx[k], p, q);
+      const Eigen::Vector3f d = p - c.base;
+      const float t = d.dot(axis);
+      const Eigen::Vector3f radial = d - t * axis;
+      if (radial.norm() > kRim * c.radius || t < -0.2f * c.radius || t > height + c.radius)
+        continue;
+      ++inside;
+      within_wall += radial.norm() <= c.radius;
+      const float side = q.allFinite() ? q.dot(radial.normalized()) : 0.f;
+      if (std::abs(side) > 0.3f) {
+        ++sided;
+        facing += side < 0.f;
+      }
+    }
+    return n > 0 && static_cast<float>(inside) >= kInside * static_cast<float>(n) &&
+           static_cast<float>(within_wall) >= kWithinWall * static_cast<float>(n) && sided > 0 &&
+           static_cast<float>(facing) >= kFacingAxis * static_cast<float>(sided);
+  };
+  std::vector<int> host(objects.size(), -1);
+  bool any = false;
+  for (std::size_t a = 0; a < objects.size(); ++a) {
+    const RecognizedObject& outer = objects[a];
+    if (!outer.evidence.fitted || !acceptGeometry(outer.evidence, params_.decision))
+      continue;
+    for (std::size_t b = 0; b < objects.size(); ++b) {
+      if (b == a || host[b] >= 0 || host[a] >= 0 ||
+          objects[b].cluster.support != outer.cluster.support)
+        continue;
+      if (isInside(outer.cylinder, objects[b])) {
+        host[b] = static_cast<int>(a);
+        any = true;
+      }
+    }
+  }
+  if (!any)
+    return;
+  std::vector<RecognizedObject> kept, joined;
+  std::vector<TabletopCluster> merged;
+  for (std::size_t a = 0; a < objects.size(); ++a) {
+    if (host[a] >= 0)
+      continue;
+    if (std::find(host.begin(), host.end(), static_cast<int>(a)) == host.end()) {
+      kept.push_back(std::move(objects[a]));
+      continue;
+    }
+    TabletopCluster c = objects[a].cluster;
+    for (std::size_t b = 0; b < objects.size(); ++b)
+      if (host[b] == static_cast<int>(a))
+        c.indices.indices.insert(c.indices.indices.end(), objects[b].cluster.indices.indices.begin(),
+                                 objects[b].cluster.indices.indices.end());
+    std::sort(c.indices.indices.begin(), c.indices.indices.end());
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.indices.indices.size()));
+    for (std::size_t k = 0; k < c.indices.indices.size(); ++k)
+      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.indices.indices[k]].getVector3fMap();
+    c.centroid = pts.rowwise().mean();
+    c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
+                                  : projectedBox(pts, camera_);
+    merged.push_back(std::move(c));
+  }
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu containers joined with their insides\n",
+            merged.size());
+  const std::vector<float> p_network = classifyClusters(merged);
+  for (std::size_t k = 0; k < merged.size(); ++k) {
+    const std::size_t first = joined.size();
+    usePriorFrameOf(merged[k].support);
+    recognizeCluster(std::move(merged[k]), p_network[k], joined);
+    if (classifier_)
+      applyClassifier(joined, first, p_network[k]);
+  }
+  objects = std::move(kept);
+  for (auto& o : joined)
+    objects.push_back(std::move(o));
 }
 
 template <typename PointT>
