@@ -209,6 +209,10 @@ private:
   /** Builds the cue estimation and the estimators (one per prior of the retries). */
   void
   configure();
+  /** What the classifier sees of the points \a indices: the image's pixels, or (an unorganized
+   * cloud without a camera) a virtual camera's at the sensor origin (lookAtObjectView). */
+  ObjectView
+  viewOf(const pcl::Indices& indices) const;
   /** The classifier's network probability of each cluster (one batch); NaN without one. */
   std::vector<float>
   classifyClusters(const std::vector<TabletopCluster>& clusters);

@@ -283,6 +283,15 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
 }
 
 template <typename PointT>
+ObjectView
+TabletopCylinderRecognizer<PointT>::viewOf(const pcl::Indices& indices) const
+{
+  if (input_->isOrganized() || camera_.valid())
+    return objectView(*input_, indices, camera_);
+  return lookAtObjectView(*input_, indices, input_->sensor_origin_.head(3));
+}
+
+template <typename PointT>
 std::vector<float>
 TabletopCylinderRecognizer<PointT>::classifyClusters(const std::vector<TabletopCluster>& clusters)
 {
@@ -293,7 +302,7 @@ TabletopCylinderRecognizer<PointT>::classifyClusters(const std::vector<TabletopC
   std::vector<ObjectView> views;
   views.reserve(clusters.size());
   for (const auto& c : clusters)
-    views.push_back(objectView(*input_, c.indices.indices, camera_));
+    views.push_back(viewOf(c.indices.indices));
   p = classifier_->cylinderProbabilities(views);
   timing_.classification +=
     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -314,7 +323,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
     auto& e = objects[k].evidence;
     e.p_network = p_cluster;
     if (split && e.fitted) {
-      views.push_back(objectView(*input_, objects[k].cluster.indices.indices, camera_));
+      views.push_back(viewOf(objects[k].cluster.indices.indices));
       which.push_back(k);
     }
   }
