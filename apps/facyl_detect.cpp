@@ -7,6 +7,7 @@
 #include "recognizer_options.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/simulation/frame_roll.h>
 
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
@@ -41,7 +42,11 @@ printHelp(const char* self)
     "                         <stem>-<k>.png when scenes share a name, k from 1)\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
-    "  --verbose              what each step found, on stderr\n"
+    "  --verbose              what each step found (PCL's debug messages, on standard\n"
+    "                         output between the JSON lines)\n"
+    "  --roll DEG             each frame as a camera rolled by DEG (90, 180, 270) clockwise\n"
+    "                         about its optical axis would have taken it (organized frames;\n"
+    "                         boxes and overlays are in the rolled image)\n"
     "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad "
     "usage.\n",
     self, facyl_cli::recognizerOptionsHelp());
@@ -126,6 +131,7 @@ struct Settings {
   int repeat{1};
   bool many{false};
   bool verbose{false}; ///< --verbose: PCL's debug messages (what the segmentation found)
+  int roll{0};         ///< --roll: quarter turns of the camera about its optical axis
   facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
 };
 
@@ -310,6 +316,11 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   pcl::fromPCLPointCloud2(blob, *cloud);
   cloud->sensor_origin_ = viewpoint.origin;
   cloud->sensor_orientation_ = viewpoint.orientation;
+  if (s.roll != 0) {
+    if (!cloud->isOrganized())
+      return fail("--roll needs an organized cloud");
+    *cloud = facyl::rollFrame(*cloud, s.roll);
+  }
   const bool has_colour = facyl_cli::hasField(blob, "rgb") || facyl_cli::hasField(blob, "rgba");
   if (cloud->empty())
     return fail("the cloud is empty");
@@ -358,7 +369,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   const facyl_cli::Arguments args(
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      {"--camera", "--overlay", "--save-clusters", "--repeat"}),
+                      {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll"}),
     facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose"}));
   files = args.positional();
   if (files.empty())
@@ -381,6 +392,10 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.overlay = args.text("--overlay", "");
   s.clusters_dir = args.text("--save-clusters", "");
   s.repeat = static_cast<int>(args.integer("--repeat", 1, 1, 1000));
+  const long long roll = args.integer("--roll", 0, 0, 270);
+  if (roll % 90 != 0)
+    throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
+  s.roll = static_cast<int>(roll / 90);
   s.verbose = args.has("--verbose");
   s.many = files.size() > 1;
   if (!s.many && !s.overlay.empty()) {

@@ -427,8 +427,8 @@ private:
   void
   classifyPoints(const std::vector<Candidate>& candidates, std::vector<SupportPlane>& all,
                  std::vector<Above>& above) const;
-  /** The three families of parallel candidates with the most points, those an upright camera
-   * would see facing up first. */
+  /** The families of parallel candidates, those an upright camera would see facing up first,
+   * then by their number of points. */
   std::vector<std::vector<std::size_t>>
   rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all) const;
   /** The supports of \a family (large enough, see min_support_area) and the objects on

@@ -643,12 +643,7 @@ TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candida
       sum += all[s].inliers.indices.size();
     return sum;
   };
-  // The three with the most points, whatever the roll; among them, an upright camera's
-  // choice first.
-  std::stable_sort(families.begin(), families.end(),
-                   [&](const auto& a, const auto& b) { return points(a) > points(b); });
-  if (families.size() > 3)
-    families.resize(3);
+  // An upright camera's choice first.
   std::stable_sort(families.begin(), families.end(), [&](const auto& a, const auto& b) {
     const bool ua = faces_up(a), ub = faces_up(b);
     return ua != ub ? ua : points(a) > points(b);
