@@ -490,6 +490,14 @@ private:
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   std::vector<SupportPlane> supports_;
   std::vector<std::vector<Eigen::Vector2f>> extents_; ///< hulls of all the supports' points
+  /** Per candidate of the last run: its hulls (see supportHull) and region area, computed once
+   * for all the trials of its family. */
+  struct Hulls {
+    bool known{false};
+    std::vector<Eigen::Vector2f> polygon, extent;
+    float region{0.f};
+  };
+  std::vector<Hulls> hulls_;
   std::size_t table_{0};
   bool table_found_{false};
   float focal_{0.f}; ///< pixels (organized input)

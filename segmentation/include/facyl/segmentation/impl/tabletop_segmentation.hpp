@@ -154,6 +154,7 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   std::vector<SupportPlane> all;
   std::vector<Above> above;
   classifyPoints(candidates, all, above);
+  hulls_.assign(candidates.size(), Hulls{});
   const double t_points = ms(t0);
   // The family of supports is the one most objects stand on: no camera roll is assumed.
   // Several families: each is judged on a coarse grid of its object points (a clustering at
@@ -676,7 +677,13 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     support.plane = all[s].plane;
     support.band = all[s].band;
     support.frame = all[s].frame;
-    support.polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
+    if (!hulls_[s].known) { // once per candidate: every trial of its family needs them
+      hulls_[s].polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
+      hulls_[s].extent = supportHull(support.frame, all[s].inliers.indices, nullptr);
+      hulls_[s].region = regionArea(candidates[s], support.frame);
+      hulls_[s].known = true;
+    }
+    support.polygon = hulls_[s].polygon;
     // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
     // by the region found on it: its infinite plane slices through the objects around it.
     const float range = (support.frame.translation() - viewpoint).norm();
@@ -689,7 +696,7 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     }
     // Its own region must be sizeable too: a small region's infinite plane can cross a
     // table.
-    const float region = regionArea(candidates[s], support.frame);
+    const float region = hulls_[s].region;
     const float hull = polygonArea(support.polygon);
     if (final)
       PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d "
@@ -702,7 +709,7 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     if (support.polygon.size() < 3 || !(largest || large))
       continue;
     kept |= static_cast<std::uint8_t>(1u << s);
-    extents_.push_back(supportHull(support.frame, all[s].inliers.indices, nullptr));
+    extents_.push_back(hulls_[s].extent);
     if (final)
       support.inliers = std::move(all[s].inliers); // a candidate is in one family only
     else
