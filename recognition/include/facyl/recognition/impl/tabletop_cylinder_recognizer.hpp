@@ -369,9 +369,12 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
     if (object.is_cylinder)
       refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
   }
-  // Cylinder-first recovery: a cluster the best fit does not explain may hold several objects.
+  // Cylinder-first recovery: a cluster the best fit does not explain, or that the classifier
+  // does not see as a cylinder as a whole, may hold several objects (each part is then
+  // classified on its own view).
+  const bool doubted = classifier_ && p_network < params_.decision.min_probability;
   if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
-      (!object.is_cylinder || best.explained_share < params_.min_explained_share)) {
+      (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {
       splitCluster(object, input, parts, objects);
