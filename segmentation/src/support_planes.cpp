@@ -242,21 +242,28 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
     }
     return out;
   };
-  // The plane and its band from every other cell (plenty for 4 parameters and a few bins),
-  // the members from all of them.
-  DepthBand band = seed_band;
+  // The plane from every other cell (plenty for 4 parameters) within twice the seed's band
+  // (the widest a grown region's band may become), the members and the band from all of
+  // them.
+  DepthBand wide = seed_band;
+  for (auto& sigma : wide.sigmas)
+    sigma *= 2.f;
+  if (wide.fixed > 0.f)
+    wide.fixed = seed_band.fixed; // a given band is not widened
   for (int it = 0; it < std::max(1, s.iterations); ++it) {
-    std::vector<std::uint8_t> next = members(band, 2);
+    std::vector<std::uint8_t> next = members(wide, 2);
     const bool same = next == member;
     member.swap(next);
     Eigen::Vector4f refit;
-    if (!fitMembers(cells, member, &band, viewpoint, refit))
+    if (!fitMembers(cells, member, &seed_band, viewpoint, refit))
       return false;
     plane = refit;
-    band = limitBand(measureBand(cells, samples, member, plane, viewpoint, s), seed_band, 2.f);
     if (same)
       break;
   }
+  member = members(wide, 1);
+  const DepthBand band =
+    limitBand(measureBand(cells, samples, member, plane, viewpoint, s), seed_band, 2.f);
   region.plane = plane;
   region.band = band;
   region.max_angle = tolerance;

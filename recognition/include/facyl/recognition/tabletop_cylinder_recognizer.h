@@ -47,7 +47,8 @@ struct TabletopRecognizerParameters {
   OrientationPrior prior{OrientationPrior::Vertical};
   std::size_t orientations{450};  ///< accumulator cells N_d, in [10, 100000]
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
-   * a lying (Horizontal) prior in the table frame and keep the best. */
+   * a lying (Horizontal) prior in the table frame, then (objects on a support) with the axis
+   * fixed along the support's normal, and keep the best. */
   bool retry_upright_lying{true};
   /** With hough.outward_normals (the default), a last retry accepts inliers whose normals point
    * at the axis: clusters made of the inside of an open container are then fitted, and so are
@@ -264,6 +265,8 @@ private:
   bool configured_{false};
   NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;
   std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators_;
+  std::size_t upright_{0};   ///< index of the estimator with the axis along the support's normal
+  bool with_support_{false}; ///< the cluster being fitted has a support
 };
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them

@@ -454,7 +454,8 @@ private:
   void
   cluster(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** cluster() on a grid of every \a stride-th pixel and row of an organized input (\a objects
-   * on that grid): the clusters hold those pixels only. */
+   * on that grid), without joining parts seen around occluders: the clusters hold those
+   * pixels only (enough to count the objects standing on a family of supports). */
   void
   clusterCoarse(const pcl::Indices& objects, int stride, std::vector<pcl::Indices>& out) const;
   void

@@ -62,6 +62,18 @@ TabletopCylinderRecognizer<PointT>::configure()
     estimators_[e].setNumberOfOrientations(params_.orientations);
     estimators_[e].setSeed(params_.seed);
   }
+  // Last, on objects with a support: the axis fixed along the support's normal, only position
+  // and radius fitted. A short, wide tin seen from above shows mostly its lid and a thin band
+  // of side, whose free fit may tilt; standing is what tabletop objects mostly do.
+  if (params_.retry_upright_lying) {
+    HoughCylinderParameters hp = params_.hough;
+    hp.refine = false; // the axis stays the support's normal
+    estimators_.emplace_back();
+    estimators_.back().setParameters(hp);
+    upright_ = estimators_.size() - 1;
+  }
+  else
+    upright_ = estimators_.size();
   configured_ = true;
 }
 
@@ -166,6 +178,9 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(int support)
     frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
   for (auto& hough : estimators_)
     hough.setReferenceFrame(frame);
+  with_support_ = support >= 0;
+  if (upright_ < estimators_.size())
+    estimators_[upright_].setAccumulators({OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
 }
 
 template <typename PointT>
@@ -680,6 +695,8 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input,
 {
   Fit best = fitOnce(input, alive, 0);
   for (std::size_t e = 1; e < estimators_.size() && !best.accepted; ++e) {
+    if (e == upright_ && !with_support_)
+      continue;
     Fit f = fitOnce(input, alive, e);
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||

@@ -538,6 +538,20 @@ TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& cand
       distinct.push_back(std::move(c));
   }
   candidates.swap(distinct);
+  // A region too small to be a support (see tryFamily) is a face of an object: its points are
+  // object points, and it is not searched further.
+  if (params_.support != TabletopSegmentationParameters::Support::LargestPlane)
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](const Candidate& c) {
+                                      Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+                                      for (const auto i : c.points)
+                                        centre += (*input_)[i].getVector3fMap();
+                                      centre /= static_cast<float>(c.points.size());
+                                      return regionArea(c, planeFrame(c.plane, centre)) <
+                                             std::min(0.25f * params_.min_support_area,
+                                                      params_.min_shelf_area);
+                                    }),
+                     candidates.end());
   if (!up_.isZero()) {
     const Eigen::Vector3f up = up_.normalized();
     const float cos_max = std::cos(params_.max_support_tilt);
@@ -1059,7 +1073,7 @@ TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int str
   if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
     ObjectSegmentationParameters op = params_.objects;
     op.min_fragment = std::max<std::size_t>(1, op.min_fragment / static_cast<std::size_t>(stride * stride));
-    op.bridge_occlusions = false; // a count of standing points needs no joined occluded parts
+    op.bridge_occlusions = false; // a count of standing objects needs no joined occluded parts
     // Neighbours are stride pixels apart: the gaps that still connect them grow alike.
     op.min_gap *= static_cast<float>(stride);
     op.max_gap *= static_cast<float>(stride);
