@@ -237,10 +237,11 @@ private:
   fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
   Fit
   fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
-  /** Classifies, fits and decides one cluster: one object, or several (recovery). */
+  /** Classifies, fits and decides one cluster: one object, or several (the recovery, when \a
+   * recover). */
   void
   recognizeCluster(TabletopCluster cluster, float p_network,
-                   std::vector<RecognizedObject>& objects);
+                   std::vector<RecognizedObject>& objects, bool recover = true);
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
   std::vector<Fit>

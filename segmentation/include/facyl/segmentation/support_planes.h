@@ -67,7 +67,7 @@ struct PlaneRegionSettings {
    * max_angle is not a plane (a dome, the top of a can). */
   float min_angle{0.05f};
   float max_angle{0.45f};
-  int iterations{4}; ///< at most this many refits
+  int iterations{3}; ///< at most this many refits
 };
 
 /** \brief A plane, its band and the cells that lie on it. */

@@ -288,7 +288,7 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
   for (std::size_t k = 0; k < merged.size(); ++k) {
     const std::size_t first = joined.size();
     usePriorFrameOf(merged[k].support);
-    recognizeCluster(std::move(merged[k]), p_network[k], joined);
+    recognizeCluster(std::move(merged[k]), p_network[k], joined, false);
     if (classifier_)
       applyClassifier(joined, first, p_network[k]);
   }
@@ -360,7 +360,8 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
 template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, float p_network,
-                                                     std::vector<RecognizedObject>& objects)
+                                                     std::vector<RecognizedObject>& objects,
+                                                     bool recover)
 {
   using Clock = std::chrono::steady_clock;
   const auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -388,7 +389,7 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
   // does not see as a cylinder as a whole, may hold several objects (each part is then
   // classified on its own view).
   const bool doubted = classifier_ && p_network < params_.decision.min_probability;
-  if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
+  if (recover && params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {

@@ -693,7 +693,6 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     support.frame = all[s].frame;
     if (!hulls_[s].known) { // once per candidate: every trial of its family needs them
       hulls_[s].polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
-      hulls_[s].extent = supportHull(support.frame, all[s].inliers.indices, nullptr);
       hulls_[s].region = regionArea(candidates[s], support.frame);
       hulls_[s].known = true;
     }
@@ -723,6 +722,8 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     if (support.polygon.size() < 3 || !(largest || large))
       continue;
     kept |= static_cast<std::uint8_t>(1u << s);
+    if (hulls_[s].extent.empty())
+      hulls_[s].extent = supportHull(support.frame, all[s].inliers.indices, nullptr);
     extents_.push_back(hulls_[s].extent);
     if (final)
       support.inliers = std::move(all[s].inliers); // a candidate is in one family only
