@@ -270,6 +270,14 @@ private:
   bool with_support_{false}; ///< the cluster being fitted has a support
 };
 
+/** \brief The convention of the recognizer's cylinders: the axis runs from the base (
+ * point_on_axis, the end nearest the support) to the top, pointing to the side of \a up (the
+ * support's normal; without a support, an upright camera's up: against the image rows); when
+ * the axis lies across \a up (within about 6 degrees of perpendicular: a lying can), it points
+ * to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
+void
+orientCylinder(CylinderModel& model, const Eigen::Vector3f& up, const Eigen::Vector3f& viewpoint);
+
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */
 pcl::Indices

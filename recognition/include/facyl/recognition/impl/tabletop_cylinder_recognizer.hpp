@@ -161,6 +161,14 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
       applyClassifier(objects, first, p_network[k]);
   }
   joinContainerInsides(objects);
+  for (auto& o : objects) // base nearest the support, axis away from it
+    if (o.evidence.fitted) {
+      const int s = o.cluster.support;
+      const Eigen::Vector3f up =
+        s >= 0 ? Eigen::Vector3f(segmentation_.getSupports()[static_cast<std::size_t>(s)].frame.linear().col(2))
+               : Eigen::Vector3f(0.f, -1.f, 0.f);
+      orientCylinder(o.cylinder, up, viewpoint);
+    }
   timing_.total = ms(t0, Clock::now());
   return true;
 }
