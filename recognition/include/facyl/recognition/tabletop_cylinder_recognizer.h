@@ -225,7 +225,8 @@ private:
   void
   usePriorFrameOf(int support);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
-   * container, cut off at its rim) to that one, and recognizes the joined objects again. */
+   * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
+   * that one, and recognizes the joined objects again. */
   void
   joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */

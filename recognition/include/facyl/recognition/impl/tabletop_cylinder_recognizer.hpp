@@ -249,6 +249,27 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
            static_cast<float>(within_wall) >= kWithinWall * static_cast<float>(n) && sided > 0 &&
            static_cast<float>(facing) >= kFacingAxis * static_cast<float>(sided);
   };
+  // A small fragment beside a cylinder, within its height and a radius of its wall (a mug's
+  // handle, cut off at the depth jump between handle and body), is a part of it.
+  constexpr float kAttachmentSize = 0.1f, kAttachmentReach = 2.f, kAttached = 0.8f;
+  const auto isAttachment = [&](const RecognizedObject& outer, const RecognizedObject& o) {
+    const auto& idx = o.cluster.indices.indices;
+    if (static_cast<float>(idx.size()) >
+        kAttachmentSize * static_cast<float>(outer.cluster.indices.indices.size()))
+      return false;
+    const CylinderModel& c = outer.cylinder;
+    const Eigen::Vector3f axis = c.axis.normalized();
+    const float height = (c.top - c.base).dot(axis);
+    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
+    std::size_t n = 0, near = 0;
+    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
+      const Eigen::Vector3f d = (*input_)[idx[k]].getVector3fMap() - c.base;
+      const float t = d.dot(axis);
+      near += (d - t * axis).norm() <= kAttachmentReach * c.radius &&
+              t >= -0.2f * c.radius && t <= height + 0.2f * c.radius;
+    }
+    return n > 0 && static_cast<float>(near) >= kAttached * static_cast<float>(n);
+  };
   std::vector<int> host(objects.size(), -1);
   bool any = false;
   for (std::size_t a = 0; a < objects.size(); ++a) {
@@ -259,7 +280,7 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       if (b == a || host[b] >= 0 || host[a] >= 0 ||
           objects[b].cluster.support != outer.cluster.support)
         continue;
-      if (isInside(outer.cylinder, objects[b])) {
+      if (isInside(outer.cylinder, objects[b]) || isAttachment(outer, objects[b])) {
         host[b] = static_cast<int>(a);
         any = true;
       }
@@ -290,7 +311,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
                                   : projectedBox(pts, camera_);
     merged.push_back(std::move(c));
   }
-  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu containers joined with their insides\n",
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides or "
+            "attachments\n",
             merged.size());
   const std::vector<float> p_network = classifyClusters(merged);
   for (std::size_t k = 0; k < merged.size(); ++k) {
