@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -62,13 +63,16 @@ printHelp(const char* self)
     "                        principal-curvature directions (yellow)\n"
     "  --screenshot OUT.png  render the first scene to OUT.png and exit (needs an X display:\n"
     "                        run under xvfb-run without a screen)\n"
+    "                        (a path not ending in .png, or one that is an input, is\n"
+    "                        refused)\n"
     "  --size W,H            window / screenshot size (default %d,%d)\n"
-    "  --model M             shape classifier for --detect: default | none | PATH.onnx\n"
+    "The recognizer's options (--detect; as in facyl_detect):\n%s"
     "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
-    "l labels.\n"
-    "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage.\n",
-    self, kOrientations, kDefaultWidth, kDefaultHeight);
+    "l labels.\n%s"
+    "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage (nothing written).\n",
+    self, kOrientations, kDefaultWidth, kDefaultHeight, facyl_cli::recognizerOptionsHelp(),
+    facyl_cli::commonHelp());
 }
 
 // ------------------------------------------------------------------------------- scene
@@ -94,6 +98,8 @@ struct Scene {
 
 struct Settings {
   std::vector<std::string> files;
+  facyl::TabletopRecognizerParameters params; ///< the recognizer's options
+  Eigen::Vector3f up{Eigen::Vector3f::Zero()};
   bool detect{true};
   std::string detections;
   bool compare_pcl{false};
@@ -159,6 +165,8 @@ void
 detectObjects(const Settings& s, Scene& scene)
 {
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setParameters(s.params);
+  rec.setUpDirection(s.up);
   rec.setClassifier(s.classifier);
   rec.setInputCloud(scene.cloud);
   std::vector<facyl::RecognizedObject> objects;
@@ -212,8 +220,14 @@ objectsFromJson(const facyl_cli::JsonValue& line, Scene& scene)
       o.cylinder.axis = jsonVector(c->get("axis")).normalized();
       o.cylinder.radius = static_cast<float>(c->get("radius") ? c->get("radius")->number : 0.0);
       o.cylinder.height = static_cast<float>(c->get("height") ? c->get("height")->number : 0.0);
-      o.cylinder.base = o.cylinder.point_on_axis;
-      o.cylinder.top = o.cylinder.base + o.cylinder.height * o.cylinder.axis;
+      if (c->get("base") && c->get("top")) { // facyl_detect's JSON since 0.1: the extent
+        o.cylinder.base = jsonVector(c->get("base"));
+        o.cylinder.top = jsonVector(c->get("top"));
+      }
+      else {
+        o.cylinder.base = o.cylinder.point_on_axis;
+        o.cylinder.top = o.cylinder.base + o.cylinder.height * o.cylinder.axis;
+      }
     }
     o.box_min = o.centroid - Eigen::Vector3f::Constant(0.03f);
     o.box_max = o.centroid + Eigen::Vector3f::Constant(0.03f);
@@ -635,13 +649,17 @@ private:
 Settings
 parseSettings(int argc, char** argv)
 {
-  const facyl_cli::Arguments args(argc, argv,
-                                  {"--detections", "--accumulator", "--screenshot", "--size", "--model"},
-                                  {"--detect", "--compare-pcl"});
+  const facyl_cli::Arguments args(
+    argc, argv,
+    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                      {"--detections", "--accumulator", "--screenshot", "--size"}),
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--detect", "--compare-pcl"}),
+    facyl_cli::recognizerAliases());
   Settings s;
   s.files = args.positional();
   if (s.files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
+  facyl_cli::applyRecognizerOptions(args, s.params, s.up);
   s.detections = args.text("--detections", "");
   if (!s.detections.empty() && args.has("--detect"))
     throw std::invalid_argument("--detect and --detections exclude each other");
@@ -653,6 +671,16 @@ parseSettings(int argc, char** argv)
   if (s.compare_pcl && s.accumulator >= 0)
     throw std::invalid_argument("--compare-pcl and --accumulator exclude each other");
   s.screenshot = args.text("--screenshot", "");
+  if (args.has("--screenshot")) {
+    std::vector<std::string> inputs = s.files;
+    inputs.push_back(s.detections);
+    const std::string model = args.text("--model", "");
+    if (!model.empty() && model != "default" && model != "none") {
+      inputs.push_back(model);
+      inputs.push_back(std::filesystem::path(model).replace_extension(".cfg").string());
+    }
+    facyl_cli::checkOutputFile("--screenshot", s.screenshot, {".png"}, "PNG image", inputs);
+  }
   const auto size = facyl_cli::pairOption(args, "--size", kDefaultWidth, kDefaultHeight);
   if (!(size.first >= 64 && size.second >= 64 && size.first <= 8192 && size.second <= 8192))
     throw std::invalid_argument("--size: expected W,H with 64 <= W, H <= 8192");
@@ -668,10 +696,8 @@ parseSettings(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_viewer", printHelp); rc >= 0)
+    return rc;
   Settings s;
   try {
     s = parseSettings(argc, argv);

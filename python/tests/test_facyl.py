@@ -59,15 +59,15 @@ def test_same_result_as_facyl_fit_for_the_same_seed():
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "c.pcd")
         write_pcd(path, pts)
-        out = subprocess.run([FACYL_FIT, "--seed", "7", "--radius-min", "0.01", "--radius-max",
-                              "0.25", path], check=True, capture_output=True, text=True).stdout
+        out = subprocess.run([FACYL_FIT, "--seed", "7", "--radius-limits", "0.01,0.25", path],
+                             check=True, capture_output=True, text=True).stdout
     ref = json.loads(out)["cylinders"][0]
     c = facyl.fit_cylinders(pts, seed=7)[0]
     # facyl_fit prints 6 significant digits; the fit itself is the same computation.
     assert c.radius == pytest.approx(ref["radius"], rel=1e-5)
     assert np.allclose(c.axis, ref["axis"], atol=1e-5)
     assert np.allclose(c.point_on_axis, ref["point_on_axis"], atol=1e-5)
-    assert len(c.inliers) == ref["inliers"]
+    assert len(c.inliers) == ref["n_inliers"]
 
 
 def test_float64_float32_fortran_and_nan_rows_give_the_same_fit():
