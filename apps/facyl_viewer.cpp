@@ -27,6 +27,10 @@
 #include <pcl/conversions.h>
 #include <pcl/visualization/pcl_visualizer.h>
 
+#include <vtkCamera.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -66,6 +70,10 @@ printHelp(const char* self)
     "                        (a path not ending in .png, or one that is an input, is\n"
     "                        refused)\n"
     "  --size W,H            window / screenshot size (default %d,%d)\n"
+    "The cloud, the table and the cylinders are drawn in the cloud's own frame, seen from its\n"
+    "sensor (the VIEWPOINT; a pose that puts the points behind the sensor, as PCL's grabber\n"
+    "frames store, is taken as the identity rotation, as the recognizer does). A frame\n"
+    "without any support is shown with its objects and no table outline.\n"
     "The recognizer's options (--detect; as in facyl_detect):\n%s"
     "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
@@ -372,16 +380,67 @@ drawTable(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const s
   viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3, tag + "table", viewport);
 }
 
-/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does. */
+/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does.
+ * The pose is the one the recognizer uses (facyl::plausibleSensorPose): PCL's grabber frames
+ * store a 180-degree turn about x with the points in the camera's frame, and the camera must
+ * then look along +z to see them. An organized frame is seen with its own intrinsics
+ * (estimated from its points and pixels: field of view from fy, the principal point as the
+ * window centre), so that a screenshot of its size lies on the frame's image; other clouds
+ * with a Kinect's field of view. */
 void
 sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int viewport)
 {
-  const Eigen::Vector3f o = cloud.sensor_origin_.head<3>();
-  const Eigen::Matrix3f r = cloud.sensor_orientation_.toRotationMatrix();
+  const Eigen::Affine3f pose = facyl::plausibleSensorPose(cloud);
+  const Eigen::Vector3f o = pose.translation();
+  const Eigen::Matrix3f r = pose.linear();
   const Eigen::Vector3f look = o + r.col(2), up = -r.col(1);
   viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(), up.z(), viewport);
-  viewer.setCameraFieldOfView(49.0 * M_PI / 180.0, viewport); // a Kinect's vertical field of view
+  double fov = 49.0 * M_PI / 180.0; // a Kinect's vertical field of view
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  if (cloud.isOrganized() && cloud.height > 1) {
+    const Eigen::Affine3f to_sensor = pose.inverse();
+    const std::size_t step = std::max<std::size_t>(1, cloud.size() / 4000);
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(cloud.size() / step + 1));
+    Eigen::Matrix2Xf px(2, pts.cols());
+    Eigen::Index n = 0;
+    for (std::size_t i = 0; i < cloud.size(); i += step)
+      if (pcl::isFinite(cloud[i])) {
+        pts.col(n) = to_sensor * cloud[i].getVector3fMap();
+        px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud.width),
+                                      static_cast<float>(i / cloud.width));
+      }
+    facyl::PinholeCamera camera;
+    const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
+    if (facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), w, h, camera) &&
+        camera.fy > 0.f) {
+      fov = 2.0 * std::atan(0.5 * h / camera.fy);
+      // VTK moves the optical axis to -WindowCenter in normalized device coordinates.
+      centre = Eigen::Vector2d(1.0 - 2.0 * (camera.cx + 0.5) / w, 2.0 * (camera.cy + 0.5) / h - 1.0);
+    }
+  }
+  viewer.setCameraFieldOfView(fov, viewport);
   viewer.setCameraClipDistances(0.01, 50.0, viewport);
+  auto renderers = viewer.getRendererCollection();
+  renderers->InitTraversal();
+  int i = 0;
+  while (vtkRenderer* renderer = renderers->GetNextItem()) {
+    if (viewport == 0 || viewport == i)
+      renderer->GetActiveCamera()->SetWindowCenter(centre.x(), centre.y());
+    ++i;
+  }
+}
+
+/** The cloud as drawn: its points in its own frame. PCLVisualizer would move a cloud by its
+ * sensor pose (sensor_origin_, sensor_orientation_), while the recognizer's table, cylinders
+ * and boxes are in the cloud's frame: drawn with the pose, a grabber frame (VIEWPOINT
+ * 0 0 0 0 1 0 0) ends up turned away from everything found on it. */
+Cloud::ConstPtr
+drawnCloud(const Cloud& cloud)
+{
+  Cloud::Ptr drawn(new Cloud(cloud));
+  drawn->sensor_origin_ = Eigen::Vector4f::Zero();
+  drawn->sensor_orientation_ = Eigen::Quaternionf::Identity();
+  return drawn;
 }
 
 // ------------------------------------------------------------------------ PCL comparison
@@ -557,7 +616,8 @@ private:
   void
   draw()
   {
-    pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(scene_.cloud);
+    const Cloud::ConstPtr drawn = drawnCloud(*scene_.cloud);
+    pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(drawn);
     if (s_.accumulator >= 0) {
       if (static_cast<std::size_t>(s_.accumulator) >= scene_.objects.size() ||
           scene_.objects[static_cast<std::size_t>(s_.accumulator)].indices.empty()) {
@@ -579,7 +639,7 @@ private:
       viewer_.createViewPort(0.0, 0.0, 0.5, 1.0, left);
       viewer_.createViewPort(0.5, 0.0, 1.0, 1.0, right);
     }
-    viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud", left);
+    viewer_.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud", left);
     if (layers_.table)
       drawTable(viewer_, scene_, "f_", left);
     drawObjects(viewer_, scene_, layers_, "f_", left);
@@ -587,7 +647,7 @@ private:
     if (s_.compare_pcl) {
       Scene pcl_scene;
       const double pcl_ms = pclObjects(scene_, pcl_scene);
-      viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud_pcl", right);
+      viewer_.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud_pcl", right);
       drawObjects(viewer_, pcl_scene, layers_, "p_", right);
       sensorCamera(viewer_, *scene_.cloud, right);
       char text[200];
