@@ -4,10 +4,11 @@ for (CTest output_safety). For every tool that writes files, each refused output
 with a message saying why, and leave every file as it was (same bytes, same time) and no new
 file behind. Also: the outputs that are fine are still written.
 
-    output_safety.py BIN_DIR DATA_DIR
+    output_safety.py BIN_DIR DATA_DIR [FIT_OPEN3D_EXAMPLE]
 
 BIN_DIR holds the tools (facyl_detect, facyl_synth, ...; facyl_viewer when built), DATA_DIR is
-the repository's data/ folder.
+the repository's data/ folder. The Open3D example is checked when python3-open3d and the facyl
+module (PYTHONPATH) are there.
 """
 import hashlib
 import os
@@ -17,6 +18,7 @@ import sys
 import tempfile
 
 BIN, DATA = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+EXAMPLE = sys.argv[3] if len(sys.argv) > 3 else ""
 SCENE = os.path.join(DATA, "default_scene.pcd")
 failures = []
 
@@ -143,5 +145,19 @@ with tempfile.TemporaryDirectory() as tmp:
     subprocess.run([tool("facyl_fit"), a], capture_output=True, timeout=300, cwd=tmp)
     check("facyl_fit writes no file", snapshot(tmp) == before)
 
+    # The Open3D example's --screenshot.
+    if EXAMPLE:
+        have = subprocess.run(["/usr/bin/python3", "-c", "import open3d, facyl"],
+                              capture_output=True).returncode == 0
+        if have:
+            cyl = os.path.join(d, "cyl.pcd")
+            shutil.copy(os.path.join(DATA, "default_cylinder.pcd"), cyl)
+            refused("fit_open3d.py FILE --screenshot FILE",
+                    ["/usr/bin/python3", EXAMPLE, cyl, "--screenshot", cyl], tmp,
+                    "a screenshot is a PNG image")
+            refused("fit_open3d.py --screenshot INPUT.png (a cloud named .png)",
+                    ["/usr/bin/python3", EXAMPLE, png, "--screenshot", png], tmp, "is also the input")
+        else:
+            print("skip fit_open3d.py: python3-open3d or the facyl module is missing")
 
 sys.exit(1 if failures else 0)
