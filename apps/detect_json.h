@@ -10,6 +10,7 @@
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -78,9 +79,14 @@ sceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
       << (tc.size() == 4 ? planeJson(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3]), digits)
                          : std::string("null"))
       << ",\"found\":" << (rec.tableFound() ? "true" : "false") << "},\"supports\":[";
-  for (std::size_t k = 0; k < supports.size(); ++k)
+  for (std::size_t k = 0; k < supports.size(); ++k) {
+    // The objects reported on it (the recognizer joins and splits the segmentation's clusters).
+    const auto on = std::count_if(objects.begin(), objects.end(), [k](const auto& o) {
+      return o.cluster.support == static_cast<int>(k);
+    });
     out << (k ? "," : "") << "{\"coefficients\":" << planeJson(supports[k].plane, digits)
-        << ",\"objects\":" << supports[k].objects << "}";
+        << ",\"objects\":" << on << "}";
+  }
   out << "],\"objects\":[";
   for (std::size_t k = 0; k < objects.size(); ++k)
     out << (k ? "," : "") << objectJson(k, objects[k], digits);
