@@ -51,7 +51,7 @@ recognizerOptionsHelp()
          "  --reject-below P       clusters whose network probability is below P are not\n"
          "                         fitted (default 0.1; 0 fits all)\n"
          "  --min-probability P    with a model: a cylinder also needs p_cylinder >= P, the\n"
-         "                         network fused with the fit's evidence (default 0.3)\n"
+         "                         network fused with the fit's evidence (default 0.5)\n"
          "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
          "angular coverage >= V and taper <= T):\n"
          "  --score S              surface (default: lateral inliers + points on the end caps\n"

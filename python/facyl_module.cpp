@@ -685,7 +685,7 @@ objects' pixel boxes. colors: uint8 RGB of the same shape, optional. up: gravity
 optional. model: "default" (the shipped shape classifier), "none", or a path to an .onnx with
 its .cfg. Any other keyword is one of facyl_detect's recognizer options with '_' for '-':
 radius_limits=(0.01, 0.25), prior="vertical" (in the table frame), voting=, neighbours=16,
-orientations=450, distance_threshold=, min_score=0.5, min_probability=0.3, reject_below=0.1,
+orientations=450, distance_threshold=, min_score=0.5, min_probability=0.5, reject_below=0.1,
 max_cylinders_per_cluster=3, clustering="edge-aware", support="standing", any_normal_sign=True,
 ... (same defaults and checks; facyl_detect -h lists them).
 Returns facyl_detect's JSON object as a dict, the same fields with the same meanings:

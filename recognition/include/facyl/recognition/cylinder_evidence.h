@@ -27,10 +27,11 @@ struct CylinderDecision {
    * the points on the fitted cylinder's end caps and inner wall as explained. */
   enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
   float min_score{0.5f};            ///< score at least this, in [0, 1]
-  /** With a classifier: p_cylinder at least this, in [0, 1]. 0.3: on held-out simulated
-   * objects the F1 of the decision is flat from 0.3 to 0.6 (docs/classifier.md); the lowest
-   * keeps the most recall when real views look less like the simulator's. */
-  float min_probability{0.3f};
+  /** With a classifier: p_cylinder at least this, in [0, 1]. 0.5: p_cylinder is a calibrated
+   * probability (the fusion is a logistic regression), so 0.5 calls an object a cylinder when
+   * that is the likelier answer; on simulated clutter the F1 is flat from 0.3 to 0.6 and 0.5
+   * halves the boxes, bowls, cones and spheres called cylinders (docs/classifier.md). */
+  float min_probability{0.5f};
   /** The inliers' curvature ratio at most this, in (0, 1]; 1 turns the check off. Rejects
    * most spheres and bowls. */
   float max_curvature_ratio{0.35f};
