@@ -3,6 +3,7 @@
  */
 #include "test_helpers.h"
 
+#include <facyl/features/polygon.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 #include <facyl/simulation/tabletop_scene.h>
@@ -107,6 +108,39 @@ TEST(TabletopGeometry, BoxesAndPolygons)
     1.f, 1.f, -1.f;      // the third is behind the camera
   EXPECT_EQ(facyl::projectedBox(pts, cam), (facyl::PixelBox{320, 240, 370, 290}));
   EXPECT_EQ(facyl::projectedBox(pts, facyl::PinholeCamera{}), (facyl::PixelBox{-1, -1, -1, -1}));
+}
+
+TEST(TabletopGeometry, RowExtremesHoldThePlanesHull)
+{
+  EXPECT_EQ(facyl::rowExtremes({12, 3, 25, 14, 11, 99, -1}, 10, 3),
+            (pcl::Indices{3, 11, 14, 25}));
+  // Pixels of a random blob seen on a tilted plane: the hull of each row's extremes, on the
+  // plane, is the hull of every pixel (a projective map keeps convex hulls).
+  const facyl::PinholeCamera cam{525.f, 525.f, 319.5f, 239.5f, 640, 480};
+  const Eigen::Vector3f n = Eigen::Vector3f(0.1f, -0.8f, -0.5f).normalized();
+  const float d = 0.6f; // plane n.x + d = 0, in front of the camera
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uni(0.f, 1.f);
+  pcl::Indices all;
+  for (int v = 0; v < cam.height; ++v)
+    for (int u = 0; u < cam.width; ++u) {
+      const float du = (u - 320.f) / 200.f, dv = (v - 300.f) / 120.f;
+      if (du * du + dv * dv < 1.f && uni(rng) < 0.7f)
+        all.push_back(v * cam.width + u);
+    }
+  const auto flat = [&](const pcl::Indices& idx) {
+    std::vector<Eigen::Vector2f> out;
+    for (const auto i : idx) {
+      const Eigen::Vector3f ray((i % cam.width - cam.cx) / cam.fx, (i / cam.width - cam.cy) / cam.fy, 1.f);
+      const Eigen::Vector3f p = ray * (-d / n.dot(ray));
+      out.emplace_back(p.x(), p.z() * 0.5f + p.y()); // any affine chart of the plane
+    }
+    return out;
+  };
+  const float full = facyl::polygonArea(facyl::convexHull2D(flat(all)));
+  const pcl::Indices ends = facyl::rowExtremes(all, cam.width, cam.height);
+  EXPECT_LT(ends.size() * 20, all.size());
+  EXPECT_NEAR(facyl::polygonArea(facyl::convexHull2D(flat(ends))), full, 1e-4f * full);
 }
 
 TEST(TabletopGeometry, PinholeFromAnOrganizedCloud)

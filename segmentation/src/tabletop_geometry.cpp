@@ -87,6 +87,30 @@ pixelBox(const pcl::Indices& indices, std::uint32_t width)
   return box;
 }
 
+pcl::Indices
+rowExtremes(const pcl::Indices& indices, std::uint32_t width, std::uint32_t height)
+{
+  const auto size = static_cast<pcl::index_t>(static_cast<std::size_t>(width) * height);
+  std::vector<pcl::index_t> first(height, -1), last(height, -1);
+  for (const auto i : indices) {
+    if (i < 0 || i >= size)
+      continue;
+    const auto row = static_cast<std::size_t>(i) / width;
+    if (first[row] < 0 || i < first[row])
+      first[row] = i;
+    if (i > last[row])
+      last[row] = i;
+  }
+  pcl::Indices out;
+  for (std::size_t row = 0; row < height; ++row)
+    if (first[row] >= 0) {
+      out.push_back(first[row]);
+      if (last[row] != first[row])
+        out.push_back(last[row]);
+    }
+  return out;
+}
+
 PixelBox
 projectedBox(const Eigen::Matrix3Xf& points, const PinholeCamera& camera)
 {

@@ -69,6 +69,13 @@ pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& pol
 PixelBox
 pixelBox(const pcl::Indices& indices, std::uint32_t width);
 
+/** \brief Of organized-cloud \a indices (an image \a width x \a height pixels), the first and the
+ * last of each image row (one when a row holds one), rows in order. The image of a plane is a
+ * projective map of it, which keeps convex hulls: the convex hull of points of a plane seen in
+ * an image has its vertices among these. Indices outside the image are skipped. */
+pcl::Indices
+rowExtremes(const pcl::Indices& indices, std::uint32_t width, std::uint32_t height);
+
 /** \brief Bounding box of the projections of \a points (camera frame; points with z <= 0 are
  * skipped), clipped to the image. All -1 when nothing projects inside. */
 PixelBox

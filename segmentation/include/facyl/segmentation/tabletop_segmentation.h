@@ -444,6 +444,10 @@ private:
   /** The pixel stride of the coarse trials of families (1 for point sets). */
   int
   coarseStride() const;
+  /** Of a candidate's \a region, the points that can be vertices of its convex hull: on an
+   * image, each row's first and last (rowExtremes); all of them in a point set. */
+  pcl::Indices
+  hullCandidates(const pcl::Indices& region) const;
   /** Area of the convex hull of the points that found \a c, in \a frame's plane. */
   float
   regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;

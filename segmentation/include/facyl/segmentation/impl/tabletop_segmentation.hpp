@@ -773,12 +773,19 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
 }
 
 template <typename PointT>
+pcl::Indices
+TabletopSegmentation<PointT>::hullCandidates(const pcl::Indices& region) const
+{
+  return searchedAsImage() ? rowExtremes(region, input_->width, input_->height) : region;
+}
+
+template <typename PointT>
 float
 TabletopSegmentation<PointT>::regionArea(const Candidate& c, const Eigen::Affine3f& frame) const
 {
   const Eigen::Affine3f to_plane = frame.inverse();
   std::vector<Eigen::Vector2f> flat;
-  for (const auto i : c.points)
+  for (const auto i : hullCandidates(c.points))
     flat.push_back((to_plane * (*input_)[i].getVector3fMap()).template head<2>());
   return polygonArea(convexHull2D(std::move(flat)));
 }
@@ -800,7 +807,7 @@ TabletopSegmentation<PointT>::supportHull(const Eigen::Affine3f& frame, const pc
     return convexHull2D(std::move(points));
   }
   if (c)
-    for (const auto i : c->points)
+    for (const auto i : hullCandidates(c->points))
       points.push_back(flat(i));
   // The region found on the plane, grown by the plane's points within 5 cm of it: the region
   // may miss a table's near edge, where a real sensor's depth bends, but the infinite plane's
