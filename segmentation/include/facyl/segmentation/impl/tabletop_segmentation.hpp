@@ -281,29 +281,34 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid) const
   small.points.assign(static_cast<std::size_t>(small.width) * small.height,
                       pcl::PointXYZ(nan, nan, nan));
   source.assign(small.size(), -1);
-  for (int v0 = 0, k = 0; v0 < h; v0 += step)
-    for (int u0 = 0; u0 < w; u0 += step, ++k) {
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      float first = 0.f;
-      int n = 0;
-      for (int dv = 0; dv < step && v0 + dv < h; ++dv)
-        for (int du = 0; du < step && u0 + du < w; ++du) {
-          const std::size_t idx = static_cast<std::size_t>(v0 + dv) * w + u0 + du;
-          const auto& p = (*input_)[idx];
-          if (!(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
-            continue;
-          if (n == 0) {
-            first = p.z;
-            source[k] = static_cast<pcl::index_t>(idx);
-          }
-          else if (std::abs(p.z - first) > 0.02f * std::abs(first))
-            continue;
-          sum += p.getVector3fMap();
-          ++n;
-        }
-      if (n > 0)
-        small[k].getVector3fMap() = sum / static_cast<float>(n);
+  // One pass over the image in row order (a block's first pixel in row order is its first
+  // valid one), the cells' sums and counts beside it.
+  const auto cw = static_cast<std::size_t>(small.width);
+  std::vector<Eigen::Vector3f> sum(small.size(), Eigen::Vector3f::Zero());
+  std::vector<float> first(small.size(), 0.f);
+  std::vector<int> count(small.size(), 0);
+  for (int v = 0; v < h; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v / step) * cw;
+    const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
+    for (int u = 0; u < w; ++u) {
+      const std::size_t idx = base + static_cast<std::size_t>(u);
+      const auto& p = (*input_)[idx];
+      if (!std::isfinite(p.z) || !(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
+        continue;
+      const std::size_t k = row + static_cast<std::size_t>(u / step);
+      if (count[k] == 0) {
+        first[k] = p.z;
+        source[k] = static_cast<pcl::index_t>(idx);
+      }
+      else if (std::abs(p.z - first[k]) > 0.02f * std::abs(first[k]))
+        continue;
+      sum[k] += p.getVector3fMap();
+      ++count[k];
     }
+  }
+  for (std::size_t k = 0; k < small.size(); ++k)
+    if (count[k] > 0)
+      small[k].getVector3fMap() = sum[k] / static_cast<float>(count[k]);
   // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
   // (for the bands).
   grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
