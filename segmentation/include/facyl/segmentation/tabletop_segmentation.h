@@ -406,6 +406,11 @@ private:
   planeSeeds(const PlaneGrid& grid) const;
   void
   findPlanesOrganized(std::vector<Candidate>& candidates);
+  /** Grows \a seeds of \a grid into candidates (growCandidate), skipping the seeds mostly on
+   * the cells of \a candidates found before; appends them. */
+  void
+  growCandidates(const PlaneGrid& grid, const std::vector<pcl::PointIndices>& seeds,
+                 std::vector<Candidate>& candidates) const;
   void
   findPlanesUnorganized(std::vector<Candidate>& candidates);
   /** How seeds grow into planes: the band measured, or plane_distance. */

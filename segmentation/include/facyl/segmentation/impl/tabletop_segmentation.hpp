@@ -425,8 +425,38 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
         static_cast<int>(input_->width) < 32 * step || static_cast<int>(input_->height) < 32 * step)
       break;
   }
+  growCandidates(grid, seeds, candidates);
+  // A surface full of holes (a dark or glossy table: weak returns lost in clumps) has few
+  // cells whose neighbourhood is whole enough for a normal on the fine grid, and no seed
+  // there; a grid twice as coarse bridges the holes. Its seeds away from the planes found
+  // grow as well.
+  const int coarse_step = 2 * grid.step;
+  if (grid.step == planeStep() && coarse_step <= 16 &&
+      static_cast<int>(input_->width) >= 32 * coarse_step &&
+      static_cast<int>(input_->height) >= 32 * coarse_step) {
+    PlaneGrid coarse;
+    planeGrid(coarse_step, coarse);
+    growCandidates(coarse, planeSeeds(coarse), candidates);
+  }
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::growCandidates(const PlaneGrid& grid,
+                                             const std::vector<pcl::PointIndices>& seeds,
+                                             std::vector<Candidate>& candidates) const
+{
   const std::size_t cell = static_cast<std::size_t>(grid.step * grid.step);
+  // The cells of the candidates found already (on this grid or another) are taken.
   std::vector<std::uint8_t> taken(grid.small->size(), 0);
+  const auto w = static_cast<pcl::index_t>(input_->width);
+  const auto cw = static_cast<pcl::index_t>(grid.small->width);
+  for (const auto& c : candidates)
+    for (const auto i : c.points) {
+      const auto k = static_cast<std::size_t>((i / w) / grid.step * cw + (i % w) / grid.step);
+      if (k < taken.size())
+        taken[k] = 1;
+    }
   for (const auto& r : seeds) {
     // A seed mostly on a plane found already is a part of it (a noisy table's regions).
     std::size_t on_earlier = 0;
