@@ -22,6 +22,10 @@
 
 namespace facyl {
 
+namespace detail {
+struct BlockMeans;
+} // namespace detail
+
 /** \brief Settings of TabletopSegmentation (lengths in cloud units, metres for sensors). */
 struct TabletopSegmentationParameters {
   /** Half-width of a support's inlier band (m), >= 0. 0 (default): measured on each support
@@ -398,9 +402,13 @@ private:
     Eigen::Matrix3Xf cells, cell_normals, samples; ///< as columns; samples: the first pixels
   };
   /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
-   * depth near the first one's, its normal, and its first pixel. */
+   * depth near the first one's, its normal, and its first pixel; with \a twice, also the grid
+   * of 2 \a step pixels, from the same pass over the image. */
   void
-  planeGrid(int step, PlaneGrid& grid) const;
+  planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice = nullptr) const;
+  /** \a grid from the block means of one step (normals, columns); empties \a blocks. */
+  void
+  finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const;
   /** The seed regions of the plane search on \a grid (cells), largest first. */
   std::vector<pcl::PointIndices>
   planeSeeds(const PlaneGrid& grid) const;

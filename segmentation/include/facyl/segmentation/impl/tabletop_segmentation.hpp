@@ -255,14 +255,41 @@ TabletopSegmentation<PointT>::regionSettings() const
   return s;
 }
 
+namespace detail {
+/** Means of the pixels of the blocks of one plane grid, filled pixel by pixel in row order:
+ * each block's first pixel with depth, and the mean of those with depth near the first's. */
+struct BlockMeans {
+  BlockMeans(int step_, int w, int h)
+  : step(step_), cw(static_cast<std::size_t>((w + step_ - 1) / step_)),
+    ch(static_cast<std::size_t>((h + step_ - 1) / step_)), sum(cw * ch, Eigen::Vector3f::Zero()),
+    first(cw * ch, 0.f), count(cw * ch, 0), source(cw * ch, -1)
+  {}
+  void
+  add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
+  {
+    const std::size_t k = static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
+    if (count[k] == 0) {
+      first[k] = p.z();
+      source[k] = idx;
+    }
+    else if (std::abs(p.z() - first[k]) > 0.02f * std::abs(first[k]))
+      return;
+    sum[k] += p;
+    ++count[k];
+  }
+  int step;
+  std::size_t cw, ch;
+  std::vector<Eigen::Vector3f> sum;
+  std::vector<float> first;
+  std::vector<int> count;
+  std::vector<pcl::index_t> source;
+};
+} // namespace detail
+
 template <typename PointT>
 void
-TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid) const
+TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice) const
 {
-  grid.step = step;
-  grid.small.reset(new pcl::PointCloud<pcl::PointXYZ>);
-  auto& small = *grid.small;
-  auto& source = grid.source;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
   std::vector<std::uint8_t> allowed; // only when indices were given
   if (!fake_indices_) {
@@ -273,42 +300,49 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid) const
   // A grid of every step-th pixel; each cell is the mean of the pixels of its block that have
   // depth near the first one's: real sensors lose several percent of their pixels (a single
   // pixel per cell would spread NaN normals) and active stereo is noisy (the mean of up to
-  // step^2 pixels is less so); the depth test keeps objects' edges sharp.
-  small.width = static_cast<std::uint32_t>((w + step - 1) / step);
-  small.height = static_cast<std::uint32_t>((h + step - 1) / step);
-  small.is_dense = false;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  small.points.assign(static_cast<std::size_t>(small.width) * small.height,
-                      pcl::PointXYZ(nan, nan, nan));
-  source.assign(small.size(), -1);
-  // One pass over the image in row order (a block's first pixel in row order is its first
-  // valid one), the cells' sums and counts beside it.
-  const auto cw = static_cast<std::size_t>(small.width);
-  std::vector<Eigen::Vector3f> sum(small.size(), Eigen::Vector3f::Zero());
-  std::vector<float> first(small.size(), 0.f);
-  std::vector<int> count(small.size(), 0);
+  // step^2 pixels is less so); the depth test keeps objects' edges sharp. One pass over the
+  // image in row order (a block's first pixel in row order is its first valid one) fills the
+  // grid and, when asked, the one of twice the step.
+  detail::BlockMeans fine(step, w, h);
+  std::optional<detail::BlockMeans> coarse;
+  if (twice)
+    coarse.emplace(2 * step, w, h);
   for (int v = 0; v < h; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v / step) * cw;
     const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
     for (int u = 0; u < w; ++u) {
       const std::size_t idx = base + static_cast<std::size_t>(u);
       const auto& p = (*input_)[idx];
       if (!std::isfinite(p.z) || !(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
         continue;
-      const std::size_t k = row + static_cast<std::size_t>(u / step);
-      if (count[k] == 0) {
-        first[k] = p.z;
-        source[k] = static_cast<pcl::index_t>(idx);
-      }
-      else if (std::abs(p.z - first[k]) > 0.02f * std::abs(first[k]))
-        continue;
-      sum[k] += p.getVector3fMap();
-      ++count[k];
+      fine.add(u, v, static_cast<pcl::index_t>(idx), p.getVector3fMap());
+      if (coarse)
+        coarse->add(u, v, static_cast<pcl::index_t>(idx), p.getVector3fMap());
     }
   }
+  finishGrid(fine, grid);
+  if (twice)
+    finishGrid(*coarse, *twice);
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const
+{
+  const int step = blocks.step;
+  const int w = static_cast<int>(input_->width);
+  grid.step = step;
+  grid.small.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  auto& small = *grid.small;
+  small.width = static_cast<std::uint32_t>(blocks.cw);
+  small.height = static_cast<std::uint32_t>(blocks.ch);
+  small.is_dense = false;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  small.points.assign(blocks.cw * blocks.ch, pcl::PointXYZ(nan, nan, nan));
   for (std::size_t k = 0; k < small.size(); ++k)
-    if (count[k] > 0)
-      small[k].getVector3fMap() = sum[k] / static_cast<float>(count[k]);
+    if (blocks.count[k] > 0)
+      small[k].getVector3fMap() = blocks.sum[k] / static_cast<float>(blocks.count[k]);
+  grid.source = std::move(blocks.source);
+  const auto& source = grid.source;
   // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
   // (for the bands).
   grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
@@ -407,10 +441,17 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
 {
   // The grid of planeStep(); on a frame too noisy for any seed there (a stereo camera far
   // from a table), coarser grids, whose means are less noisy, up to 16 pixels.
-  PlaneGrid grid;
+  PlaneGrid grid, twice;
   std::vector<pcl::PointIndices> seeds;
+  const bool two_grids = 32 * 2 * planeStep() <= static_cast<int>(input_->width) &&
+                         32 * 2 * planeStep() <= static_cast<int>(input_->height);
   for (int step = planeStep(); step <= 16; step *= 2) {
-    planeGrid(step, grid);
+    if (step == planeStep())
+      planeGrid(step, grid, two_grids ? &twice : nullptr);
+    else if (step == 2 * planeStep() && two_grids)
+      grid = twice;
+    else
+      planeGrid(step, grid);
     if (step == planeStep()) {
       focal_ = camera_.valid() ? camera_.fx
                                : estimateFocalLength(*grid.small) * static_cast<float>(step);
@@ -430,14 +471,8 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
   // cells whose neighbourhood is whole enough for a normal on the fine grid, and no seed
   // there; a grid twice as coarse bridges the holes. Its seeds away from the planes found
   // grow as well.
-  const int coarse_step = 2 * grid.step;
-  if (grid.step == planeStep() && coarse_step <= 16 &&
-      static_cast<int>(input_->width) >= 32 * coarse_step &&
-      static_cast<int>(input_->height) >= 32 * coarse_step) {
-    PlaneGrid coarse;
-    planeGrid(coarse_step, coarse);
-    growCandidates(coarse, planeSeeds(coarse), candidates);
-  }
+  if (grid.step == planeStep() && two_grids)
+    growCandidates(twice, planeSeeds(twice), candidates);
 }
 
 template <typename PointT>
