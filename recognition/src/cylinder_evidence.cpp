@@ -232,6 +232,7 @@ taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     t.push_back(x.t);
     rho.push_back(r);
   }
+  double spread = 0.0; // sum of squared axial deviations of the last fit's points
   const auto fit = [&](const std::vector<std::uint8_t>& use, float& slope, float& offset) {
     double n = 0, st = 0, sr = 0, stt = 0, str = 0;
     for (std::size_t k = 0; k < t.size(); ++k)
@@ -243,6 +244,7 @@ taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
       return false;
     slope = static_cast<float>((str - st * sr / n) / var);
     offset = static_cast<float>((sr - slope * st) / n);
+    spread = var;
     return true;
   };
   std::vector<std::uint8_t> use(t.size(), 1);
@@ -260,7 +262,18 @@ taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     use[k] = residual[k] <= cut;
   if (!fit(use, slope, offset))
     return std::numeric_limits<float>::quiet_NaN();
-  return std::abs(slope);
+  // The slope's lower 2-sigma bound: over a short visible band (a tuna can's side) the slope
+  // is uncertain, and only a taper the data show counts. Standard error of a least-squares
+  // slope: residual sigma / sqrt(sum of squared axial deviations).
+  double sse = 0.0, used = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (use[k]) {
+      const double r = rho[k] - (offset + slope * t[k]);
+      sse += r * r;
+      used += 1.0;
+    }
+  const double se = std::sqrt(sse / std::max(used - 2.0, 1.0) / spread);
+  return std::max(0.f, std::abs(slope) - static_cast<float>(2.0 * se));
 }
 
 float

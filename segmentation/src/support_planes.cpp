@@ -209,6 +209,16 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
   if (seed.size() != n || normals.cols() != cells.cols() || samples.cols() != cells.cols() ||
       (excluded && excluded->size() != n))
     return false;
+  // Once per cell: whether it may be a member at all, and its range.
+  std::vector<std::uint8_t> usable(n, 0);
+  std::vector<float> range(n, 0.f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    usable[i] = !(excluded && (*excluded)[i]) && cells.col(c).allFinite() &&
+                normals.col(c).allFinite();
+    if (usable[i])
+      range[i] = (Eigen::Vector3f(cells.col(c)) - viewpoint).norm();
+  }
   std::vector<std::uint8_t> member(n, 0);
   for (std::size_t i = 0; i < n; ++i)
     member[i] = seed[i] && cells.col(static_cast<Eigen::Index>(i)).allFinite();
@@ -223,32 +233,42 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
   if (!(tolerance <= s.max_angle))
     return false; // normals that spread this much are not a plane's (a dome, a cylinder's top)
   const float cos_max = std::cos(tolerance);
-  DepthBand band = seed_band;
-  for (int it = 0; it < std::max(1, s.iterations); ++it) {
-    std::vector<std::uint8_t> next(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
+  const auto members = [&](const DepthBand& band, std::size_t step) {
+    std::vector<std::uint8_t> out(n, 0);
+    for (std::size_t i = 0; i < n; i += step) {
       const auto c = static_cast<Eigen::Index>(i);
-      const Eigen::Vector3f p = cells.col(c), q = normals.col(c);
-      if ((excluded && (*excluded)[i]) || !p.allFinite() || !q.allFinite() ||
-          std::abs(q.dot(plane.head<3>())) < cos_max)
-        continue;
-      next[i] = std::abs(plane.head<3>().dot(p) + plane[3]) <= band.halfWidth((p - viewpoint).norm());
+      out[i] = usable[i] && std::abs(normals.col(c).dot(plane.head<3>())) >= cos_max &&
+               std::abs(plane.head<3>().dot(cells.col(c)) + plane[3]) <= band.halfWidth(range[i]);
     }
+    return out;
+  };
+  // The plane from every other cell (plenty for 4 parameters) within twice the seed's band
+  // (the widest a grown region's band may become), the members and the band from all of
+  // them.
+  DepthBand wide = seed_band;
+  for (auto& sigma : wide.sigmas)
+    sigma *= 2.f;
+  if (wide.fixed > 0.f)
+    wide.fixed = seed_band.fixed; // a given band is not widened
+  for (int it = 0; it < std::max(1, s.iterations); ++it) {
+    std::vector<std::uint8_t> next = members(wide, 2);
     const bool same = next == member;
     member.swap(next);
     Eigen::Vector4f refit;
-    if (!fitMembers(cells, member, &band, viewpoint, refit))
+    if (!fitMembers(cells, member, &seed_band, viewpoint, refit))
       return false;
     plane = refit;
-    band = limitBand(measureBand(cells, samples, member, plane, viewpoint, s), seed_band, 2.f);
     if (same)
       break;
   }
+  member = members(wide, 1);
+  const DepthBand band =
+    limitBand(measureBand(cells, samples, member, plane, viewpoint, s), seed_band, 2.f);
   region.plane = plane;
   region.band = band;
   region.max_angle = tolerance;
-  region.members = static_cast<std::size_t>(std::count(member.begin(), member.end(), 1));
-  region.member = std::move(member);
+  region.member = members(band, 1);
+  region.members = static_cast<std::size_t>(std::count(region.member.begin(), region.member.end(), 1));
   return region.members >= 3;
 }
 

@@ -71,6 +71,17 @@ template <typename PointT>
 void
 viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices);
 
+/** \brief The view of the points \a indices of \a cloud by a virtual pinhole camera at \a
+ * viewpoint looking at their centroid (its x axis along the cloud's x as far as possible):
+ * for clouds without pixels (unorganized, no camera). Its focal length makes the object's
+ * pixel box about as many pixels as it has points (the silhouette is then filled, as a
+ * sensor's image of it is), clamped to [50, 2000] pixels. points are in that camera's frame;
+ * box and crop as in objectView. An empty view (no box) when no point is in front. */
+template <typename PointT>
+ObjectView
+lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+                 const Eigen::Vector3f& viewpoint);
+
 } // namespace facyl
 
 #define FACYL_INSTANTIATE_objectView(T)                                                    \
@@ -78,7 +89,10 @@ viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl
                                                   const pcl::Indices&,                      \
                                                   const facyl::PinholeCamera&);             \
   template void facyl::viewBoxAndCrop<T>(facyl::ObjectView&, const pcl::PointCloud<T>&,     \
-                                         const pcl::Indices&);
+                                         const pcl::Indices&);                              \
+  template facyl::ObjectView facyl::lookAtObjectView<T>(const pcl::PointCloud<T>&,          \
+                                                        const pcl::Indices&,                \
+                                                        const Eigen::Vector3f&);
 
 #ifdef PCL_NO_PRECOMPILE
 #include <facyl/recognition/impl/classifier_input.hpp>

@@ -172,8 +172,9 @@ explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
  * |slope| of a robust line fit of the distance to the axis against the position along it, over
  * the columns of \a points (flagged in \a alive; all when empty) between 0.5 and 1.5 radii
  * from the axis whose normals are within 45 degrees of perpendicular to it (the side, not the
- * lids). 0 on a cylinder, tan(half-angle) on a cone. NaN with fewer than 20 such points or no
- * axial spread.
+ * lids), less two standard errors of that slope (at least 0): only a taper the points show.
+ * About 0 on a cylinder, tan(half-angle) on a cone seen along enough of its height. NaN with
+ * fewer than 20 such points or no axial spread.
  * \param normals unit normals alongside the points */
 float
 taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,

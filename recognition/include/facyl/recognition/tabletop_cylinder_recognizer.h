@@ -47,7 +47,8 @@ struct TabletopRecognizerParameters {
   OrientationPrior prior{OrientationPrior::Vertical};
   std::size_t orientations{450};  ///< accumulator cells N_d, in [10, 100000]
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
-   * a lying (Horizontal) prior in the table frame and keep the best. */
+   * a lying (Horizontal) prior in the table frame, then (objects on a support) with the axis
+   * fixed along the support's normal, and keep the best. */
   bool retry_upright_lying{true};
   /** With hough.outward_normals (the default), a last retry accepts inliers whose normals point
    * at the axis: clusters made of the inside of an open container are then fitted, and so are
@@ -209,6 +210,10 @@ private:
   /** Builds the cue estimation and the estimators (one per prior of the retries). */
   void
   configure();
+  /** What the classifier sees of the points \a indices: the image's pixels, or (an unorganized
+   * cloud without a camera) a virtual camera's at the sensor origin (lookAtObjectView). */
+  ObjectView
+  viewOf(const pcl::Indices& indices) const;
   /** The classifier's network probability of each cluster (one batch); NaN without one. */
   std::vector<float>
   classifyClusters(const std::vector<TabletopCluster>& clusters);
@@ -220,7 +225,8 @@ private:
   void
   usePriorFrameOf(int support);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
-   * container, cut off at its rim) to that one, and recognizes the joined objects again. */
+   * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
+   * that one, which keeps its fit and is classified again as a whole. */
   void
   joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */
@@ -260,7 +266,17 @@ private:
   bool configured_{false};
   NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;
   std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators_;
+  std::size_t upright_{0};   ///< index of the estimator with the axis along the support's normal
+  bool with_support_{false}; ///< the cluster being fitted has a support
 };
+
+/** \brief The convention of the recognizer's cylinders: the axis runs from the base (
+ * point_on_axis, the end nearest the support) to the top, pointing to the side of \a up (the
+ * support's normal; without a support, an upright camera's up: against the image rows); when
+ * the axis lies across \a up (within about 6 degrees of perpendicular: a lying can), it points
+ * to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
+void
+orientCylinder(CylinderModel& model, const Eigen::Vector3f& up, const Eigen::Vector3f& viewpoint);
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */

@@ -66,8 +66,8 @@ struct PlaneRegionSettings {
    * angle of the seed's normals, at least min_angle; a seed whose normals spread more than
    * max_angle is not a plane (a dome, the top of a can). */
   float min_angle{0.05f};
-  float max_angle{0.25f};
-  int iterations{4}; ///< at most this many refits
+  float max_angle{0.45f};
+  int iterations{3}; ///< at most this many refits
 };
 
 /** \brief A plane, its band and the cells that lie on it. */

@@ -73,7 +73,9 @@ struct TabletopSegmentationParameters {
   float min_support_area{0.04f};
   /** A plane inside the object band of a larger parallel support (a shelf, a box top) is a
    * support only when the region found on it is at least this large (m^2): smaller ones are
-   * the tops of objects standing on the larger support. */
+   * the tops of objects standing on the larger support. Planes of other orientations this large
+   * (walls, a floor seen from a low camera) are structure: their points are never object
+   * points (smaller ones may be the faces of boxes). */
   float min_shelf_area{0.1f};
   /** A cluster stands on a support when it reaches down to within this height of the
    * support's band (m): the lowest visible points of an object are above its contact. */
@@ -193,12 +195,14 @@ struct SupportPlane {
  * candidate (table legs) are not objects.
  *
  * Which family of parallel planes holds the supports is decided by the objects standing on
- * them (the family with the most object points standing on its planes), so that any camera
+ * them (the family with clearly the most objects standing on its planes), so that any camera
  * roll works without an up direction; an upright camera (supports facing the top of the image)
  * only breaks ties. The table is the candidate of that family with the most object points
- * standing on it; when nothing stands on any, the largest one (tableFound() is then false). A
- * frame without any support (a wall, a close-up) still gets its objects: the compact segments
- * off the large planes, with support -1, tableFound() false and empty table coefficients.
+ * standing on it; when nothing stands on any, the largest one (tableFound() is then false), and
+ * the compact segments off the supports are objects too, with support -1 (a table without
+ * depth: glossy or dark). A frame without any support (a wall, a close-up) still gets its
+ * objects: the compact segments of the frame, with support -1, tableFound() false and empty
+ * table coefficients.
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
@@ -372,6 +376,7 @@ private:
     std::vector<TabletopCluster> clusters;
     std::size_t table{0};
     std::size_t standing{0}; ///< object points standing on the supports
+    std::size_t standing_objects{0}; ///< objects standing on them
   };
 
   /** The block size of the plane search on organized input (see plane_step). */
@@ -384,10 +389,21 @@ private:
   /** segment() on a cloud in the sensor's frame (identity sensor pose). */
   bool
   segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
-  /** The plane-search grid of an organized input: each cell the mean of the pixels of its
-   * block with depth near the first one's; \a source: each cell's first pixel (-1: none). */
+  /** The plane-search grid of an organized input at one block size. */
+  struct PlaneGrid {
+    int step{1};                                  ///< block size (pixels)
+    pcl::PointCloud<pcl::PointXYZ>::Ptr small;    ///< the cells, organized
+    std::vector<pcl::index_t> source;             ///< each cell's first pixel (-1: none)
+    pcl::PointCloud<pcl::Normal>::Ptr normals;    ///< the cells' normals
+    Eigen::Matrix3Xf cells, cell_normals, samples; ///< as columns; samples: the first pixels
+  };
+  /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
+   * depth near the first one's, its normal, and its first pixel. */
   void
-  planeGrid(pcl::PointCloud<pcl::PointXYZ>& grid, std::vector<pcl::index_t>& source) const;
+  planeGrid(int step, PlaneGrid& grid) const;
+  /** The seed regions of the plane search on \a grid (cells), largest first. */
+  std::vector<pcl::PointIndices>
+  planeSeeds(const PlaneGrid& grid) const;
   void
   findPlanesOrganized(std::vector<Candidate>& candidates);
   void
@@ -413,12 +429,10 @@ private:
   void
   classifyPoints(const std::vector<Candidate>& candidates, std::vector<SupportPlane>& all,
                  std::vector<Above>& above) const;
-  /** Families of parallel candidates, those an upright camera would see facing up first,
-   * each by its number of points; at most three. \a agreed: the first one also has the most
-   * points. */
+  /** The families of parallel candidates, those an upright camera would see facing up first,
+   * then by their number of points. */
   std::vector<std::vector<std::size_t>>
-  rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all,
-               bool& agreed) const;
+  rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all) const;
   /** The supports of \a family (large enough, see min_support_area) and the objects on
    * them, on every \a stride-th pixel and row of an organized input (1: all; larger: only the
    * standing points are counted, to compare families). \a final: the result (the family's
@@ -442,7 +456,8 @@ private:
   void
   cluster(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** cluster() on a grid of every \a stride-th pixel and row of an organized input (\a objects
-   * on that grid): the clusters hold those pixels only. */
+   * on that grid), without joining parts seen around occluders: the clusters hold those
+   * pixels only (enough to count the objects standing on a family of supports). */
   void
   clusterCoarse(const pcl::Indices& objects, int stride, std::vector<pcl::Indices>& out) const;
   void
@@ -465,9 +480,11 @@ private:
   /** Makes \a trial the result: supports, table, its coefficients and hull. */
   void
   adopt(Trial trial, std::vector<TabletopCluster>& clusters);
-  /** No support in view: the compact segments of the frame are its objects (support -1). */
+  /** No support in view (or none that objects stand on): the compact segments of the frame
+   * (of its points not flagged in \a taken) are objects too, with support -1. */
   void
-  segmentWithoutSupport(std::vector<TabletopCluster>& clusters);
+  segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
+                        const std::vector<std::uint8_t>* taken = nullptr);
   TabletopCluster
   makeCluster(pcl::Indices indices, int support) const;
   void
@@ -478,6 +495,16 @@ private:
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   std::vector<SupportPlane> supports_;
   std::vector<std::vector<Eigen::Vector2f>> extents_; ///< hulls of all the supports' points
+  /** Per candidate of the last run: its hulls (see supportHull) and region area, computed once
+   * for all the trials of its family. */
+  struct Hulls {
+    bool known{false};
+    std::vector<Eigen::Vector2f> polygon, extent;
+    float region{0.f};
+  };
+  std::vector<Hulls> hulls_;
+  DepthBand noise_;        ///< the band of the largest plane of the last run
+  bool has_noise_{false};
   std::size_t table_{0};
   bool table_found_{false};
   float focal_{0.f}; ///< pixels (organized input)

@@ -8,6 +8,7 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/point_traits.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace facyl {
@@ -87,6 +88,58 @@ viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl
           put(view.pixels(0, k), view.pixels(1, k), cloud[indices[static_cast<std::size_t>(k)]]);
     }
   }
+}
+
+template <typename PointT>
+ObjectView
+lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+                 const Eigen::Vector3f& viewpoint)
+{
+  ObjectView view;
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  std::size_t finite = 0;
+  for (const auto i : indices)
+    if (pcl::isFinite(cloud[static_cast<std::size_t>(i)])) {
+      centroid += cloud[static_cast<std::size_t>(i)].getVector3fMap();
+      ++finite;
+    }
+  if (finite == 0 || !((centroid / static_cast<float>(finite) - viewpoint).norm() > 0.f))
+    return view;
+  // The camera: z towards the centroid, x along the cloud's x as far as possible.
+  const Eigen::Vector3f z = (centroid / static_cast<float>(finite) - viewpoint).normalized();
+  Eigen::Vector3f x = Eigen::Vector3f::UnitX() - z.x() * z;
+  if (x.norm() < 0.3f)
+    x = Eigen::Vector3f::UnitY() - z.y() * z;
+  x.normalize();
+  Eigen::Matrix3f to_camera;
+  to_camera.row(0) = x;
+  to_camera.row(1) = z.cross(x);
+  to_camera.row(2) = z;
+  const auto n = static_cast<Eigen::Index>(indices.size());
+  view.points.resize(3, n);
+  view.pixels.setConstant(2, n, -1);
+  Eigen::AlignedBox2f tangent; // the points' x/z, y/z
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto& p = cloud[static_cast<std::size_t>(indices[static_cast<std::size_t>(k)])];
+    view.points.col(k) = to_camera * (p.getVector3fMap() - viewpoint);
+    const Eigen::Vector3f c = view.points.col(k);
+    if (c.allFinite() && c.z() > 0.f)
+      tangent.extend(Eigen::Vector2f(c.x() / c.z(), c.y() / c.z()));
+  }
+  if (tangent.isEmpty())
+    return view;
+  // About one point per pixel of the box: the silhouette is filled.
+  const float area = std::max(tangent.sizes().prod(), 1e-12f);
+  const float f = std::clamp(std::sqrt(static_cast<float>(finite) / area), 50.f, 2000.f);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Vector3f c = view.points.col(k);
+    if (!c.allFinite() || !(c.z() > 0.f))
+      continue;
+    view.pixels(0, k) = static_cast<int>(std::lround(f * (c.x() / c.z() - tangent.min().x())));
+    view.pixels(1, k) = static_cast<int>(std::lround(f * (c.y() / c.z() - tangent.min().y())));
+  }
+  viewBoxAndCrop(view, cloud, indices);
+  return view;
 }
 
 } // namespace facyl

@@ -62,6 +62,18 @@ TabletopCylinderRecognizer<PointT>::configure()
     estimators_[e].setNumberOfOrientations(params_.orientations);
     estimators_[e].setSeed(params_.seed);
   }
+  // Last, on objects with a support: the axis fixed along the support's normal, only position
+  // and radius fitted. A short, wide tin seen from above shows mostly its lid and a thin band
+  // of side, whose free fit may tilt; standing is what tabletop objects mostly do.
+  if (params_.retry_upright_lying) {
+    HoughCylinderParameters hp = params_.hough;
+    hp.refine = false; // the axis stays the support's normal
+    estimators_.emplace_back();
+    estimators_.back().setParameters(hp);
+    upright_ = estimators_.size() - 1;
+  }
+  else
+    upright_ = estimators_.size();
   configured_ = true;
 }
 
@@ -149,6 +161,14 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
       applyClassifier(objects, first, p_network[k]);
   }
   joinContainerInsides(objects);
+  for (auto& o : objects) // base nearest the support, axis away from it
+    if (o.evidence.fitted) {
+      const int s = o.cluster.support;
+      const Eigen::Vector3f up =
+        s >= 0 ? Eigen::Vector3f(segmentation_.getSupports()[static_cast<std::size_t>(s)].frame.linear().col(2))
+               : Eigen::Vector3f(0.f, -1.f, 0.f);
+      orientCylinder(o.cylinder, up, viewpoint);
+    }
   timing_.total = ms(t0, Clock::now());
   return true;
 }
@@ -166,6 +186,9 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(int support)
     frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
   for (auto& hough : estimators_)
     hough.setReferenceFrame(frame);
+  with_support_ = support >= 0;
+  if (upright_ < estimators_.size())
+    estimators_[upright_].setAccumulators({OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
 }
 
 template <typename PointT>
@@ -226,6 +249,27 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
            static_cast<float>(within_wall) >= kWithinWall * static_cast<float>(n) && sided > 0 &&
            static_cast<float>(facing) >= kFacingAxis * static_cast<float>(sided);
   };
+  // A small fragment beside a cylinder, within its height and a radius of its wall (a mug's
+  // handle, cut off at the depth jump between handle and body), is a part of it.
+  constexpr float kAttachmentSize = 0.1f, kAttachmentReach = 2.f, kAttached = 0.8f;
+  const auto isAttachment = [&](const RecognizedObject& outer, const RecognizedObject& o) {
+    const auto& idx = o.cluster.indices.indices;
+    if (static_cast<float>(idx.size()) >
+        kAttachmentSize * static_cast<float>(outer.cluster.indices.indices.size()))
+      return false;
+    const CylinderModel& c = outer.cylinder;
+    const Eigen::Vector3f axis = c.axis.normalized();
+    const float height = (c.top - c.base).dot(axis);
+    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
+    std::size_t n = 0, near = 0;
+    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
+      const Eigen::Vector3f d = (*input_)[idx[k]].getVector3fMap() - c.base;
+      const float t = d.dot(axis);
+      near += (d - t * axis).norm() <= kAttachmentReach * c.radius &&
+              t >= -0.2f * c.radius && t <= height + 0.2f * c.radius;
+    }
+    return n > 0 && static_cast<float>(near) >= kAttached * static_cast<float>(n);
+  };
   std::vector<int> host(objects.size(), -1);
   bool any = false;
   for (std::size_t a = 0; a < objects.size(); ++a) {
@@ -236,7 +280,7 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       if (b == a || host[b] >= 0 || host[a] >= 0 ||
           objects[b].cluster.support != outer.cluster.support)
         continue;
-      if (isInside(outer.cylinder, objects[b])) {
+      if (isInside(outer.cylinder, objects[b]) || isAttachment(outer, objects[b])) {
         host[b] = static_cast<int>(a);
         any = true;
       }
@@ -244,8 +288,9 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
   }
   if (!any)
     return;
+  // The joined object keeps the cylinder fitted to the outer wall and its evidence (the fit
+  // already saw the wall); the classifier judges the whole.
   std::vector<RecognizedObject> kept, joined;
-  std::vector<TabletopCluster> merged;
   for (std::size_t a = 0; a < objects.size(); ++a) {
     if (host[a] >= 0)
       continue;
@@ -253,7 +298,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       kept.push_back(std::move(objects[a]));
       continue;
     }
-    TabletopCluster c = objects[a].cluster;
+    RecognizedObject o = std::move(objects[a]);
+    TabletopCluster& c = o.cluster;
     for (std::size_t b = 0; b < objects.size(); ++b)
       if (host[b] == static_cast<int>(a))
         c.indices.indices.insert(c.indices.indices.end(), objects[b].cluster.indices.indices.begin(),
@@ -265,21 +311,35 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     c.centroid = pts.rowwise().mean();
     c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
                                   : projectedBox(pts, camera_);
-    merged.push_back(std::move(c));
+    joined.push_back(std::move(o));
   }
-  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu containers joined with their insides\n",
-            merged.size());
-  const std::vector<float> p_network = classifyClusters(merged);
-  for (std::size_t k = 0; k < merged.size(); ++k) {
-    const std::size_t first = joined.size();
-    usePriorFrameOf(merged[k].support);
-    recognizeCluster(std::move(merged[k]), p_network[k], joined);
-    if (classifier_)
-      applyClassifier(joined, first, p_network[k]);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides or "
+            "attachments\n",
+            joined.size());
+  if (classifier_) {
+    std::vector<TabletopCluster> views;
+    for (const auto& o : joined)
+      views.push_back(o.cluster);
+    const std::vector<float> p = classifyClusters(views);
+    for (std::size_t k = 0; k < joined.size(); ++k) {
+      auto& e = joined[k].evidence;
+      e.p_network = p[k];
+      e.p_cylinder = classifier_->fuse(e.p_network, e, params_.decision);
+      joined[k].is_cylinder = acceptCylinder(e, params_.decision);
+    }
   }
   objects = std::move(kept);
   for (auto& o : joined)
     objects.push_back(std::move(o));
+}
+
+template <typename PointT>
+ObjectView
+TabletopCylinderRecognizer<PointT>::viewOf(const pcl::Indices& indices) const
+{
+  if (input_->isOrganized() || camera_.valid())
+    return objectView(*input_, indices, camera_);
+  return lookAtObjectView(*input_, indices, input_->sensor_origin_.head(3));
 }
 
 template <typename PointT>
@@ -293,7 +353,7 @@ TabletopCylinderRecognizer<PointT>::classifyClusters(const std::vector<TabletopC
   std::vector<ObjectView> views;
   views.reserve(clusters.size());
   for (const auto& c : clusters)
-    views.push_back(objectView(*input_, c.indices.indices, camera_));
+    views.push_back(viewOf(c.indices.indices));
   p = classifier_->cylinderProbabilities(views);
   timing_.classification +=
     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -314,7 +374,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
     auto& e = objects[k].evidence;
     e.p_network = p_cluster;
     if (split && e.fitted) {
-      views.push_back(objectView(*input_, objects[k].cluster.indices.indices, camera_));
+      views.push_back(viewOf(objects[k].cluster.indices.indices));
       which.push_back(k);
     }
   }
@@ -360,9 +420,12 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
     if (object.is_cylinder)
       refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
   }
-  // Cylinder-first recovery: a cluster the best fit does not explain may hold several objects.
+  // Cylinder-first recovery: a cluster the best fit does not explain, or that the classifier
+  // does not see as a cylinder as a whole, may hold several objects (each part is then
+  // classified on its own view).
+  const bool doubted = classifier_ && p_network < params_.decision.min_probability;
   if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
-      (!object.is_cylinder || best.explained_share < params_.min_explained_share)) {
+      (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {
       splitCluster(object, input, parts, objects);
@@ -445,15 +508,17 @@ TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluste
   const Eigen::Vector3f a = model.axis.normalized();
   const float d = model.distance_threshold;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
-  std::vector<std::uint8_t> in_cluster; // membership of the cluster's pixels near the inliers
   std::vector<Eigen::Vector3f> near;
-  const std::unordered_set<pcl::index_t> members(cluster.begin(), cluster.end());
+  // The cluster's indices are ascending: membership by binary search.
+  const auto member = [&cluster](pcl::index_t j) {
+    return std::binary_search(cluster.begin(), cluster.end(), j);
+  };
   for (const auto i : model.inliers) {
     const int u0 = static_cast<int>(i % w), v0 = static_cast<int>(i / w);
     for (int v = v0; v < std::min(h, v0 + stride); ++v)
       for (int u = u0; u < std::min(w, u0 + stride); ++u) {
         const auto j = static_cast<pcl::index_t>(v * w + u);
-        if (!members.count(j))
+        if (!member(j))
           continue;
         const Eigen::Vector3f p = (*input_)[j].getVector3fMap();
         const float rho = distanceToLine(p, model.base, a);
@@ -668,6 +733,8 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input,
 {
   Fit best = fitOnce(input, alive, 0);
   for (std::size_t e = 1; e < estimators_.size() && !best.accepted; ++e) {
+    if (e == upright_ && !with_support_)
+      continue;
     Fit f = fitOnce(input, alive, e);
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||

@@ -33,7 +33,7 @@
 
 namespace facyl {
 
-/** How many times more standing points another family of supports needs than the one an
+/** How many times more standing objects another family of supports needs than the one an
  * upright camera would choose (see segmentInSensorFrame). */
 constexpr float kFamilyMargin = 1.5f;
 
@@ -45,6 +45,7 @@ TabletopSegmentation<PointT>::reset()
   extents_.clear();
   table_ = 0;
   table_found_ = false;
+  has_noise_ = false;
   focal_ = 0.f;
   image_down_.setZero();
   table_coefficients_.values.clear();
@@ -150,19 +151,25 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   else
     findPlanesUnorganized(candidates);
   keepSupportCandidates(candidates);
+  // The sensor's noise by range, as measured on the largest plane: the depth gaps of the object
+  // segmentation are never below it.
+  noise_ = candidates.empty() ? DepthBand{} : candidates.front().band;
+  has_noise_ = !candidates.empty();
   const double t_planes = ms(t0);
   std::vector<SupportPlane> all;
   std::vector<Above> above;
   classifyPoints(candidates, all, above);
+  hulls_.assign(candidates.size(), Hulls{});
   const double t_points = ms(t0);
   // The family of supports is the one most objects stand on: no camera roll is assumed.
   // Several families: each is judged on a coarse grid of its object points (a clustering at
   // full resolution costs several milliseconds), and only the one most objects stand on is
-  // segmented at full resolution. The first in rankFamilies' order (an upright camera's
-  // choice) is kept unless another holds clearly more (kFamilyMargin times): with few objects
-  // in view, the faces of a box can hold as many as the table.
-  bool agreed = false;
-  const auto families = rankFamilies(candidates, all, agreed);
+  // segmented at full resolution. Objects are counted, not points (a flat patch of a floor
+  // next to a wall may stand on the wall as one large "object"). The first in rankFamilies'
+  // order (an upright camera's choice) is kept unless another holds clearly more
+  // (kFamilyMargin times): with few objects in view, a box's faces can hold as many as the
+  // table.
+  const auto families = rankFamilies(candidates, all);
   std::size_t chosen = 0, tried = 0;
   if (families.size() > 1) {
     std::size_t most = 0;
@@ -170,13 +177,14 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
       const Trial coarse = tryFamily(families[f], candidates, all, above, coarseStride(), false);
       tried += !coarse.supports.empty();
       PCL_DEBUG("[facyl::TabletopSegmentation] family %zu (%zu planes, first (%.3f %.3f %.3f)): "
-                "%zu supports, %zu points standing (coarse)\n",
+                "%zu supports, %zu objects standing (%zu points, coarse)\n",
                 f, families[f].size(), candidates[families[f].front()].plane[0],
                 candidates[families[f].front()].plane[1], candidates[families[f].front()].plane[2],
-                coarse.supports.size(), coarse.standing);
+                coarse.supports.size(), coarse.standing_objects, coarse.standing);
       if (!coarse.supports.empty() &&
-          (tried == 1 || static_cast<float>(coarse.standing) > kFamilyMargin * static_cast<float>(most)))
-        chosen = f, most = coarse.standing;
+          (tried == 1 || static_cast<float>(coarse.standing_objects) >
+                           kFamilyMargin * static_cast<float>(most)))
+        chosen = f, most = coarse.standing_objects;
     }
   }
   std::optional<Trial> best;
@@ -188,8 +196,22 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   PCL_DEBUG("[facyl::TabletopSegmentation] %.2f ms: planes %.2f, points %.2f, family %zu of "
             "%zu (%zu with supports)\n",
             ms(t0), t_planes, t_points - t_planes, chosen, families.size(), tried);
-  if (best)
+  if (best) {
     adopt(std::move(*best), clusters);
+    if (!table_found_) {
+      // Nothing stands on the supports in view (a table without depth: glossy, dark): the
+      // compact segments off them and off the clusters found are objects too, without a
+      // support.
+      std::vector<std::uint8_t> taken(input_->size(), 0);
+      for (const auto& support : supports_)
+        for (const auto i : support.inliers.indices)
+          taken[static_cast<std::size_t>(i)] = 1;
+      for (const auto& c : clusters)
+        for (const auto i : c.indices.indices)
+          taken[static_cast<std::size_t>(i)] = 1;
+      segmentWithoutSupport(clusters, &taken);
+    }
+  }
   else {
     PCL_DEBUG("[facyl::TabletopSegmentation] no support in view: %zu candidate planes, none "
               "of at least %g m^2\n",
@@ -235,10 +257,12 @@ TabletopSegmentation<PointT>::regionSettings() const
 
 template <typename PointT>
 void
-TabletopSegmentation<PointT>::planeGrid(pcl::PointCloud<pcl::PointXYZ>& small,
-                                        std::vector<pcl::index_t>& source) const
+TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid) const
 {
-  const int step = planeStep();
+  grid.step = step;
+  grid.small.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  auto& small = *grid.small;
+  auto& source = grid.source;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
   std::vector<std::uint8_t> allowed; // only when indices were given
   if (!fake_indices_) {
@@ -280,6 +304,63 @@ TabletopSegmentation<PointT>::planeGrid(pcl::PointCloud<pcl::PointXYZ>& small,
       if (n > 0)
         small[k].getVector3fMap() = sum / static_cast<float>(n);
     }
+  // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
+  // (for the bands).
+  grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
+  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
+  // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
+  // to their angular spacing at other resolutions.
+  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f / static_cast<float>(w));
+  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
+  ne.setInputCloud(grid.small);
+  ne.compute(*grid.normals);
+  const auto n = static_cast<Eigen::Index>(small.size());
+  grid.cells.resize(3, n);
+  grid.cell_normals.resize(3, n);
+  grid.samples.resize(3, n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    grid.cells.col(k) = small[kk].getVector3fMap();
+    grid.cell_normals.col(k) = (*grid.normals)[kk].getNormalVector3fMap();
+    grid.samples.col(k) = source[kk] >= 0
+                            ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
+                            : Eigen::Vector3f::Constant(nan);
+  }
+}
+
+template <typename PointT>
+std::vector<pcl::PointIndices>
+TabletopSegmentation<PointT>::planeSeeds(const PlaneGrid& grid) const
+{
+  // pcl::OrganizedMultiPlaneSegmentation's regions, largest first. Its thresholds only make
+  // seeds (the band of each plane is measured afterwards); on a frame too noisy for any seed of
+  // the least plane size they are relaxed, twice at most.
+  const std::size_t cell = static_cast<std::size_t>(grid.step * grid.step);
+  const std::size_t min_cells = std::max<std::size_t>(10, params_.min_plane_points / cell / 4);
+  std::vector<pcl::PointIndices> inliers;
+  float relax = 1.f;
+  for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
+    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
+    mps.setMinInliers(static_cast<unsigned>(min_cells));
+    mps.setAngularThreshold(std::min(0.5f, relax * params_.plane_angle));
+    mps.setDistanceThreshold(relax * (params_.plane_distance > 0.f ? params_.plane_distance
+                                                                   : kSeedDistance));
+    mps.setMaximumCurvature(relax * relax * 0.001);
+    mps.setInputNormals(grid.normals);
+    mps.setInputCloud(grid.small);
+    std::vector<pcl::ModelCoefficients> coefficients;
+    inliers.clear();
+    mps.segment(coefficients, inliers);
+    if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
+          return r.indices.size() * cell >= params_.min_plane_points;
+        }))
+      break;
+  }
+  std::sort(inliers.begin(), inliers.end(), [](const auto& a, const auto& b) {
+    return a.indices.size() > b.indices.size();
+  });
+  return inliers;
 }
 
 template <typename PointT>
@@ -319,73 +400,41 @@ template <typename PointT>
 void
 TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candidates)
 {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr small(new pcl::PointCloud<pcl::PointXYZ>);
-  std::vector<pcl::index_t> source;
-  planeGrid(*small, source);
-  const int step = planeStep();
-  const int w = static_cast<int>(input_->width);
-  focal_ = camera_.valid() ? camera_.fx : estimateFocalLength(*small) * static_cast<float>(step);
-  image_down_ = imageDownDirection(*small, input_->sensor_origin_.head(3));
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-  ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
-  // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
-  // to their angular spacing at other resolutions.
-  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f / static_cast<float>(w));
-  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
-  ne.setInputCloud(small);
-  ne.compute(*normals);
-  // The cells as columns, with their normals and one raw pixel each (for the bands).
-  const auto n = static_cast<Eigen::Index>(small->size());
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  Eigen::Matrix3Xf cells(3, n), cell_normals(3, n), samples(3, n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    cells.col(k) = (*small)[kk].getVector3fMap();
-    cell_normals.col(k) = (*normals)[kk].getNormalVector3fMap();
-    samples.col(k) = source[kk] >= 0 ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
-                                     : Eigen::Vector3f::Constant(nan);
-  }
-  // Seeds: pcl::OrganizedMultiPlaneSegmentation's regions, largest first. Its thresholds only
-  // make seeds (the band of each plane is measured afterwards); on a frame too noisy for any
-  // seed of the least plane size they are relaxed, twice at most.
-  const std::size_t cell = static_cast<std::size_t>(step * step);
-  const std::size_t min_cells = std::max<std::size_t>(10, params_.min_plane_points / cell / 4);
-  std::vector<pcl::PointIndices> inliers;
-  float relax = 1.f;
-  for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
-    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
-    mps.setMinInliers(static_cast<unsigned>(min_cells));
-    mps.setAngularThreshold(std::min(0.5f, relax * params_.plane_angle));
-    mps.setDistanceThreshold(relax * (params_.plane_distance > 0.f ? params_.plane_distance
-                                                                   : kSeedDistance));
-    mps.setMaximumCurvature(relax * relax * 0.001);
-    mps.setInputNormals(normals);
-    mps.setInputCloud(small);
-    std::vector<pcl::ModelCoefficients> coefficients;
-    inliers.clear();
-    mps.segment(coefficients, inliers);
-    if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
-          return r.indices.size() * cell >= params_.min_plane_points;
-        }))
+  // The grid of planeStep(); on a frame too noisy for any seed there (a stereo camera far
+  // from a table), coarser grids, whose means are less noisy, up to 16 pixels.
+  PlaneGrid grid;
+  std::vector<pcl::PointIndices> seeds;
+  for (int step = planeStep(); step <= 16; step *= 2) {
+    planeGrid(step, grid);
+    if (step == planeStep()) {
+      focal_ = camera_.valid() ? camera_.fx
+                               : estimateFocalLength(*grid.small) * static_cast<float>(step);
+      image_down_ = imageDownDirection(*grid.small, input_->sensor_origin_.head(3));
+    }
+    seeds = planeSeeds(grid);
+    PCL_DEBUG("[facyl::TabletopSegmentation] grid of %d pixels: %zu seeds, largest %zu cells\n",
+              step, seeds.size(), seeds.empty() ? std::size_t{0} : seeds.front().indices.size());
+    const std::size_t cell = static_cast<std::size_t>(step * step);
+    if (std::any_of(seeds.begin(), seeds.end(),
+                    [&](const auto& r) { return r.indices.size() * cell >= params_.min_plane_points; }) ||
+        static_cast<int>(input_->width) < 32 * step || static_cast<int>(input_->height) < 32 * step)
       break;
   }
-  std::sort(inliers.begin(), inliers.end(), [](const auto& a, const auto& b) {
-    return a.indices.size() > b.indices.size();
-  });
-  std::vector<std::uint8_t> taken(small->size(), 0);
-  for (const auto& r : inliers) {
+  const std::size_t cell = static_cast<std::size_t>(grid.step * grid.step);
+  std::vector<std::uint8_t> taken(grid.small->size(), 0);
+  for (const auto& r : seeds) {
     // A seed mostly on a plane found already is a part of it (a noisy table's regions).
     std::size_t on_earlier = 0;
     for (const auto k : r.indices)
       on_earlier += taken[static_cast<std::size_t>(k)];
     if (2 * on_earlier >= r.indices.size() || candidates.size() >= 2 * params_.max_planes + 4)
       continue;
-    std::vector<std::uint8_t> seed(small->size(), 0);
+    std::vector<std::uint8_t> seed(grid.small->size(), 0);
     for (const auto k : r.indices)
       seed[static_cast<std::size_t>(k)] = 1;
     Candidate c;
-    if (growCandidate(cells, cell_normals, samples, seed, source, cell, taken, c))
+    if (growCandidate(grid.cells, grid.cell_normals, grid.samples, seed, grid.source, cell,
+                      taken, c))
       candidates.push_back(std::move(c));
   }
 }
@@ -490,28 +539,38 @@ TabletopSegmentation<PointT>::keepSupportCandidates(std::vector<Candidate>& cand
                    candidates.end());
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.support > b.support; });
-  // A region lying on a larger candidate, within its band (a part of the same table seen
-  // through a sensor's bend), is a part of it, not another support.
+  // A region lying on a larger candidate, nearly parallel and level with it at its centre (a
+  // part of the same table seen through a sensor's bend, with a slope of its own), is a part
+  // of it, not another support; a box top or a shelf is above the larger one's band.
   std::vector<Candidate> distinct;
   for (auto& c : candidates) {
+    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+    for (const auto i : c.points)
+      centre += (*input_)[i].getVector3fMap();
+    centre /= static_cast<float>(std::max<std::size_t>(1, c.points.size()));
     const bool part = std::any_of(distinct.begin(), distinct.end(), [&](const Candidate& big) {
-      if (big.plane.template head<3>().dot(c.plane.template head<3>()) < std::cos(0.2f))
-        return false;
-      std::vector<float> h, r;
-      for (const auto i : c.points) {
-        const Eigen::Vector3f p = (*input_)[i].getVector3fMap();
-        h.push_back(std::abs(big.plane.template head<3>().dot(p) + big.plane[3]));
-        r.push_back((p - viewpoint).norm());
-      }
-      const auto mid = static_cast<std::ptrdiff_t>(h.size() / 2);
-      std::nth_element(h.begin(), h.begin() + mid, h.end());
-      std::nth_element(r.begin(), r.begin() + mid, r.end());
-      return h[h.size() / 2] < big.band.halfWidth(r[r.size() / 2]);
+      return big.plane.template head<3>().dot(c.plane.template head<3>()) >= std::cos(0.2f) &&
+             std::abs(big.plane.template head<3>().dot(centre) + big.plane[3]) <
+               big.band.halfWidth((centre - viewpoint).norm());
     });
     if (!part)
       distinct.push_back(std::move(c));
   }
   candidates.swap(distinct);
+  // A region too small to be a support (see tryFamily) is a face of an object: its points are
+  // object points, and it is not searched further.
+  if (params_.support != TabletopSegmentationParameters::Support::LargestPlane)
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](const Candidate& c) {
+                                      Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+                                      for (const auto i : c.points)
+                                        centre += (*input_)[i].getVector3fMap();
+                                      centre /= static_cast<float>(c.points.size());
+                                      return regionArea(c, planeFrame(c.plane, centre)) <
+                                             std::min(0.25f * params_.min_support_area,
+                                                      params_.min_shelf_area);
+                                    }),
+                     candidates.end());
   if (!up_.isZero()) {
     const Eigen::Vector3f up = up_.normalized();
     const float cos_max = std::cos(params_.max_support_tilt);
@@ -590,10 +649,8 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
 template <typename PointT>
 std::vector<std::vector<std::size_t>>
 TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candidates,
-                                           const std::vector<SupportPlane>& all,
-                                           bool& agreed) const
+                                           const std::vector<SupportPlane>& all) const
 {
-  agreed = true;
   if (candidates.empty())
     return {};
   if (params_.support == TabletopSegmentationParameters::Support::LargestPlane)
@@ -620,15 +677,11 @@ TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candida
       sum += all[s].inliers.indices.size();
     return sum;
   };
+  // An upright camera's choice first.
   std::stable_sort(families.begin(), families.end(), [&](const auto& a, const auto& b) {
     const bool ua = faces_up(a), ub = faces_up(b);
     return ua != ub ? ua : points(a) > points(b);
   });
-  agreed = std::all_of(families.begin(), families.end(), [&](const auto& f) {
-    return points(f) <= points(families.front());
-  });
-  if (families.size() > 3)
-    families.resize(3);
   return families;
 }
 
@@ -636,7 +689,7 @@ template <typename PointT>
 int
 TabletopSegmentation<PointT>::coarseStride() const
 {
-  return searchedAsImage() ? 2 * planeStep() : 1;
+  return searchedAsImage() ? planeStep() : 1;
 }
 
 template <typename PointT>
@@ -657,7 +710,12 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     support.plane = all[s].plane;
     support.band = all[s].band;
     support.frame = all[s].frame;
-    support.polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
+    if (!hulls_[s].known) { // once per candidate: every trial of its family needs them
+      hulls_[s].polygon = supportHull(support.frame, all[s].inliers.indices, &candidates[s]);
+      hulls_[s].region = regionArea(candidates[s], support.frame);
+      hulls_[s].known = true;
+    }
+    support.polygon = hulls_[s].polygon;
     // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
     // by the region found on it: its infinite plane slices through the objects around it.
     const float range = (support.frame.translation() - viewpoint).norm();
@@ -670,7 +728,7 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     }
     // Its own region must be sizeable too: a small region's infinite plane can cross a
     // table.
-    const float region = regionArea(candidates[s], support.frame);
+    const float region = hulls_[s].region;
     const float hull = polygonArea(support.polygon);
     if (final)
       PCL_DEBUG("[facyl::TabletopSegmentation] family plane %zu: normal (%.3f %.3f %.3f) d "
@@ -683,7 +741,9 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     if (support.polygon.size() < 3 || !(largest || large))
       continue;
     kept |= static_cast<std::uint8_t>(1u << s);
-    extents_.push_back(supportHull(support.frame, all[s].inliers.indices, nullptr));
+    if (hulls_[s].extent.empty())
+      hulls_[s].extent = supportHull(support.frame, all[s].inliers.indices, nullptr);
+    extents_.push_back(hulls_[s].extent);
     if (final)
       support.inliers = std::move(all[s].inliers); // a candidate is in one family only
     else
@@ -857,8 +917,10 @@ TabletopSegmentation<PointT>::assignClusters(std::vector<pcl::Indices>& groups, 
       continue;
     SupportPlane& support = supports_[static_cast<std::size_t>(pl.support)];
     ++support.objects;
-    if (pl.standing)
+    if (pl.standing) {
       support.standing_points += group.size() * scale;
+      ++trial.standing_objects;
+    }
     if (scale == 1)
       trial.clusters.push_back(makeCluster(std::move(group), pl.support));
   }
@@ -906,13 +968,14 @@ TabletopSegmentation<PointT>::adopt(Trial trial, std::vector<TabletopCluster>& c
 
 template <typename PointT>
 void
-TabletopSegmentation<PointT>::segmentWithoutSupport(std::vector<TabletopCluster>& clusters)
+TabletopSegmentation<PointT>::segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
+                                                    const std::vector<std::uint8_t>* taken)
 {
   // Every point may belong to an object; objects are the segments of the frame that fit in
   // the object box (max_height in each direction): walls, floors and furniture do not.
   pcl::Indices points;
   for (const auto i : *indices_)
-    if (pcl::isFinite((*input_)[i]))
+    if (pcl::isFinite((*input_)[i]) && !(taken && (*taken)[static_cast<std::size_t>(i)]))
       points.push_back(i);
   std::vector<pcl::Indices> groups;
   cluster(points, groups);
@@ -981,7 +1044,7 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
     for (std::size_t i = 0; i < input_->size(); ++i)
       has_depth_[i] = pcl::isFinite((*input_)[i]);
     out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
-                                  params_.objects);
+                                  params_.objects, has_noise_ ? &noise_ : nullptr);
     return;
   }
   pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
@@ -1031,16 +1094,20 @@ TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int str
   if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
     ObjectSegmentationParameters op = params_.objects;
     op.min_fragment = std::max<std::size_t>(1, op.min_fragment / static_cast<std::size_t>(stride * stride));
-    op.bridge_occlusions = false; // a count of standing points needs no joined occluded parts
+    op.bridge_occlusions = false; // a count of standing objects needs no joined occluded parts
+    // Neighbours are stride pixels apart: the gaps that still connect them grow alike.
+    op.min_gap *= static_cast<float>(stride);
+    op.max_gap *= static_cast<float>(stride);
     groups = segmentObjectsOrganized(coarse, has_depth, focal_ / static_cast<float>(stride),
-                                     input_->sensor_origin_.head(3), op);
+                                     input_->sensor_origin_.head(3), op,
+                                     has_noise_ ? &noise_ : nullptr);
   }
   else {
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(coarse));
     pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
       new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
     comparator->setInputCloud(cloud);
-    comparator->setDistanceThreshold(params_.cluster_tolerance, false);
+    comparator->setDistanceThreshold(static_cast<float>(stride) * params_.cluster_tolerance, false);
     pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
     components.setInputCloud(cloud);
     pcl::PointCloud<pcl::Label> labels;
@@ -1188,7 +1255,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
     }
   }
   const std::vector<pcl::Indices> segments =
-    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects);
+    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects,
+                            has_noise_ ? &noise_ : nullptr);
   // Every object point takes the segment of its pixel.
   std::vector<int> segment_of(n, -1);
   for (std::size_t s = 0; s < segments.size(); ++s)

@@ -1,0 +1,376 @@
+/*
+ * facyl: any table, any depth camera. Support bands measured from the data (noise and bias
+ * that grow with range), plane regions that hold on noisy and bent tables, any camera roll
+ * without an up direction, frames without a support, classifier views of unorganized clouds,
+ * and (when ../shared/data/real is present) real frames of sensors and rooms the pipeline was
+ * not tuned on.
+ */
+#include "test_helpers.h"
+
+#include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/support_planes.h>
+#include <facyl/segmentation/tabletop_segmentation.h>
+#include <facyl/simulation/frame_roll.h>
+#include <facyl/simulation/random.h>
+#include <facyl/simulation/tabletop_scene.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/io/pcd_io.h>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+
+namespace {
+
+/** Standard normal samples of a seeded generator. */
+struct Gauss {
+  facyl::Random rng;
+  explicit Gauss(std::uint64_t seed) : rng(seed) {}
+  float
+  operator()()
+  {
+    return rng.normal();
+  }
+};
+
+facyl::RenderedScene
+cluttered(std::uint64_t seed, const std::string& sensor = "kinect")
+{
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  facyl::parseSensorPreset(sensor, p.sensor, p.camera);
+  p.seed = seed;
+  return facyl::simulateTabletopScene(p);
+}
+
+std::vector<facyl::RecognizedObject>
+recognize(const Cloud::ConstPtr& cloud, facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec)
+{
+  rec.setInputCloud(cloud);
+  std::vector<facyl::RecognizedObject> objects;
+  EXPECT_TRUE(rec.recognize(objects));
+  return objects;
+}
+
+/** The table plane (a, b, c, d) in the frame of a camera rolled by \a quarter_turns. */
+Eigen::Vector4f
+rolledPlane(Eigen::Vector4f plane, int quarter_turns)
+{
+  for (int t = 0; t < quarter_turns; ++t)
+    plane.head<2>() = Eigen::Vector2f(-plane[1], plane[0]);
+  return plane;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------- bands
+
+TEST(DepthBand, RecoversNoiseThatGrowsWithRange)
+{
+  // A structured-light sensor's axial noise: sigma = 2.85e-3 range^2 (Kinect v1), over 0.5-3 m.
+  Gauss gauss(3);
+  facyl::Random pick(4);
+  std::vector<float> ranges, residuals;
+  for (int i = 0; i < 20000; ++i) {
+    const float r = 0.5f + 2.5f * pick.uniform(0.f, 1.f);
+    ranges.push_back(r);
+    residuals.push_back(2.85e-3f * r * r * gauss());
+  }
+  const facyl::DepthBand band = facyl::estimateDepthBand(ranges, residuals, 3.f, 1e-4f);
+  ASSERT_GE(band.ranges.size(), 4u);
+  for (std::size_t b = 1; b < band.sigmas.size(); ++b)
+    EXPECT_GE(band.sigmas[b], band.sigmas[b - 1]); // non-decreasing with range
+  for (const float r : {0.8f, 1.5f, 2.5f}) {
+    const float truth = 2.85e-3f * r * r;
+    EXPECT_NEAR(band.sigma(r), truth, 0.15f * truth) << "range " << r;
+    EXPECT_FLOAT_EQ(band.halfWidth(r), 3.f * band.sigma(r));
+  }
+  // Beyond the farthest bin the band keeps growing with range^2; nearer, it stays.
+  EXPECT_NEAR(band.sigma(6.f) / band.sigma(band.ranges.back()),
+              std::pow(6.f / band.ranges.back(), 2.f), 1e-3f);
+  EXPECT_FLOAT_EQ(band.sigma(0.1f), band.sigmas.front());
+  // A fixed band, and the floor of a noise-free plane.
+  EXPECT_FLOAT_EQ(facyl::fixedBand(0.015f).halfWidth(2.f), 0.015f);
+  const facyl::DepthBand flat =
+    facyl::estimateDepthBand(ranges, std::vector<float>(ranges.size(), 0.f), 3.f, 1e-4f);
+  EXPECT_FLOAT_EQ(flat.halfWidth(1.f), 3e-4f);
+  EXPECT_FLOAT_EQ(facyl::estimateDepthBand({}, {}, 3.f, 1e-4f).halfWidth(1.f), 3e-4f);
+}
+
+TEST(PlaneRegion, GrowsANoisyBentTableFromOnePieceAndStaysOffTheWall)
+{
+  // Cells of a 1.6 x 1 m table seen from the origin 0.6-2 m away, bent by 6 mm (a sensor's
+  // radial bias), with 2 mm-at-1-m noise growing with range^2; a wall across its far edge.
+  Gauss gauss(11);
+  std::vector<Eigen::Vector3f> cells, normals;
+  std::vector<std::uint8_t> is_table;
+  const Eigen::Vector3f up(0.f, -0.8f, -0.6f); // towards the sensor
+  const Eigen::Vector3f along = Eigen::Vector3f(0.f, 0.6f, -0.8f).cross(up).normalized();
+  const Eigen::Vector3f depth(0.f, 0.6f, -0.8f);
+  const Eigen::Vector3f centre(0.f, 0.5f, 1.2f);
+  for (int i = -40; i <= 40; ++i)
+    for (int j = -25; j <= 25; ++j) {
+      const float x = 0.02f * static_cast<float>(i), y = 0.02f * static_cast<float>(j);
+      const Eigen::Vector3f flat = centre + x * along - y * depth;
+      const float bend = 0.006f * (x * x + y * y) / 0.89f;
+      const float r = flat.norm();
+      cells.push_back(flat + (bend + 2e-3f * r * r * gauss()) * up);
+      normals.push_back((up + 0.02f * Eigen::Vector3f(gauss(), gauss(), gauss())).normalized());
+      is_table.push_back(1);
+    }
+  const Eigen::Vector3f wall_base = centre - 0.5f * (-depth);
+  for (int i = -40; i <= 40; ++i)
+    for (int k = 1; k <= 20; ++k) {
+      cells.push_back(wall_base + 0.02f * static_cast<float>(i) * along + 0.02f * k * up +
+                      0.5f * depth + 1e-3f * gauss() * depth);
+      normals.push_back(-depth);
+      is_table.push_back(0);
+    }
+  const auto n = static_cast<Eigen::Index>(cells.size());
+  Eigen::Matrix3Xf c(3, n), q(3, n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    c.col(k) = cells[static_cast<std::size_t>(k)];
+    q.col(k) = normals[static_cast<std::size_t>(k)];
+  }
+  // The seed: a 20 x 20 cm piece near the table's centre.
+  std::vector<std::uint8_t> seed(cells.size(), 0);
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    seed[k] = is_table[k] && (cells[k] - centre).norm() < 0.1f;
+  facyl::PlaneRegion region;
+  ASSERT_TRUE(facyl::refinePlaneRegion(c, q, c, seed, Eigen::Vector3f::Zero(), {}, region));
+  std::size_t table_members = 0, wall_members = 0, table = 0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    table += is_table[k];
+    table_members += is_table[k] && region.member[k];
+    wall_members += !is_table[k] && region.member[k];
+  }
+  EXPECT_GE(table_members, 95 * table / 100); // the whole (bent, noisy) table
+  EXPECT_EQ(wall_members, 0u);
+  EXPECT_GT(region.plane.head<3>().dot(up), std::cos(0.02f));
+  // The band covers noise and bend: wider than the noise alone at 1 m, narrower than a table
+  // of 3 cm.
+  EXPECT_GT(region.band.halfWidth(1.f), 3.f * 2e-3f);
+  EXPECT_LT(region.band.halfWidth(1.f), 0.03f);
+  // A seed whose normals spread like a dome's is no plane.
+  facyl::PlaneRegionSettings strict;
+  strict.max_angle = 0.01f;
+  EXPECT_FALSE(facyl::refinePlaneRegion(c, q, c, seed, Eigen::Vector3f::Zero(), strict, region));
+}
+
+// ---------------------------------------------------------------- supports
+
+TEST(AnyTable, NoisyFarTableIsOneSupport)
+{
+  // Active stereo at 1.6-2.2 m with 1.5 times the stereo preset's noise (sigma 18 mm at 2 m): a fixed 15 mm band would cut
+  // the table into pieces; the measured band keeps it whole and finds the objects on it.
+  for (const std::uint64_t seed : {1000u, 1003u, 1004u}) {
+    facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+    facyl::parseSensorPreset("stereo", p.sensor, p.camera);
+    p.sensor.noise_coefficient *= 1.5f;
+    p.camera_distance = {1.6f, 2.2f};
+    p.seed = seed;
+    const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+    Cloud::Ptr cloud(new Cloud(s.cloud));
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setInputCloud(cloud);
+    std::vector<facyl::TabletopCluster> clusters;
+    ASSERT_TRUE(seg.segment(clusters));
+    ASSERT_TRUE(seg.tableFound()) << seed;
+    const auto& c = seg.getTableCoefficients().values;
+    EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), std::cos(0.03f)) << seed;
+    EXPECT_NEAR(c[3], s.table_plane[3], 0.02f) << seed;
+    const auto& table = seg.getSupports()[seg.getTableIndex()];
+    const float range = table.frame.translation().norm();
+    EXPECT_GT(table.band.halfWidth(range), 0.015f) << seed; // wider than the old fixed band
+    std::size_t visible = 0;
+    for (std::size_t k = 0; k < s.scene.objects.size(); ++k)
+      visible += s.visible_pixels[k] >= 1000;
+    EXPECT_GE(clusters.size() + 1, visible) << seed; // (touching objects may merge)
+  }
+}
+
+TEST(AnyTable, RolledCamerasNeedNoUpDirection)
+{
+  // The same frames as a camera rolled by 90, 180 and 270 degrees would take them: the table,
+  // and the same objects within one, without --up.
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  for (const std::uint64_t seed : {1001u, 1002u, 1005u}) {
+    const facyl::RenderedScene s = cluttered(seed);
+    const auto upright = recognize(Cloud::ConstPtr(new Cloud(s.cloud)), rec);
+    ASSERT_TRUE(rec.tableFound());
+    std::size_t upright_cylinders = 0;
+    for (const auto& o : upright)
+      upright_cylinders += o.is_cylinder;
+    for (int turns = 1; turns <= 3; ++turns) {
+      const std::string what = "seed " + std::to_string(seed) + ", " +
+                               std::to_string(90 * turns) + " degrees";
+      const auto objects =
+        recognize(Cloud::ConstPtr(new Cloud(facyl::rollFrame(s.cloud, turns))), rec);
+      ASSERT_TRUE(rec.tableFound()) << what;
+      const auto& c = rec.getTableCoefficients().values;
+      const Eigen::Vector4f truth = rolledPlane(s.table_plane, turns);
+      EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(truth.head<3>()), std::cos(0.05f)) << what;
+      EXPECT_NEAR(c[3], truth[3], 0.02f) << what;
+      EXPECT_NEAR(static_cast<double>(objects.size()), static_cast<double>(upright.size()), 1.0)
+        << what;
+      std::size_t cylinders = 0;
+      for (const auto& o : objects)
+        cylinders += o.is_cylinder;
+      EXPECT_NEAR(static_cast<double>(cylinders), static_cast<double>(upright_cylinders), 1.0)
+        << what;
+    }
+  }
+}
+
+TEST(AnyTable, AFrameWithoutASupportStillGetsItsObjects)
+{
+  // A close-up: only the objects have depth (table, floor and walls removed).
+  facyl::TabletopSceneParameters p;
+  p.min_objects = p.max_objects = 3;
+  p.cylinder_share = 1.f;
+  p.lying_share = 0.f;
+  p.seed = 21;
+  const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+  Cloud::Ptr cloud(new Cloud(s.cloud));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t cans = 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    if (s.object_id[i] < 2)
+      (*cloud)[i].x = (*cloud)[i].y = (*cloud)[i].z = nan;
+  for (std::size_t k = 0; k < s.scene.objects.size(); ++k)
+    cans += s.visible_pixels[k] >= 1000;
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  const auto objects = recognize(cloud, rec);
+  EXPECT_FALSE(rec.tableFound());
+  EXPECT_TRUE(rec.getSupports().empty());
+  EXPECT_TRUE(rec.getTableCoefficients().values.empty());
+  std::size_t cylinders = 0;
+  for (const auto& o : objects) {
+    EXPECT_EQ(o.cluster.support, -1);
+    cylinders += o.is_cylinder;
+  }
+  EXPECT_GE(cylinders + 1, cans);
+  EXPECT_GE(cylinders, 1u);
+  // A wall filling the frame: no error, no object.
+  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr wall(new Cloud(160, 120));
+  for (std::uint32_t v = 0; v < wall->height; ++v)
+    for (std::uint32_t u = 0; u < wall->width; ++u) {
+      auto& q = wall->at(u, v);
+      q.z = 1.5f;
+      q.x = (static_cast<float>(u) - 79.5f) * q.z / 130.f;
+      q.y = (static_cast<float>(v) - 59.5f) * q.z / 130.f;
+    }
+  EXPECT_TRUE(recognize(wall, rec).empty());
+  EXPECT_FALSE(rec.tableFound());
+}
+
+TEST(AnyTable, UnorganizedCloudsGetAClassifierView)
+{
+  const facyl::RenderedScene s = cluttered(1007);
+  Cloud::Ptr points(new Cloud);
+  for (const auto& q : s.cloud)
+    if (pcl::isFinite(q))
+      points->push_back(q);
+  auto classifier = std::make_shared<facyl::CylinderClassifier>();
+  classifier->load(facyl::CylinderClassifier::defaultModelPath());
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setClassifier(classifier);
+  const auto objects = recognize(points, rec);
+  ASSERT_FALSE(objects.empty());
+  std::size_t known = 0;
+  for (const auto& o : objects)
+    known += std::isfinite(o.evidence.p_network);
+  EXPECT_EQ(known, objects.size());
+  // The view itself: about one point per pixel of its box, in front of the virtual camera.
+  const facyl::ObjectView view =
+    facyl::lookAtObjectView(*points, objects.front().cluster.indices.indices,
+                            Eigen::Vector3f::Zero());
+  ASSERT_GE(view.box[0], 0);
+  const float box = static_cast<float>((view.box[2] - view.box[0] + 1) * (view.box[3] - view.box[1] + 1));
+  const float n = static_cast<float>(objects.front().cluster.indices.indices.size());
+  EXPECT_GT(box, 0.5f * n);
+  EXPECT_LT(box, 2.f * n);
+  EXPECT_GT(view.points.row(2).minCoeff(), 0.f);
+}
+
+// ---------------------------------------------------------------- real frames
+
+namespace {
+
+struct Label {
+  std::string frame, object, cls;
+  int u{0}, v{0};
+};
+
+std::vector<Label>
+readLabels(const std::string& csv)
+{
+  std::vector<Label> out;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::string cur;
+    bool quoted = false;
+    for (const char ch : line) {
+      if (ch == '"')
+        quoted = !quoted;
+      else if (ch == ',' && !quoted)
+        f.push_back(cur), cur.clear();
+      else
+        cur += ch;
+    }
+    f.push_back(cur);
+    if (f.size() >= 5)
+      out.push_back({f[0], f[1], f[2], std::stoi(f[3]), std::stoi(f[4])});
+  }
+  return out;
+}
+
+} // namespace
+
+TEST(RealFrames, OtherSensorsAndRooms)
+{
+  const std::string csv = facyl_test::realFile("rgbd/labels.csv");
+  if (csv.empty())
+    GTEST_SKIP() << "../shared/data/real/rgbd is absent";
+  const std::vector<Label> labels = readLabels(csv);
+  std::map<std::string, std::vector<Label>> by_frame;
+  for (const auto& l : labels)
+    by_frame[l.frame].push_back(l);
+  auto classifier = std::make_shared<facyl::CylinderClassifier>();
+  classifier->load(facyl::CylinderClassifier::defaultModelPath());
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setClassifier(classifier);
+  for (const auto& [frame, frame_labels] : by_frame) {
+    Cloud::Ptr cloud(new Cloud);
+    ASSERT_EQ(pcl::io::loadPCDFile(facyl_test::realFile("rgbd/" + frame + ".pcd"), *cloud), 0);
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    ASSERT_TRUE(rec.recognize(objects)) << frame; // never an error
+    for (const auto& l : frame_labels) {
+      if (l.cls == "none")
+        continue;
+      // The smallest object box holding the label's pixel.
+      const facyl::RecognizedObject* best = nullptr;
+      for (const auto& o : objects) {
+        const auto& b = o.cluster.box;
+        if (b[0] <= l.u && l.u <= b[2] && b[1] <= l.v && l.v <= b[3] &&
+            (!best || (b[2] - b[0]) * (b[3] - b[1]) <
+                        (best->cluster.box[2] - best->cluster.box[0]) *
+                          (best->cluster.box[3] - best->cluster.box[1])))
+          best = &o;
+      }
+      if (l.cls == "cylinder") {
+        ASSERT_NE(best, nullptr) << frame << " " << l.object;
+        EXPECT_TRUE(best->is_cylinder) << frame << " " << l.object;
+      }
+    }
+  }
+}
