@@ -2,7 +2,8 @@
  * facyl_crops: the shape classifier's data. Runs the tabletop recognizer (without a
  * classifier) on simulated scenes and writes, for every object it reports, the network's input
  * images (classifierImage, both channel sets) and one CSV row: the ground truth and the fit's
- * evidence (fusionFeatures). Also the single-object crops of the UW RGB-D Object dataset.
+ * evidence (fusionFeatures). Also the single-object crops of the UW RGB-D Object dataset, and
+ * real crops harvested from mOSD's scenes of boxes only.
  * recognition/training reads what it writes; with --model the rows also get the network's
  * probability from CylinderClassifier (the C++ side of a model, for checks and evaluation).
  *
@@ -49,16 +50,28 @@ printHelp(const char* self)
   std::printf(
     "Usage: %s [options] OUT_DIR\n"
     "Writes the shape classifier's data to OUT_DIR: rgb.u8 and depth.u8 (the network's input\n"
-    "images of every object, 3 resp. 2 x size x size bytes, planar) and objects.csv (one row\n"
-    "per object: ground truth, fit evidence and fusion features).\n"
+    "images of every object, 3 resp. 2 x size x size bytes, planar; depthrgb is depth's\n"
+    "planes followed by rgb's) and objects.csv (one row per object: ground truth, fit\n"
+    "evidence and fusion features).\n"
     "  --sim N            simulated scenes: the recognizer's objects, labelled by the\n"
     "                     ground truth (default 0)\n"
     "  --seed S           seed of the first scene (default %llu); scene k uses S + k\n"
-    "  --layout L         mix (default: scene k is spread for even k, cluttered for odd k) |\n"
-    "                     spread | cluttered\n"
-    "  --sensor S         mix (default: kinect for k mod 4 < 2, else stereo) | kinect | stereo\n"
+    "  --layout L[,L...]  layouts taken in turn: scene k has layout k mod n of the list\n"
+    "                     (spread | cluttered | realistic; a layout may repeat to weigh it);\n"
+    "                     mix (default) = spread,cluttered\n"
+    "  --sensor S[,S...]  sensors taken in turn after each round of layouts: scene k has\n"
+    "                     sensor (k / layouts) mod n (kinect | stereo | random);\n"
+    "                     mix (default) = kinect,stereo\n"
+    "                     Objects that are mostly scenery (far furniture, robots of the\n"
+    "                     realistic layout) are skipped: neither targets nor distractors.\n"
     "  --uw DIR           also the UW RGB-D Object crops in DIR (*.pcd with x y z rgb imX imY;\n"
     "                     the category is the file name up to _<digit>)\n"
+    "  --mosd DIR         also real crops harvested from mOSD frames DIR/learnK.pcd the\n"
+    "                     paper's way (III-B1): scenes that hold boxes only, so every object\n"
+    "                     is a non-cylinder; an object the recognizer reports is kept where\n"
+    "                     it agrees with one of the dataset's labelled objects (IoU >= 0.5)\n"
+    "  --mosd-scenes A-B  those scenes (default 0-29; learn30-44 hold cylinders, and\n"
+    "                     learn33-44 are an evaluation set: refused)\n"
     "  --size S           image size (default %d)\n"
     "  --model M          none (default) | default | PATH.onnx: adds the network's probability\n"
     "OUT is a folder that exists; it gets rgb.u8, depth.u8 and objects.csv (refused when\n"
@@ -70,7 +83,9 @@ printHelp(const char* self)
 struct Settings {
   std::size_t sim{0};
   std::uint64_t seed{kDefaultSeed};
-  std::string layout{"mix"}, sensor{"mix"}, uw, out;
+  std::vector<std::string> layouts{"spread", "cluttered"}, sensors{"kinect", "stereo"};
+  std::string uw, mosd, out;
+  int mosd_first{0}, mosd_last{29};
   int size{kDefaultSize};
   facyl::ShapeClassifier::Ptr classifier;
 };
@@ -134,15 +149,16 @@ networkProbability(const Settings& s, const facyl::ObjectView& view)
                       : std::numeric_limits<float>::quiet_NaN();
 }
 
-/** The scene parameters of simulated scene \a k. */
+/** The scene parameters of simulated scene \a k: its layout and sensor from the lists, taken
+ * in turn (the default lists give the first model's mix: spread and cluttered alternate, two
+ * Kinect-like scenes, then two stereo ones). */
 facyl::TabletopSceneParameters
 sceneParameters(const Settings& s, std::size_t k)
 {
-  const bool cluttered = s.layout == "mix" ? (k % 2 == 1) : s.layout == "cluttered";
-  const std::string sensor = s.sensor == "mix" ? (k % 4 < 2 ? "kinect" : "stereo") : s.sensor;
-  facyl::TabletopSceneParameters p =
-    cluttered ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
-  facyl::parseSensorPreset(sensor, p.sensor, p.camera);
+  facyl::TabletopSceneParameters p;
+  facyl::parseLayoutPreset(s.layouts[k % s.layouts.size()], p);
+  facyl::parseSensorPreset(s.sensors[(k / s.layouts.size()) % s.sensors.size()], p.sensor,
+                           p.camera);
   p.seed = s.seed + k;
   return p;
 }
@@ -171,6 +187,11 @@ simulatedScene(const Settings& s, std::size_t k, Recognizer& rec, DataWriter& ou
         id = l, most = c;
     const float purity =
       static_cast<float>(most) / static_cast<float>(std::max<std::size_t>(1, o.cluster.indices.indices.size()));
+    // Scenery (far furniture and what stands on it, robots) holds cans and cylindrical
+    // links as well as boxes, and its class says nothing about its shape: neither a
+    // cylinder nor a distractor, as facyl_tabletop_eval scores it.
+    if (id >= facyl::kFirstSceneryId)
+      continue;
     std::string kind = id == 0 ? "background" : (id == 1 ? "table" : "");
     int label = 0;
     if (id >= 2) {
@@ -291,11 +312,101 @@ uwCrops(const Settings& s, DataWriter& out)
   return failed;
 }
 
+/** The presets of a comma-separated list; "mix" is \a mix. \throws std::invalid_argument
+ * naming \a option for an empty or unknown entry. */
+template <typename Known>
+std::vector<std::string>
+presetList(const std::string& text, const std::vector<std::string>& mix, const char* option,
+           Known known)
+{
+  if (text == "mix")
+    return mix;
+  std::vector<std::string> list;
+  std::istringstream in(text);
+  std::string name;
+  while (std::getline(in, name, ','))
+    if (name.empty() || !known(name))
+      throw std::invalid_argument(std::string(option) + ": unknown preset '" + name + "' in '" +
+                                  text + "' (see -h)");
+    else
+      list.push_back(name);
+  if (list.empty() || text.back() == ',')
+    throw std::invalid_argument(std::string(option) + ": expected a comma-separated list, got '" +
+                                text + "'");
+  return list;
+}
+
+/** Scenes learn0-29 of mOSD hold boxes only (learn30-32 a tube among boxes, learn33-44
+ * cylindric objects, the labelled evaluation scenes). */
+constexpr int kMosdLastBoxScene = 29;
+
+/** Real crops of the mOSD scenes of boxes only (paper III-B1: a scene holds either cylinders
+ * or not, so its objects are labelled by the scene). Kept where the recognizer's object is one
+ * of the dataset's labelled objects (IoU >= 0.5): no fragments, merges or table parts.
+ * \return the number of files that failed. */
+std::size_t
+mosdCrops(const Settings& s, Recognizer& rec, DataWriter& out)
+{
+  std::size_t failed = 0;
+  const facyl::PinholeCamera none;
+  for (int k = s.mosd_first; k <= s.mosd_last; ++k) {
+    const std::string name = "learn" + std::to_string(k);
+    const std::string file = (std::filesystem::path(s.mosd) / (name + ".pcd")).string();
+    pcl::PointCloud<pcl::PointXYZRGBL> labelled;
+    Cloud::Ptr cloud(new Cloud);
+    if (pcl::io::loadPCDFile(file, labelled) < 0) {
+      std::fprintf(stderr, "facyl_crops: cannot read %s\n", file.c_str());
+      ++failed;
+      continue;
+    }
+    pcl::copyPointCloud(labelled, *cloud);
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    if (!rec.recognize(objects)) {
+      std::fprintf(stderr, "facyl_crops: %s: no table\n", file.c_str());
+      ++failed;
+      continue;
+    }
+    // The dataset's objects: label / 10 for labels >= 20 (parts of one object share a decade).
+    std::map<int, std::size_t> truth_size;
+    for (const auto& p : labelled)
+      if (p.label >= 20)
+        ++truth_size[static_cast<int>(p.label / 10)];
+    for (std::size_t j = 0; j < objects.size(); ++j) {
+      const auto& indices = objects[j].cluster.indices.indices;
+      std::map<int, std::size_t> votes;
+      for (const auto i : indices) {
+        const auto label = labelled[static_cast<std::size_t>(i)].label;
+        if (label >= 20)
+          ++votes[static_cast<int>(label / 10)];
+      }
+      int id = 0;
+      std::size_t most = 0;
+      for (const auto& [l, c] : votes)
+        if (c > most)
+          id = l, most = c;
+      if (id == 0)
+        continue;
+      const float iou = static_cast<float>(most) /
+                        static_cast<float>(indices.size() + truth_size[id] - most);
+      if (iou < 0.5f)
+        continue;
+      const facyl::ObjectView view = facyl::objectView(*cloud, indices, none);
+      out.write(view, "real", "mosd-" + name, static_cast<int>(j), "box", 0, iou,
+                objects[j].evidence, networkProbability(s, view));
+    }
+  }
+  return failed;
+}
+
 Settings
 parseSettings(int argc, char** argv)
 {
   const facyl_cli::Arguments args(
-    argc, argv, {"--sim", "--seed", "--layout", "--sensor", "--uw", "--size", "--model"}, {});
+    argc, argv,
+    {"--sim", "--seed", "--layout", "--sensor", "--uw", "--mosd", "--mosd-scenes", "--size",
+     "--model"},
+    {});
   if (args.positional().size() != 1)
     throw std::invalid_argument("give exactly one output folder (see -h)");
   Settings s;
@@ -303,23 +414,43 @@ parseSettings(int argc, char** argv)
   s.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0, 100000));
   s.seed = static_cast<std::uint64_t>(
     args.integer("--seed", static_cast<long long>(kDefaultSeed), 0, facyl_cli::kMaxSeed));
-  s.layout = args.text("--layout", "mix");
-  if (s.layout != "mix" && s.layout != "spread" && s.layout != "cluttered")
-    throw std::invalid_argument("--layout must be mix, spread or cluttered");
-  s.sensor = args.text("--sensor", "mix");
-  if (s.sensor != "mix" && s.sensor != "kinect" && s.sensor != "stereo")
-    throw std::invalid_argument("--sensor must be mix, kinect or stereo");
+  s.layouts = presetList(args.text("--layout", "mix"), {"spread", "cluttered"}, "--layout",
+                         [](const std::string& name) {
+                           facyl::TabletopSceneParameters p;
+                           return facyl::parseLayoutPreset(name, p);
+                         });
+  s.sensors = presetList(args.text("--sensor", "mix"), {"kinect", "stereo"}, "--sensor",
+                         [](const std::string& name) {
+                           facyl::DepthSensorModel m;
+                           facyl::CameraIntrinsics c;
+                           return facyl::parseSensorPreset(name, m, c);
+                         });
   s.uw = args.text("--uw", "");
   if (!s.uw.empty() && !std::filesystem::is_directory(s.uw))
     throw std::invalid_argument("--uw: folder '" + s.uw + "' does not exist");
+  s.mosd = args.text("--mosd", "");
+  if (!s.mosd.empty() && !std::filesystem::is_directory(s.mosd))
+    throw std::invalid_argument("--mosd: folder '" + s.mosd + "' does not exist");
+  const std::string scenes = args.text("--mosd-scenes", "0-29");
+  char dash = 0, extra = 0;
+  if (std::sscanf(scenes.c_str(), "%d%c%d%c", &s.mosd_first, &dash, &s.mosd_last, &extra) != 3 ||
+      dash != '-' || s.mosd_first < 0 || s.mosd_last < s.mosd_first)
+    throw std::invalid_argument("--mosd-scenes: expected A-B with 0 <= A <= B, got '" + scenes +
+                                "'");
+  if (s.mosd_last > kMosdLastBoxScene)
+    throw std::invalid_argument("--mosd-scenes: only learn0-29 hold boxes only (learn30-44 "
+                                "hold cylinders; learn33-44 are an evaluation set)");
   s.size = static_cast<int>(args.integer("--size", kDefaultSize, 8, 512));
-  if (s.sim == 0 && s.uw.empty())
-    throw std::invalid_argument("give --sim N and/or --uw DIR");
+  if (s.sim == 0 && s.uw.empty() && s.mosd.empty())
+    throw std::invalid_argument("give --sim N, --uw DIR and/or --mosd DIR");
   if (!std::filesystem::is_directory(s.out))
     throw std::invalid_argument("folder '" + s.out + "' does not exist");
   std::vector<std::string> inputs;
   if (!s.uw.empty())
     for (const auto& e : std::filesystem::directory_iterator(s.uw))
+      inputs.push_back(e.path().string());
+  if (!s.mosd.empty())
+    for (const auto& e : std::filesystem::directory_iterator(s.mosd))
       inputs.push_back(e.path().string());
   const std::string model = args.text("--model", "none");
   if (model != "default" && model != "none") {
@@ -363,6 +494,8 @@ main(int argc, char** argv)
     }
     if (!s.uw.empty())
       failed += uwCrops(s, out);
+    if (!s.mosd.empty())
+      failed += mosdCrops(s, rec, out);
     std::printf("{\"objects\":%zu,\"failed\":%zu,\"size\":%d}\n", out.rows(), failed, s.size);
   }
   catch (const std::exception& e) {

@@ -115,6 +115,36 @@ TEST(ClassifierInput, RgbImageIsTheCropPaddedToASquare)
   EXPECT_EQ(image[400 + 10 * 20 + 5], 10); // green plane
 }
 
+TEST(ClassifierInput, DepthRgbImageIsTheDepthPlanesThenTheRgbPlanes)
+{
+  // facyl_crops writes depth.u8 and rgb.u8; train_classifier.py joins them into the depthrgb
+  // input: that must be what the classifier makes of the same view.
+  std::vector<int> idx;
+  Cloud::Ptr cloud = cylinderPatch(idx);
+  std::vector<int> half(idx.begin(), idx.begin() + 200);
+  for (const auto& indices : {idx, half}) {
+    const facyl::ObjectView view = facyl::objectView(*cloud, indices, facyl::PinholeCamera{});
+    auto joined = facyl::classifierImage(view, {facyl::ClassifierChannels::Depth, 24});
+    const auto rgb = facyl::classifierImage(view, {facyl::ClassifierChannels::Rgb, 24});
+    ASSERT_FALSE(joined.empty());
+    ASSERT_FALSE(rgb.empty());
+    joined.insert(joined.end(), rgb.begin(), rgb.end());
+    const auto image = facyl::classifierImage(view, {facyl::ClassifierChannels::DepthRgb, 24});
+    ASSERT_EQ(image.size(), 5u * 24 * 24);
+    EXPECT_EQ(image, joined);
+  }
+  // Without colour (no crop) or without pixels there is no input.
+  facyl::ObjectView grey = facyl::objectView(*cloud, idx, facyl::PinholeCamera{});
+  grey.crop = facyl::RgbImage{};
+  EXPECT_TRUE(facyl::classifierImage(grey, {facyl::ClassifierChannels::DepthRgb, 24}).empty());
+  EXPECT_TRUE(facyl::classifierImage(facyl::ObjectView{}, {facyl::ClassifierChannels::DepthRgb, 24}).empty());
+  EXPECT_EQ(facyl::channelCount(facyl::ClassifierChannels::DepthRgb), 5);
+  facyl::ClassifierChannels c = facyl::ClassifierChannels::Rgb;
+  ASSERT_TRUE(facyl::parseClassifierChannels("depthrgb", c));
+  EXPECT_EQ(c, facyl::ClassifierChannels::DepthRgb);
+  EXPECT_EQ(facyl::toString(c), "depthrgb");
+}
+
 // ------------------------------------------------------------------ model description
 
 TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
@@ -131,6 +161,8 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
   EXPECT_EQ(facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info), "");
   EXPECT_TRUE(info.has_fusion);
   EXPECT_EQ(info.fusion[8], 9.f);
+  EXPECT_EQ(facyl::parseClassifierModelInfo("channels depthrgb\nsize 64\n", info), "");
+  EXPECT_EQ(info.input.channels, facyl::ClassifierChannels::DepthRgb);
   EXPECT_NE(facyl::parseClassifierModelInfo("size 64\n", info), "");
   EXPECT_NE(facyl::parseClassifierModelInfo("channels hsv\nsize 64\n", info).find("line 1"), std::string::npos);
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 4\n", info), "");
@@ -260,8 +292,14 @@ TEST(CylinderClassifier, BadModelsGiveErrorsThatNameTheFile)
   writeFile("text.cfg", cfg);
   EXPECT_NE(message(writeFile("text.onnx", "hello")).find("cannot read it"), std::string::npos);
   // Wrong input shape (channels) and wrong output count.
+  // (another channel set than the shipped model's, whichever that is)
   std::string rgb = cfg;
-  rgb.replace(rgb.find("channels depth"), 14, "channels rgb");
+  const auto channels_at = rgb.find("channels ");
+  ASSERT_NE(channels_at, std::string::npos);
+  const auto channels_end = rgb.find('\n', channels_at);
+  const bool shipped_rgb = rgb.substr(channels_at, channels_end - channels_at) == "channels rgb";
+  rgb.replace(channels_at, channels_end - channels_at,
+              shipped_rgb ? "channels depth" : "channels rgb");
   writeFile("rgb.cfg", rgb);
   EXPECT_NE(message(writeFile("rgb.onnx", onnx)).find("does not take the described input"),
             std::string::npos);

@@ -15,7 +15,15 @@ namespace facyl {
 std::string
 toString(ClassifierChannels channels)
 {
-  return channels == ClassifierChannels::Rgb ? "rgb" : "depth";
+  switch (channels) {
+  case ClassifierChannels::Rgb:
+    return "rgb";
+  case ClassifierChannels::Depth:
+    return "depth";
+  case ClassifierChannels::DepthRgb:
+    return "depthrgb";
+  }
+  return "unknown";
 }
 
 bool
@@ -25,6 +33,8 @@ parseClassifierChannels(const std::string& text, ClassifierChannels& channels)
     channels = ClassifierChannels::Rgb;
   else if (text == "depth")
     channels = ClassifierChannels::Depth;
+  else if (text == "depthrgb")
+    channels = ClassifierChannels::DepthRgb;
   else
     return false;
   return true;
@@ -33,7 +43,15 @@ parseClassifierChannels(const std::string& text, ClassifierChannels& channels)
 int
 channelCount(ClassifierChannels channels)
 {
-  return channels == ClassifierChannels::Rgb ? 3 : 2;
+  switch (channels) {
+  case ClassifierChannels::Rgb:
+    return 3;
+  case ClassifierChannels::Depth:
+    return 2;
+  case ClassifierChannels::DepthRgb:
+    return 5;
+  }
+  return 0;
 }
 
 namespace {
@@ -140,7 +158,14 @@ classifierImage(const ObjectView& view, const ClassifierInputSpec& spec)
     return rgbImage(view, sq, spec.size);
   if (view.pixels.cols() != view.points.cols())
     return {};
-  return depthImage(view, sq, spec.size);
+  std::vector<std::uint8_t> depth = depthImage(view, sq, spec.size);
+  if (spec.channels == ClassifierChannels::Depth || depth.empty())
+    return depth;
+  const std::vector<std::uint8_t> rgb = rgbImage(view, sq, spec.size);
+  if (rgb.empty())
+    return {};
+  depth.insert(depth.end(), rgb.begin(), rgb.end());
+  return depth;
 }
 
 } // namespace facyl

@@ -38,7 +38,7 @@ parseClassifierModelInfo(const std::string& text, ClassifierModelInfo& info)
     if (key == "channels") {
       std::string value;
       if (!(in >> value) || !parseClassifierChannels(value, out.input.channels))
-        return where + "expected rgb or depth";
+        return where + "expected rgb, depth or depthrgb";
       seen_channels = true;
     }
     else if (key == "size") {

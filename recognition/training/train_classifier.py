@@ -9,7 +9,7 @@ same input, fits the fusion model (a logistic regression of fusionFeatures, with
 logit, on the calibration split) and reports the held-out test split.
 
     /usr/bin/python3 recognition/training/train_classifier.py --data DIR... --out OUT \
-        [--channels depth|rgb] [--epochs N] [--seed S]
+        [--channels depth|rgb|depthrgb] [--epochs N] [--seed S] [--real-repeat R]
 
 Writes OUT/cylinder_net.onnx, OUT/cylinder_net.cfg, OUT/curves.png, OUT/report.json and
 OUT/test_predictions.csv. The images are exactly what facyl's classifierImage makes (C++), so
@@ -30,7 +30,10 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 MEAN, SCALE = 127.5, 1.0 / 127.5
-CHANNELS = {"rgb": 3, "depth": 2}
+CHANNELS = {"rgb": 3, "depth": 2, "depthrgb": 5}
+# The files of facyl_crops that make each channel set: depthrgb is depth's planes followed by
+# rgb's, as facyl::classifierImage makes it (ClassifierChannels::DepthRgb).
+FILES = {"rgb": ("rgb",), "depth": ("depth",), "depthrgb": ("depth", "rgb")}
 FUSION_FEATURES = 9  # facyl::kFusionFeatures
 
 
@@ -40,22 +43,30 @@ def load_folder(folder, channels):
     """Rows of objects.csv and the images of one channel set (N x C x S x S uint8)."""
     with open(os.path.join(folder, "objects.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
-    raw = np.fromfile(os.path.join(folder, channels + ".u8"), dtype=np.uint8)
-    c = CHANNELS[channels]
-    per = raw.size // max(1, len(rows))
-    size = int(round(math.sqrt(per / c)))
-    if len(rows) == 0 or c * size * size * len(rows) != raw.size:
-        sys.exit(f"train_classifier: {folder}: {raw.size} bytes do not hold {len(rows)} "
-                 f"images of {c} channels")
-    return rows, raw.reshape(len(rows), c, size, size), size
+    parts, size = [], None
+    for name in FILES[channels]:
+        raw = np.fromfile(os.path.join(folder, name + ".u8"), dtype=np.uint8)
+        c = CHANNELS[name]
+        per = raw.size // max(1, len(rows))
+        s = int(round(math.sqrt(per / c)))
+        if len(rows) == 0 or c * s * s * len(rows) != raw.size or (size is not None and s != size):
+            sys.exit(f"train_classifier: {folder}: {raw.size} bytes of {name}.u8 do not hold "
+                     f"{len(rows)} images of {c} channels")
+        size = s
+        parts.append(raw.reshape(len(rows), c, s, s))
+    return rows, np.concatenate(parts, 1) if len(parts) > 1 else parts[0], size
 
 
-def split_of(source, scene):
+def split_of(source, scene, train_real=False):
     """0 train, 1 calibration, 2 test: by a hash of the scene, so a scene's objects stay
-    together. Real data (not 'sim') is never trained on: 3."""
+    together. Real crops harvested for training (source 'real', with train_real) go to train
+    (80 %) or calibration, never to the simulated test split; other real data (UW crops) is
+    never trained on: 3."""
+    h = zlib.crc32(scene.encode()) % 100
+    if source == "real" and train_real:
+        return 0 if h < 80 else 1
     if source != "sim":
         return 3
-    h = zlib.crc32(scene.encode()) % 100
     return 0 if h < 70 else (1 if h < 85 else 2)
 
 
@@ -119,11 +130,35 @@ def to_input(batch_u8):
     return (torch.from_numpy(batch_u8).float() - MEAN) * SCALE
 
 
-def augment(x, rng, channels):
+def smooth_depth(f, rng, max_sigma):
+    """Real depth maps are smooth where the simulator's are sharp: stereo matching windows and
+    the sensors' spatial filters round a box's edges (the foam brick and the Spam tin of the
+    rgbd frames look like short cans). Blurs the relative depth of half of the images within
+    their masks (normalised convolution), by a Gaussian of sigma in [0, max_sigma] pixels."""
+    n = len(f)
+    sigma = np.round(rng.uniform(0.0, max_sigma, size=n) * 2) / 2 * (rng.random(n) < 0.5)
+    for s in np.unique(sigma[sigma > 0]):
+        idx = np.flatnonzero(sigma == s)
+        r = int(math.ceil(2.5 * s))
+        k = np.exp(-0.5 * (np.arange(-r, r + 1) / s) ** 2)
+        k = torch.from_numpy((k / k.sum()).astype(np.float32))
+        m = torch.from_numpy((f[idx, 0] > 0).astype(np.float32))[:, None]
+        d = torch.from_numpy(f[idx, 1] - 128.0)[:, None]
+        blur = lambda t: F.conv2d(F.conv2d(t, k.view(1, 1, 1, -1), padding=(0, r)),
+                                  k.view(1, 1, -1, 1), padding=(r, 0))
+        num, den = blur(d * m), blur(m)
+        out = torch.where((m > 0) & (den > 1e-3), num / den.clamp_min(1e-3), d)[:, 0].numpy()
+        f[idx, 1] = out + 128.0
+    return f
+
+
+def augment(x, rng, channels, depth_blur=0.0):
     """Mirrored images (paper IV-B), quarter turns (a standing can turned by 90 degrees is a
     lying one; the camera may roll), shifts of up to 4 pixels, and the faults of real depth
     images that the simulator makes too rarely: missing pixels in the object's mask (speckle,
-    dark or shiny surfaces), a ragged mask border, depth noise; for RGB, colour jitter."""
+    dark or shiny surfaces), a ragged mask border, depth noise; for RGB, colours randomized:
+    gain and offset per channel, the channels swapped, grey. A pixel without depth keeps its
+    colour (the camera still sees it)."""
     x = x.copy()
     flip = rng.random(len(x)) < 0.5
     x[flip] = x[flip][..., ::-1]
@@ -138,8 +173,8 @@ def augment(x, rng, channels):
     for i in range(len(x)):
         dy, dx = rng.integers(0, 2 * pad + 1, size=2)
         out[i] = padded[i, :, dy:dy + x.shape[2], dx:dx + x.shape[3]]
-    if channels == "depth":
-        f = out.astype(np.float32)
+    f = out.astype(np.float32)
+    if channels in ("depth", "depthrgb"):
         n, _, h, w = f.shape
         # Missing pixels: a per-image rate in [0, 0.35], some in 2x2 blocks.
         rate = rng.uniform(0.0, 0.35, size=(n, 1, 1)) * (rng.random((n, 1, 1)) < 0.7)
@@ -152,15 +187,22 @@ def augment(x, rng, channels):
         sigma = rng.uniform(0.0, 6.0, size=(n, 1, 1))
         inside = f[:, 0] > 0
         f[:, 1] += np.where(inside, rng.normal(size=(n, h, w)) * sigma, 0.0)
-        out = np.clip(np.rint(f), 0, 255).astype(np.uint8)
-    else:
-        f = out.astype(np.float32)
+        if depth_blur > 0:
+            f = smooth_depth(f, rng, depth_blur)
+    if channels in ("rgb", "depthrgb"):
+        c = slice(f.shape[1] - 3, f.shape[1])
+        rgb = f[:, c]
         gain = rng.uniform(0.6, 1.4, size=(len(f), 3, 1, 1))
         bias = rng.uniform(-30, 30, size=(len(f), 3, 1, 1))
-        f = f * gain + bias
+        rgb = rgb * gain + bias
+        if channels == "depthrgb":
+            # Colours and textures of the simulator are few: any permutation of the channels.
+            order = np.argsort(rng.random((len(f), 3)), axis=1)
+            rgb = np.take_along_axis(rgb, order[:, :, None, None], axis=1)
         gray = rng.random(len(f)) < 0.3
-        f[gray] = f[gray].mean(1, keepdims=True)
-        out = np.clip(np.rint(f), 0, 255).astype(np.uint8)
+        rgb[gray] = rgb[gray].mean(1, keepdims=True)
+        f[:, c] = rgb
+    out = np.clip(np.rint(f), 0, 255).astype(np.uint8)
     return np.ascontiguousarray(out)
 
 
@@ -323,6 +365,11 @@ def main():
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
     ap.add_argument("--max-train", type=int, default=0, help="at most this many training images")
+    ap.add_argument("--depth-blur", type=float, default=0.0,
+                    help="blur half of the depth images by up to this sigma (pixels; 0: off)")
+    ap.add_argument("--real-repeat", type=int, default=0,
+                    help="train on the real crops (source 'real', facyl_crops --mosd), each "
+                         "this many times per epoch (0: not at all)")
     args = ap.parse_args()
     if args.epochs < 1 or args.batch < 1:
         sys.exit("train_classifier: --epochs and --batch must be >= 1")
@@ -336,10 +383,13 @@ def main():
 
     rows, images, size = load(args.data, args.channels)
     labels = np.array([int(r["label"]) for r in rows])
-    split = np.array([split_of(r["source"], r["scene"]) for r in rows])
+    split = np.array([split_of(r["source"], r["scene"], args.real_repeat > 0) for r in rows])
     train = np.flatnonzero(split == 0)
     if args.max_train:
         train = train[:args.max_train]
+    real = np.array([r["source"] == "real" for r in rows])
+    if args.real_repeat > 1:
+        train = np.concatenate([train] + [train[real[train]]] * (args.real_repeat - 1))
     calib, test = np.flatnonzero(split == 1), np.flatnonzero(split == 2)
     if len(train) == 0:
         sys.exit("train_classifier: no simulated objects to train on")
@@ -349,8 +399,9 @@ def main():
         calib = train
     c = CHANNELS[args.channels]
     print(f"train_classifier: {len(rows)} objects ({size}x{size}, {args.channels}): train "
-          f"{len(train)} ({labels[train].mean():.2f} cylinders), calibration {len(calib)}, "
-          f"test {len(test)}", flush=True)
+          f"{len(train)} ({labels[train].mean():.2f} cylinders, {int(real[train].sum())} real), "
+          f"calibration {len(calib)} ({int(real[calib].sum())} real), test {len(test)}",
+          flush=True)
 
     net = CylinderNet(c, args.width)
     opt = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=1e-4)
@@ -364,7 +415,7 @@ def main():
         total, correct, loss_sum = 0, 0, 0.0
         for i in range(0, len(order), args.batch):
             idx = order[i:i + args.batch]
-            x = to_input(augment(images[idx], rng, args.channels))
+            x = to_input(augment(images[idx], rng, args.channels, args.depth_blur))
             y = torch.from_numpy(labels[idx]).long()
             logits = net(x)
             loss = F.cross_entropy(logits, y)
@@ -403,7 +454,9 @@ def main():
 
     # The held-out test split.
     report = {"data": args.data, "channels": args.channels, "size": size, "seed": args.seed,
-              "epochs": args.epochs, "width": args.width, "train": int(len(train)),
+              "epochs": args.epochs, "width": args.width, "real_repeat": args.real_repeat,
+              "depth_blur": args.depth_blur,
+              "train": int(len(train)),
               "calibration": int(len(calib)), "test": int(len(test)),
               "opencv_max_abs_diff": diff, "history": history,
               "fusion": None if fusion_w is None else [float(v) for v in fusion_w]}

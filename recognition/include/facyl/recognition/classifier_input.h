@@ -19,17 +19,18 @@ namespace facyl {
 
 /** \brief The network's input channels. */
 enum class ClassifierChannels {
-  Rgb,  ///< the RGB crop, as in the paper (3 channels)
-  Depth ///< 2.5-D: the object's mask and its depth relative to its median (2 channels)
+  Rgb,     ///< the RGB crop, as in the paper (3 channels)
+  Depth,   ///< 2.5-D: the object's mask and its depth relative to its median (2 channels)
+  DepthRgb ///< Depth's 2 channels followed by Rgb's 3 (5 channels)
 };
 
-/** \brief "rgb" or "depth". */
+/** \brief "rgb", "depth" or "depthrgb". */
 std::string
 toString(ClassifierChannels channels);
-/** \brief Parses "rgb" or "depth". \return false for anything else. */
+/** \brief Parses "rgb", "depth" or "depthrgb". \return false for anything else. */
 bool
 parseClassifierChannels(const std::string& text, ClassifierChannels& channels);
-/** \brief 3 for Rgb, 2 for Depth. */
+/** \brief 3 for Rgb, 2 for Depth, 5 for DepthRgb. */
 int
 channelCount(ClassifierChannels channels);
 
@@ -46,7 +47,11 @@ struct ClassifierInputSpec {
  * - Depth: channel 0 is 255 where a point of the object was seen, else 0; channel 1 is
  *   128 + 127 clamp((z - median z) / extent, -1, 1) there (extent: the larger of the object's
  *   x and y spans in the camera frame, at least 1 cm), 128 elsewhere.
- * \return an empty vector when the view has no box, or (Rgb) no crop, or (Depth) no pixels. */
+ * - DepthRgb: Depth's two planes, then Rgb's three (the same square, so pixel (x, y) of every
+ *   plane is the same pixel of the frame; training data joins facyl_crops' depth and rgb
+ *   images into it).
+ * \return an empty vector when the view has no box, or (Rgb, DepthRgb) no crop, or (Depth,
+ * DepthRgb) no pixels. */
 std::vector<std::uint8_t>
 classifierImage(const ObjectView& view, const ClassifierInputSpec& spec);
 

@@ -21,7 +21,7 @@ namespace facyl {
  * how its output becomes a probability, and the fusion model. Read from a text file of
  * "key value..." lines (# starts a comment):
  * \code
- * channels depth          # rgb | depth (see ClassifierChannels)
+ * channels depth          # rgb | depth | depthrgb (see ClassifierChannels)
  * size 64                 # input is channels x size x size
  * mean 127.5              # input value = (byte - mean) * scale
  * scale 0.0078431373
