@@ -87,6 +87,10 @@ validate(const CylinderTrackerParameters& p)
     why << "shrink_weight " << p.shrink_weight << " is not in (0, 1]; ";
   if (!in(p.min_probability, 0, 1))
     why << "min_probability " << p.min_probability << " is not in [0, 1]; ";
+  if (!(p.reference_quality > 0.f && std::isfinite(p.reference_quality)))
+    why << "reference_quality " << p.reference_quality << " must be > 0; ";
+  if (!in(p.radius_window, 1, 1000))
+    why << "radius_window " << p.radius_window << " is not in [1, 1000]; ";
   if (!in(p.decision_probability, 0.5, 0.99))
     why << "decision_probability " << p.decision_probability << " is not in [0.5, 0.99]; ";
   std::string s = why.str();
@@ -197,6 +201,7 @@ struct CylinderTracker::Observation {
   AssociationGeometry geometry; ///< world
   Eigen::Vector3f base{Eigen::Vector3f::Zero()}, top{Eigen::Vector3f::Zero()}; ///< world
   float p{0.5f};       ///< evidence that it is a cylinder
+  float quality{1.f};  ///< points x angular coverage of the fit (cylinders)
   int support{-1};
   std::size_t points{0};
 };
@@ -301,6 +306,8 @@ CylinderTracker::startTrack(const Observation& o, int object)
     t.var_axis = square(params_.measurement_axis);
     t.var_radius = square(params_.measurement_radius + 0.05f * t.radius);
     t.var_extent = square(params_.measurement_extent);
+    t.radii.assign(1, t.radius);
+    t.radius_weights.assign(1, o.quality * o.quality);
     axisUp(t);
   }
   t.confirmed = t.hits >= static_cast<std::size_t>(params_.confirm_hits);
@@ -326,9 +333,14 @@ CylinderTracker::correct(CylinderTrack& t, const Observation& o, float weight)
       t.var_axis = square(params_.measurement_axis);
       t.var_radius = square(params_.measurement_radius + 0.05f * t.radius);
       t.var_extent = square(params_.measurement_extent);
+      t.radii.assign(1, t.radius);
+      t.radius_weights.assign(1, o.quality * o.quality);
     }
     else {
-      filterAxis(t.axis, t.var_axis, g.axis, square(params_.measurement_axis) / weight, k);
+      // Observations count by what the frame saw of the object (reference_quality).
+      const float scale =
+        std::clamp(params_.reference_quality / std::max(o.quality, 1e-3f), 0.25f, 4.f) / weight;
+      filterAxis(t.axis, t.var_axis, g.axis, square(params_.measurement_axis) * scale, k);
       // The observed axis line where it passes the track's centre: only the offset across the
       // axis moves the line (along it, occlusion moves the visible centre).
       Eigen::Vector3f a = g.axis;
@@ -338,12 +350,22 @@ CylinderTracker::correct(CylinderTrack& t, const Observation& o, float weight)
       Eigen::Vector3f across = q - t.centre;
       across -= t.axis * across.dot(t.axis);
       filterPoint(t.centre, t.var_position, t.centre + across,
-                  square(params_.measurement_position) / weight, k);
+                  square(params_.measurement_position) * scale, k);
+      // The radius: the median of the last observations (weight < 1: unanchored frames
+      // count once in four).
+      t.radii.push_back(g.radius);
+      t.radius_weights.push_back(o.quality * o.quality * weight);
+      if (t.radii.size() > static_cast<std::size_t>(params_.radius_window)) {
+        t.radii.erase(t.radii.begin(), t.radii.end() - params_.radius_window);
+        t.radius_weights.erase(t.radius_weights.begin(),
+                               t.radius_weights.end() - params_.radius_window);
+      }
       filterScalar(t.radius, t.var_radius, g.radius,
-                   square(params_.measurement_radius + 0.05f * g.radius) / weight, k);
+                   square(params_.measurement_radius + 0.05f * g.radius) * scale, k);
+      t.radius = weightedMedian(t.radii, t.radius_weights);
       const float sb = (o.base - t.centre).dot(t.axis), st = (o.top - t.centre).dot(t.axis);
       filterExtent(t.lo, t.hi, t.var_extent, std::min(sb, st), std::max(sb, st),
-                   square(params_.measurement_extent) / weight, params_.shrink_weight);
+                   square(params_.measurement_extent) * scale, params_.shrink_weight);
       const float mid = 0.5f * (t.lo + t.hi);
       t.centre += mid * t.axis;
       t.lo -= mid;
@@ -358,6 +380,7 @@ CylinderTracker::correct(CylinderTrack& t, const Observation& o, float weight)
   t.misses = 0;
   t.occluded = 0;
   t.out_of_view = 0;
+  t.seen_through = 0;
   t.status = TrackStatus::Seen;
   if (t.hits >= static_cast<std::size_t>(params_.confirm_hits))
     t.confirmed = true;
@@ -543,11 +566,14 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       o.geometry.centre = 0.5f * (o.base + o.top);
       o.geometry.radius = c.radius;
       o.geometry.height = (o.top - o.base).norm();
+      o.quality = static_cast<float>(o.points) * std::max(0.05f, c.angular_coverage);
     }
-    const float p = r.evidence.p_cylinder;
-    o.p = std::isfinite(p) ? p
-                           : (r.is_cylinder ? params_.decision_probability
-                                            : 1.f - params_.decision_probability);
+    // The decision sets the side, the probability its strength.
+    const float p = r.evidence.p_cylinder, side = params_.decision_probability;
+    if (r.is_cylinder)
+      o.p = std::isfinite(p) ? std::max(p, side) : side;
+    else
+      o.p = std::isfinite(p) ? std::min(p, 1.f - side) : 1.f - side;
     return o;
   };
 
@@ -657,9 +683,12 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
   const float inf = std::numeric_limits<float>::infinity();
   Eigen::MatrixXf cost(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(m));
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m; ++j)
-      cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
-        obs[i].valid ? associationCost(tg[j], obs[i].geometry, params_.association) : inf;
+    for (std::size_t j = 0; j < m; ++j) {
+      float c = obs[i].valid ? associationCost(tg[j], obs[i].geometry, params_.association) : inf;
+      if (tracks_[j].seen_through > 0 && c > 0.25f * params_.association.gate)
+        c = inf;
+      cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = c;
+    }
   std::vector<int> match = assignMinimumCost(cost, params_.association.gate);
   // A second chance, with twice the sigmas, for what is left on both sides: an object whose
   // fit changed much is still the one at the track's place.
@@ -673,7 +702,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       if (match[i] < 0 && obs[i].valid)
         rows.push_back(static_cast<int>(i));
     for (std::size_t j = 0; j < m; ++j)
-      if (!taken[j])
+      if (!taken[j] && tracks_[j].seen_through == 0)
         cols.push_back(static_cast<int>(j));
     if (!rows.empty() && !cols.empty()) {
       AssociationSettings loose = params_.association;
@@ -779,7 +808,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
     case TrackStatus::Occluded: ++t.occluded; break;
     case TrackStatus::Merged: {
       auto& a = assignments_[static_cast<std::size_t>(inside)];
-      if (a.role == TrackAssignment::Role::Started) {
+      if (a.role == TrackAssignment::Role::Started && t.seen_through == 0) {
         // The object at its place started a new track: it is this one, seen with a fit too
         // different to match (the new track goes; the geometry is not updated from it).
         for (auto& other : tracks_)
@@ -790,7 +819,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
                     square(params_.measurement_centroid), params_.huber_k);
         t.log_odds = updateLogOdds(t.log_odds, o.p, params_.confidence_limit);
         ++t.hits;
-        t.misses = t.occluded = t.out_of_view = 0;
+        t.misses = t.occluded = t.out_of_view = t.seen_through = 0;
         t.status = TrackStatus::Seen;
         t.object = inside;
         a.role = TrackAssignment::Role::Matched;
@@ -804,7 +833,10 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       a.merged.push_back(t.id);
       break;
     }
-    case TrackStatus::SeenThrough: t.misses += params_.see_through_misses; break;
+    case TrackStatus::SeenThrough:
+      t.misses += params_.see_through_misses;
+      ++t.seen_through;
+      break;
     default: t.misses += 1; break;
     }
   }

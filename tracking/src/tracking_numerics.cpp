@@ -431,6 +431,41 @@ filterExtent(float& lo, float& hi, float& var, float z_lo, float z_hi, float var
 }
 
 float
+median(std::vector<float> values)
+{
+  if (values.empty())
+    return std::numeric_limits<float>::quiet_NaN();
+  const std::size_t h = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(h), values.end());
+  if (values.size() % 2)
+    return values[h];
+  const float upper = values[h];
+  return 0.5f * (upper + *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(h)));
+}
+
+float
+weightedMedian(const std::vector<float>& values, const std::vector<float>& weights)
+{
+  std::vector<std::pair<float, float>> v;
+  float total = 0.f;
+  for (std::size_t i = 0; i < values.size() && i < weights.size(); ++i)
+    if (weights[i] > 0.f && std::isfinite(values[i])) {
+      v.emplace_back(values[i], weights[i]);
+      total += weights[i];
+    }
+  if (v.empty())
+    return std::numeric_limits<float>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  float cumulated = 0.f;
+  for (const auto& [value, weight] : v) {
+    cumulated += weight;
+    if (cumulated >= 0.5f * total)
+      return value;
+  }
+  return v.back().first;
+}
+
+float
 logOdds(float p)
 {
   if (!std::isfinite(p))

@@ -70,12 +70,22 @@ struct CylinderTrackerParameters {
   float measurement_radius{0.003f};   ///< m, plus 5% of the radius, > 0
   float measurement_extent{0.01f};    ///< m, each end along the axis, > 0
   float process_position{0.002f};     ///< m per frame, >= 0
-  float process_axis{0.01f};          ///< rad per frame, >= 0
+  float process_axis{0.003f};          ///< rad per frame, >= 0
   float process_radius{0.0005f};      ///< m per frame, >= 0
   /** An observed end of a cylinder inside the tracked extent counts with this weight (an
    * occluded end), one beyond it fully; in (0, 1]. */
   float shrink_weight{0.3f};
   float huber_k{2.f}; ///< outlying observations pull by at most this many sigmas, > 0
+  /** The radius is the weighted median of the last this many observed radii, in [1, 1000]:
+   * a fit's radius errs mostly by a few percent and sometimes by tens (a partial arc, a
+   * neighbour's points), which a mean, even a robust one, follows too far. */
+  int radius_window{30};
+  /** How much an observation counts grows with what the frame saw of the object: its points
+   * times the angular coverage of its fit (a cylinder seen in 500 points errs ten times more
+   * in radius than one seen in 2500). The measurement variances above are those of an object
+   * of this quality (points x coverage, > 0), divided by an observation's quality over it
+   * (within [1/4, 4]); the radius median weighs each radius by its quality. */
+  float reference_quality{600.f};
 
   // ---- confidence
   /** The track's log-odds of being a cylinder stay within +-this (4.6: p in [0.01, 0.99]),
@@ -84,9 +94,11 @@ struct CylinderTrackerParameters {
   /** A track is a cylinder when its p_cylinder is at least this (and it has a cylinder
    * estimate), in [0, 1]. */
   float min_probability{0.5f};
-  /** The evidence of a frame without a classifier (p_cylinder NaN): this probability for an
-   * accepted cylinder, 1 - this for another object, in [0.5, 0.99]. */
-  float decision_probability{0.8f};
+  /** A frame's evidence: its decision sets the side, its p_cylinder (when known) the
+   * strength. An accepted cylinder counts as p_cylinder clamped to at least this, another
+   * object as p_cylinder clamped to at most 1 - this; without a classifier (p_cylinder NaN)
+   * as this and 1 - this. In [0.5, 0.99]. */
+  float decision_probability{0.6f};
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
@@ -120,6 +132,10 @@ struct CylinderTrack {
   int misses{0};           ///< missed frames in a row (see_through_misses each when seen through)
   int occluded{0};         ///< hidden or merged frames in a row
   int out_of_view{0};      ///< frames in a row outside the image
+  /** Frames in a row the sensor saw through its place: while > 0 only an object right at its
+   * place (a quarter of the association gate) continues it; what appears behind a taken-away
+   * object does not take over its id. */
+  int seen_through{0};
   TrackStatus status{TrackStatus::Seen};
   int object{-1};          ///< the last frame's object matched to it, -1: none
   int merged_into{-1};     ///< status Merged: the track whose object holds its place, -1: none
@@ -136,6 +152,8 @@ struct CylinderTrack {
   float lo{0.f}, hi{0.f};
   float var_position{0.f}, var_axis{0.f}, var_radius{0.f}, var_extent{0.f};
   std::size_t cylinder_hits{0}; ///< frames that gave a cylinder
+  std::vector<float> radii;     ///< the last observed radii (radius_window), oldest first
+  std::vector<float> radius_weights; ///< their qualities
   float log_odds{0.f};          ///< of being a cylinder, from every frame's evidence
 
   /** \brief The filtered probability that the object is a cylinder. */

@@ -174,6 +174,17 @@ void
 filterExtent(float& lo, float& hi, float& var, float z_lo, float z_hi, float var_z,
              float shrink_weight);
 
+/** \brief Median of \a values (the mean of the two middle ones for an even count); NaN when
+ * empty. */
+float
+median(std::vector<float> values);
+
+/** \brief Weighted median of \a values with \a weights (> 0; same count): the smallest value
+ * at which the cumulated weight reaches half the total. NaN when empty or no weight is
+ * positive. */
+float
+weightedMedian(const std::vector<float>& values, const std::vector<float>& weights);
+
 /** \brief Log-odds of a probability, \a p clamped to [0.01, 0.99]. */
 float
 logOdds(float p);
