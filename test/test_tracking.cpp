@@ -279,6 +279,20 @@ TEST(TrackingNumerics, FiltersAreRobustAndSignFree)
   EXPECT_LT(facyl::probability(l), 0.5f); // a long history is overturned by two frames
   EXPECT_FLOAT_EQ(facyl::median({3.f, 1.f, 2.f}), 2.f);
   EXPECT_FLOAT_EQ(facyl::weightedMedian({1.f, 2.f, 10.f}, {1.f, 5.f, 1.f}), 2.f);
+  // The consensus axis: a wrong first fit is outvoted by the agreeing later ones, whatever
+  // their signs; the flags say which agreed.
+  {
+    const Eigen::Vector3f wrong = Eigen::Vector3f(1.f, 0.f, 0.2f).normalized();
+    const Eigen::Vector3f up1 = Eigen::Vector3f(0.02f, 0.f, 1.f).normalized();
+    const Eigen::Vector3f up2 = Eigen::Vector3f(-0.02f, 0.f, -1.f).normalized();
+    std::vector<char> agree;
+    const Eigen::Vector3f c =
+      facyl::consensusAxis({wrong, up1, up2}, {2.f, 1.5f, 1.5f}, 0.14f, &agree);
+    EXPECT_GT(std::abs(c.z()), 0.999f);
+    EXPECT_NEAR(c.norm(), 1.f, 1e-5f);
+    EXPECT_EQ(agree, (std::vector<char>{0, 1, 1}));
+    EXPECT_EQ(facyl::consensusAxis({}, {}, 0.14f), Eigen::Vector3f::Zero());
+  }
   // Association: an occluded end (the visible centre moves along the axis) costs nothing.
   facyl::AssociationGeometry t, o;
   t.cylinder = o.cylinder = true;

@@ -68,19 +68,14 @@ validate(const CylinderTrackerParameters& p)
   if (!(p.fragment_margin >= 0.f && std::isfinite(p.fragment_margin)))
     why << "fragment_margin " << p.fragment_margin << " must be >= 0; ";
   for (const auto& [name, v] :
-       {std::pair<const char*, float>{"measurement_position", p.measurement_position},
-        {"measurement_centroid", p.measurement_centroid},
-        {"measurement_axis", p.measurement_axis},
-        {"measurement_radius", p.measurement_radius},
+       {std::pair<const char*, float>{"measurement_centroid", p.measurement_centroid},
         {"measurement_extent", p.measurement_extent},
         {"huber_k", p.huber_k},
         {"confidence_limit", p.confidence_limit}})
     if (!(v > 0.f && std::isfinite(v)))
       why << name << " " << v << " must be > 0; ";
   for (const auto& [name, v] :
-       {std::pair<const char*, float>{"process_position", p.process_position},
-        {"process_axis", p.process_axis},
-        {"process_radius", p.process_radius}})
+       {std::pair<const char*, float>{"process_position", p.process_position}})
     if (!(v >= 0.f && std::isfinite(v)))
       why << name << " " << v << " must be >= 0; ";
   if (!(p.shrink_weight > 0.f && p.shrink_weight <= 1.f))
@@ -89,8 +84,10 @@ validate(const CylinderTrackerParameters& p)
     why << "min_probability " << p.min_probability << " is not in [0, 1]; ";
   if (!(p.reference_quality > 0.f && std::isfinite(p.reference_quality)))
     why << "reference_quality " << p.reference_quality << " must be > 0; ";
-  if (!in(p.radius_window, 1, 1000))
-    why << "radius_window " << p.radius_window << " is not in [1, 1000]; ";
+  if (!in(p.history, 1, 1000))
+    why << "history " << p.history << " is not in [1, 1000]; ";
+  if (!(p.axis_agreement > 0.f && p.axis_agreement <= 1.5708f))
+    why << "axis_agreement " << p.axis_agreement << " is not in (0, pi/2]; ";
   if (!in(p.decision_probability, 0.5, 0.99))
     why << "decision_probability " << p.decision_probability << " is not in [0.5, 0.99]; ";
   std::string s = why.str();
@@ -228,6 +225,7 @@ CylinderTracker::reset()
   tracks_.clear();
   assignments_.clear();
   has_pose_ = false;
+  has_velocity_ = false;
   world_on_support_ = false;
   frame_to_world_ = Eigen::Affine3f::Identity();
 }
@@ -241,15 +239,11 @@ CylinderTracker::endTracks()
 void
 CylinderTracker::predict()
 {
-  const float qp = square(params_.process_position), qa = square(params_.process_axis),
-              qr = square(params_.process_radius);
+  const float qp = square(params_.process_position);
   for (auto& t : tracks_) {
     ++t.age;
     t.var_centroid += qp;
-    t.var_position += qp;
     t.var_extent += qp;
-    t.var_axis += qa;
-    t.var_radius += qr;
     t.status = TrackStatus::NotUpdated;
     t.object = -1;
     t.merged_into = -1;
@@ -302,12 +296,8 @@ CylinderTracker::startTrack(const Observation& o, int object)
     t.radius = o.geometry.radius;
     t.lo = -0.5f * o.geometry.height;
     t.hi = 0.5f * o.geometry.height;
-    t.var_position = square(params_.measurement_position);
-    t.var_axis = square(params_.measurement_axis);
-    t.var_radius = square(params_.measurement_radius + 0.05f * t.radius);
     t.var_extent = square(params_.measurement_extent);
-    t.radii.assign(1, t.radius);
-    t.radius_weights.assign(1, o.quality * o.quality);
+    t.fits.assign(1, CylinderTrack::Fit{t.axis, t.centre, t.radius, o.quality * o.quality});
     axisUp(t);
   }
   t.confirmed = t.hits >= static_cast<std::size_t>(params_.confirm_hits);
@@ -329,40 +319,59 @@ CylinderTracker::correct(CylinderTrack& t, const Observation& o, float weight)
       t.radius = g.radius;
       t.lo = -0.5f * g.height;
       t.hi = 0.5f * g.height;
-      t.var_position = square(params_.measurement_position);
-      t.var_axis = square(params_.measurement_axis);
-      t.var_radius = square(params_.measurement_radius + 0.05f * t.radius);
       t.var_extent = square(params_.measurement_extent);
-      t.radii.assign(1, t.radius);
-      t.radius_weights.assign(1, o.quality * o.quality);
+      t.fits.assign(1, CylinderTrack::Fit{t.axis, t.centre, t.radius, o.quality * o.quality * weight});
     }
     else {
       // Observations count by what the frame saw of the object (reference_quality).
       const float scale =
         std::clamp(params_.reference_quality / std::max(o.quality, 1e-3f), 0.25f, 4.f) / weight;
-      filterAxis(t.axis, t.var_axis, g.axis, square(params_.measurement_axis) * scale, k);
-      // The observed axis line where it passes the track's centre: only the offset across the
-      // axis moves the line (along it, occlusion moves the visible centre).
-      Eigen::Vector3f a = g.axis;
-      if (a.dot(t.axis) < 0.f)
-        a = -a;
-      const Eigen::Vector3f q = g.centre + a * (t.centre - g.centre).dot(a);
-      Eigen::Vector3f across = q - t.centre;
-      across -= t.axis * across.dot(t.axis);
-      filterPoint(t.centre, t.var_position, t.centre + across,
-                  square(params_.measurement_position) * scale, k);
-      // The radius: the median of the last observations (weight < 1: unanchored frames
-      // count once in four).
-      t.radii.push_back(g.radius);
-      t.radius_weights.push_back(o.quality * o.quality * weight);
-      if (t.radii.size() > static_cast<std::size_t>(params_.radius_window)) {
-        t.radii.erase(t.radii.begin(), t.radii.end() - params_.radius_window);
-        t.radius_weights.erase(t.radius_weights.begin(),
-                               t.radius_weights.end() - params_.radius_window);
+      // The history: the axis most fits agree with, the line and radius they give.
+      t.fits.push_back(CylinderTrack::Fit{g.axis, g.centre, g.radius, o.quality * o.quality * weight});
+      if (t.fits.size() > static_cast<std::size_t>(params_.history))
+        t.fits.erase(t.fits.begin(), t.fits.end() - params_.history);
+      std::vector<Eigen::Vector3f> axes;
+      std::vector<float> weights;
+      for (const auto& f : t.fits) {
+        axes.push_back(f.axis);
+        weights.push_back(f.weight);
       }
-      filterScalar(t.radius, t.var_radius, g.radius,
-                   square(params_.measurement_radius + 0.05f * g.radius) * scale, k);
-      t.radius = weightedMedian(t.radii, t.radius_weights);
+      std::vector<char> agree;
+      const Eigen::Vector3f axis = consensusAxis(axes, weights, params_.axis_agreement, &agree);
+      if (axis.dot(t.axis) < 0.f) { // keep the extent's sense
+        const float lo = t.lo;
+        t.lo = -t.hi;
+        t.hi = -lo;
+      }
+      t.axis = axis.dot(t.axis) < 0.f ? Eigen::Vector3f(-axis) : axis;
+      // The line: where the agreeing fits' axes pass the plane across the axis at the centre,
+      // a weighted median in each direction of that plane, twice.
+      const Eigen::Vector3f e1 = t.axis.unitOrthogonal(), e2 = t.axis.cross(e1);
+      for (int pass = 0; pass < 2; ++pass) {
+        std::vector<float> u, v, w;
+        for (std::size_t i = 0; i < t.fits.size(); ++i) {
+          if (!agree[i])
+            continue;
+          const auto& f = t.fits[i];
+          const Eigen::Vector3f a = f.axis.dot(t.axis) < 0.f ? Eigen::Vector3f(-f.axis) : f.axis;
+          const Eigen::Vector3f q = f.centre + a * (t.centre - f.centre).dot(a) - t.centre;
+          u.push_back(q.dot(e1));
+          v.push_back(q.dot(e2));
+          w.push_back(f.weight);
+        }
+        const float du = weightedMedian(u, w), dv = weightedMedian(v, w);
+        if (std::isfinite(du) && std::isfinite(dv))
+          t.centre += du * e1 + dv * e2;
+      }
+      std::vector<float> radii, radius_weights;
+      for (std::size_t i = 0; i < t.fits.size(); ++i)
+        if (agree[i]) {
+          radii.push_back(t.fits[i].radius);
+          radius_weights.push_back(t.fits[i].weight);
+        }
+      const float r = weightedMedian(radii, radius_weights);
+      if (std::isfinite(r))
+        t.radius = r;
       const float sb = (o.base - t.centre).dot(t.axis), st = (o.top - t.centre).dot(t.axis);
       filterExtent(t.lo, t.hi, t.var_extent, std::min(sb, st), std::max(sb, st),
                    square(params_.measurement_extent) * scale, params_.shrink_weight);
@@ -514,8 +523,15 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
                                   }),
                    preference.end());
   const bool continuing = has_pose_ && world_on_support_;
+  // The camera keeps its motion between two frames (constant velocity) when the last two
+  // frames were anchored one after the other; else it stays where it was.
+  const Eigen::Affine3f predicted =
+    has_velocity_ ? Eigen::Affine3f(frame_to_world_ * (previous_frame_to_world_.inverse() * frame_to_world_))
+                  : frame_to_world_;
+  const Eigen::Affine3f last_pose = frame_to_world_;
+  const bool last_anchored = info_.anchored && !info_.skipped;
   const auto continues = [&](int k) {
-    const Eigen::Affine3f m = frame_to_world_ * supports[static_cast<std::size_t>(k)].frame;
+    const Eigen::Affine3f m = predicted * supports[static_cast<std::size_t>(k)].frame;
     const float cos_angle = std::min(1.f, std::abs(m.linear().col(2).normalized().z()));
     return std::acos(cos_angle) <= params_.max_plane_angle &&
            std::abs(m.translation().z()) <= params_.max_plane_offset &&
@@ -577,7 +593,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
     return o;
   };
 
-  Eigen::Affine3f pose = has_pose_ ? frame_to_world_ : Eigen::Affine3f::Identity();
+  Eigen::Affine3f pose = has_pose_ ? predicted : Eigen::Affine3f::Identity();
   bool new_scene = false;
   if (anchor >= 0) {
     const Eigen::Affine3f plane_to_cloud = supports[static_cast<std::size_t>(anchor)].frame;
@@ -592,18 +608,29 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       world_on_support_ = true;
     }
     else {
-      const PlanarRigid prior = inPlaneComponent(frame_to_world_ * plane_to_cloud);
+      const PlanarRigid prior = inPlaneComponent(predicted * plane_to_cloud);
+      // Lying cylinders (axis within 30 degrees of the plane) are lines: their horizontal
+      // direction fixes the yaw.
+      const auto lyingAxis = [](const AssociationGeometry& g) -> Eigen::Vector2f {
+        if (!g.cylinder || std::abs(g.axis.z()) > 0.5f)
+          return Eigen::Vector2f::Zero();
+        return g.axis.head<2>().normalized();
+      };
       Eigen::Matrix2Xf from(2, static_cast<Eigen::Index>(objects.size()));
+      Eigen::Matrix2Xf from_axes(2, from.cols());
       std::vector<Observation> local(objects.size());
       for (std::size_t i = 0; i < objects.size(); ++i) {
         local[i] = observe(objects[i], cloud_to_plane);
         from.col(static_cast<Eigen::Index>(i)) = reference(local[i].geometry).head<2>();
+        from_axes.col(static_cast<Eigen::Index>(i)) = lyingAxis(local[i].geometry);
       }
       Eigen::Matrix2Xf to(2, static_cast<Eigen::Index>(tracks_.size()));
+      Eigen::Matrix2Xf to_axes(2, to.cols());
       std::vector<AssociationGeometry> tg(tracks_.size());
       for (std::size_t j = 0; j < tracks_.size(); ++j) {
         tg[j] = geometryOf(tracks_[j]);
         to.col(static_cast<Eigen::Index>(j)) = reference(tg[j]).head<2>();
+        to_axes.col(static_cast<Eigen::Index>(j)) = lyingAxis(tg[j]);
       }
       std::vector<RegistrationCandidate> candidates;
       for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -622,7 +649,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
               continue;
             const bool upright = std::abs(t.axis.z()) > kUprightCos;
             c.weight = trust;
-            c.tolerance = upright ? 0.02f : 0.04f;
+            c.tolerance = upright || std::abs(t.axis.z()) < 0.5f ? 0.02f : 0.04f; // tilted: 4 cm
           }
           else {
             if (std::abs(reference(o).z() - reference(t).z()) > 0.06f)
@@ -633,7 +660,8 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
           candidates.push_back(c);
         }
       }
-      const PlanarRegistration reg = registerInPlane(from, to, candidates, prior, params_.registration);
+      const PlanarRegistration reg =
+        registerInPlane(from, to, candidates, prior, params_.registration, from_axes, to_axes);
       pose = reg.transform.asAffine() * cloud_to_plane;
       info.registration = reg.transform;
       info.registered = reg.matched_objects;
@@ -666,6 +694,8 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
   }
   else if (!has_pose_)
     world_on_support_ = false; // the world is this cloud's frame until a support is seen
+  has_velocity_ = has_pose_ && info.anchored && last_anchored && !new_scene;
+  previous_frame_to_world_ = last_pose;
   frame_to_world_ = pose;
   has_pose_ = true;
   info.anchor = anchor;
@@ -840,6 +870,51 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
     default: t.misses += 1; break;
     }
   }
+  // Two tracks of one object (a new one started while the old one was merged into another
+  // segment or its fit changed): when they agree within one sigma (associationCost < 1) the
+  // younger one goes into the older one, whose id stays.
+  for (std::size_t j = 0; j < tracks_.size(); ++j)
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      auto& older = tracks_[i];
+      auto& younger = tracks_[j];
+      if (i == j || older.id >= younger.id || younger.misses > 1000 || older.misses > 1000 ||
+          !younger.confirmed || (older.status == TrackStatus::Seen && younger.status == TrackStatus::Seen))
+        continue;
+      const AssociationGeometry a = geometryOf(older), b = geometryOf(younger);
+      if (associationCost(a, b, params_.association) >= 1.f)
+        continue;
+      if (younger.status == TrackStatus::Seen) { // the older one takes the frame's object
+        older.status = TrackStatus::Seen;
+        older.object = younger.object;
+        older.misses = older.occluded = older.out_of_view = older.seen_through = 0;
+        older.merged_into = -1;
+        older.centroid = younger.centroid;
+        if (younger.has_cylinder) {
+          older.has_cylinder = true;
+          older.fits.insert(older.fits.end(), younger.fits.begin(), younger.fits.end());
+          if (older.fits.size() > static_cast<std::size_t>(params_.history))
+            older.fits.erase(older.fits.begin(), older.fits.end() - params_.history);
+          older.centre = younger.centre;
+          older.axis = younger.axis;
+          older.radius = younger.radius;
+          older.lo = younger.lo;
+          older.hi = younger.hi;
+        }
+      }
+      older.hits += younger.hits;
+      older.cylinder_hits += younger.cylinder_hits;
+      older.log_odds = std::clamp(older.log_odds + younger.log_odds, -params_.confidence_limit,
+                                  params_.confidence_limit);
+      for (auto& a_k : assignments_) {
+        if (a_k.track_id == younger.id)
+          a_k.track_id = older.id;
+        for (auto& id : a_k.merged)
+          if (id == younger.id)
+            id = older.id;
+      }
+      younger.misses = std::numeric_limits<int>::max() / 2; // ended below
+      younger.confirmed = false;
+    }
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const CylinderTrack& t) {
                                  if (!t.confirmed)

@@ -90,17 +90,95 @@ fitPlanarRigid(const Eigen::Matrix2Xf& from, const Eigen::Matrix2Xf& to,
 
 namespace {
 
+/** Half-length (m) of the segment that stands for a lying cylinder's axis in the fits: its
+ * angle then weighs like a position error at 30 cm. A lying cylinder's axis is fitted to a
+ * tenth of a degree, an upright one's position to about 2 mm: a direction is worth a point
+ * pair more than a metre apart; 30 cm keeps a wrong one (a box's edge fitted) from pulling. */
+constexpr float kAxisArm = 0.3f;
+
+/** The landmarks of a registration: points, and for lying cylinders their axis directions. */
+struct Landmarks {
+  const Eigen::Matrix2Xf& objects;
+  const Eigen::Matrix2Xf& tracks;
+  const Eigen::Matrix2Xf& object_axes; ///< empty, or unit / zero columns
+  const Eigen::Matrix2Xf& track_axes;
+
+  /** Both ends of candidate \a k have an axis: they agree along a line. */
+  bool
+  isLine(const RegistrationCandidate& k) const
+  {
+    return object_axes.cols() > k.object && track_axes.cols() > k.track &&
+           object_axes.col(k.object).squaredNorm() > 0.5f && track_axes.col(k.track).squaredNorm() > 0.5f;
+  }
+  /** Residual of \a k under \a t: the distance of the points, or for a line the distance
+   * across the track's axis and the angle between the axes (times kAxisArm). */
+  float
+  residual(const RegistrationCandidate& k, const PlanarRigid& t) const
+  {
+    const Eigen::Vector2f d = t.apply(objects.col(k.object)) - tracks.col(k.track);
+    if (!isLine(k))
+      return d.norm();
+    const Eigen::Vector2f a = track_axes.col(k.track);
+    const Eigen::Vector2f across = d - a * d.dot(a);
+    const float c = std::cos(t.yaw), s = std::sin(t.yaw);
+    const Eigen::Vector2f o = object_axes.col(k.object);
+    const Eigen::Vector2f turned(c * o.x() - s * o.y(), s * o.x() + c * o.y());
+    const float sine = std::abs(turned.x() * a.y() - turned.y() * a.x());
+    return std::sqrt(across.squaredNorm() + kAxisArm * kAxisArm * sine * sine);
+  }
+  /** The point pairs \a k gives a Procrustes fit at \a t, with weight \a w: the points, or for
+   * a line a segment along each axis, the track's centred where the object's lies across it. */
+  void
+  pairs(const RegistrationCandidate& k, const PlanarRigid& t, float w,
+        std::vector<Eigen::Vector2f>& from, std::vector<Eigen::Vector2f>& to,
+        std::vector<float>& weights) const
+  {
+    const Eigen::Vector2f o = objects.col(k.object);
+    if (!isLine(k)) {
+      from.push_back(o);
+      to.push_back(tracks.col(k.track));
+      weights.push_back(w);
+      return;
+    }
+    const Eigen::Vector2f p = t.apply(o);
+    Eigen::Vector2f a = track_axes.col(k.track);
+    const float c = std::cos(t.yaw), s = std::sin(t.yaw);
+    const Eigen::Vector2f ao = object_axes.col(k.object);
+    if (Eigen::Vector2f(c * ao.x() - s * ao.y(), s * ao.x() + c * ao.y()).dot(a) < 0.f)
+      a = -a;
+    const Eigen::Vector2f foot = tracks.col(k.track) + a * (p - tracks.col(k.track)).dot(a);
+    for (const float side : {-1.f, 1.f}) {
+      from.push_back(o + side * kAxisArm * ao);
+      to.push_back(foot + side * kAxisArm * a);
+      weights.push_back(0.5f * w);
+    }
+  }
+};
+
+PlanarRigid
+fitPairs(const std::vector<Eigen::Vector2f>& from, const std::vector<Eigen::Vector2f>& to,
+         const std::vector<float>& weights, float fallback_yaw)
+{
+  Eigen::Matrix2Xf f(2, static_cast<Eigen::Index>(from.size())), t(2, f.cols());
+  Eigen::VectorXf w(f.cols());
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    f.col(static_cast<Eigen::Index>(i)) = from[i];
+    t.col(static_cast<Eigen::Index>(i)) = to[i];
+    w(static_cast<Eigen::Index>(i)) = weights[i];
+  }
+  return fitPlanarRigid(f, t, w, fallback_yaw);
+}
+
 /** Residuals of the candidates under \a t, greedy one-to-one: the best agreeing candidates
  * first, each object and track once. \return the score; \a inliers the chosen candidates. */
 float
-scoreUnique(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
-            const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& t,
-            std::vector<int>* inliers, std::size_t* matched_objects)
+scoreUnique(const Landmarks& l, const std::vector<RegistrationCandidate>& candidates,
+            const PlanarRigid& t, std::vector<int>* inliers, std::size_t* matched_objects)
 {
   std::vector<std::pair<float, int>> agree;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const auto& k = candidates[c];
-    const float r = (t.apply(objects.col(k.object)) - tracks.col(k.track)).norm();
+    const float r = l.residual(k, t);
     if (r < k.tolerance)
       agree.emplace_back(k.weight * (1.f - (r * r) / (k.tolerance * k.tolerance)),
                          static_cast<int>(c));
@@ -131,23 +209,66 @@ scoreUnique(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
 /** The fast score of the hypothesis search: each object's best agreeing candidate (a track
  * may count twice; the unique score decides between the best hypotheses). */
 float
-scoreFast(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
-          const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& t,
-          std::vector<float>& best_of_object)
+scoreFast(const Landmarks& l, const std::vector<RegistrationCandidate>& candidates,
+          const PlanarRigid& t, std::vector<float>& best_of_object)
 {
   std::fill(best_of_object.begin(), best_of_object.end(), 0.f);
-  const float c = std::cos(t.yaw), s = std::sin(t.yaw);
   for (const auto& k : candidates) {
-    const Eigen::Vector2f o = objects.col(k.object);
-    const Eigen::Vector2f p(c * o.x() - s * o.y() + t.t.x(), s * o.x() + c * o.y() + t.t.y());
-    const float r2 = (p - tracks.col(k.track)).squaredNorm();
-    const float tol2 = k.tolerance * k.tolerance;
-    if (r2 < tol2) {
+    const float r = l.residual(k, t);
+    if (r < k.tolerance) {
       float& b = best_of_object[static_cast<std::size_t>(k.object)];
-      b = std::max(b, k.weight * (1.f - r2 / tol2));
+      b = std::max(b, k.weight * (1.f - (r * r) / (k.tolerance * k.tolerance)));
     }
   }
   return std::accumulate(best_of_object.begin(), best_of_object.end(), 0.f);
+}
+
+/** \a best refined by weighted Procrustes on its unique inliers, twice. */
+PlanarRegistration
+refine(const Landmarks& l, const std::vector<RegistrationCandidate>& near,
+       const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& best,
+       const PlanarRigid& prior, const RegistrationSettings& settings, bool best_is_prior)
+{
+  PlanarRegistration out;
+  PlanarRigid t = best;
+  std::vector<int> inliers;
+  std::size_t matched = 0;
+  float score = scoreUnique(l, near, t, &inliers, &matched);
+  for (int iteration = 0; iteration < 2 && !inliers.empty(); ++iteration) {
+    std::vector<Eigen::Vector2f> from, to;
+    std::vector<float> w;
+    for (const int c : inliers) {
+      const auto& k = near[static_cast<std::size_t>(c)];
+      l.pairs(k, t, k.weight / (k.tolerance * k.tolerance), from, to, w);
+    }
+    const PlanarRigid refined = fitPairs(from, to, w, t.yaw);
+    if (std::abs(wrapAngle(refined.yaw - prior.yaw)) > settings.max_yaw_change ||
+        (refined.t - prior.t).norm() > 2.f * settings.search_radius)
+      break;
+    std::vector<int> refined_inliers;
+    std::size_t refined_matched = 0;
+    const float refined_score = scoreUnique(l, near, refined, &refined_inliers, &refined_matched);
+    if (refined_score + 1e-6f < score && refined_matched <= matched)
+      break;
+    t = refined;
+    inliers = std::move(refined_inliers);
+    matched = refined_matched;
+    score = refined_score;
+  }
+  out.transform = t;
+  out.score = score;
+  out.matched_objects = matched;
+  out.from_prior = best_is_prior;
+  // Inliers as indices into the caller's candidates.
+  for (const int c : inliers) {
+    const auto& k = near[static_cast<std::size_t>(c)];
+    for (std::size_t j = 0; j < candidates.size(); ++j)
+      if (candidates[j].object == k.object && candidates[j].track == k.track) {
+        out.inliers.push_back(static_cast<int>(j));
+        break;
+      }
+  }
+  return out;
 }
 
 } // namespace
@@ -155,22 +276,73 @@ scoreFast(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
 PlanarRegistration
 registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
                 const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& prior,
-                const RegistrationSettings& settings)
+                const RegistrationSettings& settings, const Eigen::Matrix2Xf& object_axes,
+                const Eigen::Matrix2Xf& track_axes)
 {
   PlanarRegistration out;
   out.transform = prior;
+  const Landmarks l{objects, tracks, object_axes, track_axes};
   // Candidates that the prior can reach, strongest first.
   std::vector<RegistrationCandidate> near;
   for (const auto& k : candidates)
     if (k.object >= 0 && k.object < objects.cols() && k.track >= 0 && k.track < tracks.cols() &&
         k.weight > 0.f && k.tolerance > 0.f &&
-        (prior.apply(objects.col(k.object)) - tracks.col(k.track)).norm() <=
-          settings.search_radius)
+        (prior.apply(objects.col(k.object)) - tracks.col(k.track)).norm() <= settings.search_radius)
       near.push_back(k);
   if (near.empty())
     return out;
   std::stable_sort(near.begin(), near.end(),
                    [](const auto& a, const auto& b) { return a.weight > b.weight; });
+  const auto reachable = [&](const PlanarRigid& h) {
+    return std::abs(wrapAngle(h.yaw - prior.yaw)) <= settings.max_yaw_change &&
+           (h.t - prior.t).norm() <= 2.f * settings.search_radius;
+  };
+
+  // From the prior first: each object's closest candidate, reweighted (Huber on the residual)
+  // within a shrinking radius, four times (ICP-like; a stream's prior is close). Accepted when
+  // at least half of the objects with candidates, and two, agree: the search below is for
+  // jumps and costs O(c^2 (n + m)).
+  {
+    PlanarRigid local = prior;
+    float radius = 0.5f * settings.search_radius;
+    std::vector<int> closest(static_cast<std::size_t>(objects.cols()));
+    std::vector<float> residual(static_cast<std::size_t>(objects.cols()));
+    for (int iteration = 0; iteration < 4; ++iteration) {
+      std::fill(closest.begin(), closest.end(), -1);
+      std::fill(residual.begin(), residual.end(), radius);
+      for (std::size_t c = 0; c < near.size(); ++c) {
+        const float r = l.residual(near[c], local);
+        if (r < residual[static_cast<std::size_t>(near[c].object)]) {
+          residual[static_cast<std::size_t>(near[c].object)] = r;
+          closest[static_cast<std::size_t>(near[c].object)] = static_cast<int>(c);
+        }
+      }
+      std::vector<Eigen::Vector2f> from, to;
+      std::vector<float> w;
+      for (std::size_t i = 0; i < closest.size(); ++i)
+        if (closest[i] >= 0) {
+          const auto& k = near[static_cast<std::size_t>(closest[i])];
+          l.pairs(k, local,
+                  k.weight / (k.tolerance * k.tolerance) * huberWeight(residual[i], k.tolerance, 1.f),
+                  from, to, w);
+        }
+      if (from.empty())
+        break;
+      const PlanarRigid next = fitPairs(from, to, w, local.yaw);
+      if (!reachable(next))
+        break;
+      local = next;
+      radius = std::max(0.5f * radius, 0.05f);
+    }
+    std::vector<char> has(static_cast<std::size_t>(objects.cols()), 0);
+    for (const auto& k : near)
+      has[static_cast<std::size_t>(k.object)] = 1;
+    const auto with_candidates = static_cast<std::size_t>(std::count(has.begin(), has.end(), 1));
+    std::size_t agreeing = 0;
+    scoreUnique(l, near, local, nullptr, &agreeing);
+    if (agreeing >= 2 && 2 * agreeing >= with_candidates)
+      return refine(l, near, candidates, local, prior, settings, false);
+  }
 
   // A slight preference for hypotheses near the prior breaks ties (one landmark, several
   // tracks of its kind in reach).
@@ -180,13 +352,12 @@ registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
   };
   std::vector<float> best_of_object(static_cast<std::size_t>(objects.cols()), 0.f);
   PlanarRigid best = prior;
-  float best_score = scoreFast(objects, tracks, near, prior, best_of_object);
+  float best_score = scoreFast(l, near, prior, best_of_object);
   bool best_is_prior = true;
   const auto consider = [&](const PlanarRigid& h) {
-    if (std::abs(wrapAngle(h.yaw - prior.yaw)) > settings.max_yaw_change ||
-        (h.t - prior.t).norm() > 2.f * settings.search_radius)
+    if (!reachable(h))
       return;
-    const float score = scoreFast(objects, tracks, near, h, best_of_object) - deviation(h);
+    const float score = scoreFast(l, near, h, best_of_object) - deviation(h);
     if (score > best_score) {
       best_score = score;
       best = h;
@@ -223,51 +394,7 @@ registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
       consider(h);
       ++hypotheses;
     }
-
-  // Refinement on the unique inliers, twice.
-  PlanarRigid t = best;
-  std::vector<int> inliers;
-  std::size_t matched = 0;
-  float score = scoreUnique(objects, tracks, near, t, &inliers, &matched);
-  for (int iteration = 0; iteration < 2 && !inliers.empty(); ++iteration) {
-    Eigen::Matrix2Xf from(2, static_cast<Eigen::Index>(inliers.size()));
-    Eigen::Matrix2Xf to(2, from.cols());
-    Eigen::VectorXf w(from.cols());
-    for (std::size_t i = 0; i < inliers.size(); ++i) {
-      const auto& k = near[static_cast<std::size_t>(inliers[i])];
-      from.col(static_cast<Eigen::Index>(i)) = objects.col(k.object);
-      to.col(static_cast<Eigen::Index>(i)) = tracks.col(k.track);
-      w(static_cast<Eigen::Index>(i)) = k.weight / (k.tolerance * k.tolerance);
-    }
-    const PlanarRigid refined = fitPlanarRigid(from, to, w, t.yaw);
-    if (std::abs(wrapAngle(refined.yaw - prior.yaw)) > settings.max_yaw_change ||
-        (refined.t - prior.t).norm() > 2.f * settings.search_radius)
-      break;
-    std::vector<int> refined_inliers;
-    std::size_t refined_matched = 0;
-    const float refined_score =
-      scoreUnique(objects, tracks, near, refined, &refined_inliers, &refined_matched);
-    if (refined_score + 1e-6f < score && refined_matched <= matched)
-      break;
-    t = refined;
-    inliers = std::move(refined_inliers);
-    matched = refined_matched;
-    score = refined_score;
-  }
-  out.transform = t;
-  out.score = score;
-  out.matched_objects = matched;
-  out.from_prior = best_is_prior;
-  // Inliers as indices into the caller's candidates.
-  for (const int c : inliers) {
-    const auto& k = near[static_cast<std::size_t>(c)];
-    for (std::size_t j = 0; j < candidates.size(); ++j)
-      if (candidates[j].object == k.object && candidates[j].track == k.track) {
-        out.inliers.push_back(static_cast<int>(j));
-        break;
-      }
-  }
-  return out;
+  return refine(l, near, candidates, best, prior, settings, best_is_prior);
 }
 
 float
@@ -463,6 +590,40 @@ weightedMedian(const std::vector<float>& values, const std::vector<float>& weigh
       return value;
   }
   return v.back().first;
+}
+
+Eigen::Vector3f
+consensusAxis(const std::vector<Eigen::Vector3f>& axes, const std::vector<float>& weights,
+              float inlier_angle, std::vector<char>* inliers)
+{
+  const std::size_t n = std::min(axes.size(), weights.size());
+  if (inliers)
+    inliers->assign(axes.size(), 0);
+  if (n == 0)
+    return Eigen::Vector3f::Zero();
+  const float cos_limit = std::cos(inlier_angle);
+  std::size_t best = 0;
+  float best_support = -1.f;
+  for (std::size_t i = 0; i < n; ++i) {
+    float support = 0.f;
+    for (std::size_t j = 0; j < n; ++j)
+      if (std::abs(axes[i].dot(axes[j])) >= cos_limit)
+        support += std::max(0.f, weights[j]);
+    if (support >= best_support) {
+      best_support = support;
+      best = i;
+    }
+  }
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  for (std::size_t j = 0; j < n; ++j) {
+    const float d = axes[best].dot(axes[j]);
+    if (std::abs(d) < cos_limit)
+      continue;
+    sum += std::max(0.f, weights[j]) * (d < 0.f ? -axes[j] : axes[j]);
+    if (inliers)
+      (*inliers)[j] = 1;
+  }
+  return sum.norm() > 0.f ? Eigen::Vector3f(sum.normalized()) : axes[best];
 }
 
 float

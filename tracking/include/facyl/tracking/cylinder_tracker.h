@@ -64,27 +64,27 @@ struct CylinderTrackerParameters {
 
   // ---- filtering (per observation: the measurement's standard deviation; per frame: the
   // process noise, what re-anchoring may move a static object by)
-  float measurement_position{0.008f}; ///< m, a cylinder's axis, > 0
   float measurement_centroid{0.02f};  ///< m, the centroid of the visible points, > 0
-  float measurement_axis{0.05f};      ///< rad, > 0
-  float measurement_radius{0.003f};   ///< m, plus 5% of the radius, > 0
-  float measurement_extent{0.01f};    ///< m, each end along the axis, > 0
+  float measurement_extent{0.01f};    ///< m, each end of a cylinder along its axis, > 0
   float process_position{0.002f};     ///< m per frame, >= 0
-  float process_axis{0.003f};          ///< rad per frame, >= 0
-  float process_radius{0.0005f};      ///< m per frame, >= 0
   /** An observed end of a cylinder inside the tracked extent counts with this weight (an
    * occluded end), one beyond it fully; in (0, 1]. */
   float shrink_weight{0.3f};
   float huber_k{2.f}; ///< outlying observations pull by at most this many sigmas, > 0
-  /** The radius is the weighted median of the last this many observed radii, in [1, 1000]:
-   * a fit's radius errs mostly by a few percent and sometimes by tens (a partial arc, a
-   * neighbour's points), which a mean, even a robust one, follows too far. */
-  int radius_window{30};
+  /** The cylinder is estimated from its last this many observations, in [1, 1000]: the
+   * axis that most of them agree with (consensusAxis, within axis_agreement), the axis line
+   * where the agreeing ones put it (weighted medians across the axis) and their weighted
+   * median radius. A fit's radius errs mostly by a few percent and sometimes by tens (a
+   * partial arc, a neighbour's points), its axis now and then by tens of degrees: a mean,
+   * even a robust one, follows such a fit too far, and a wrong first fit for a long time. */
+  int history{30};
+  float axis_agreement{0.14f}; ///< rad (8 degrees), in (0, pi/2]
   /** How much an observation counts grows with what the frame saw of the object: its points
    * times the angular coverage of its fit (a cylinder seen in 500 points errs ten times more
    * in radius than one seen in 2500). The measurement variances above are those of an object
    * of this quality (points x coverage, > 0), divided by an observation's quality over it
-   * (within [1/4, 4]); the radius median weighs each radius by its quality. */
+   * (within [1/4, 4]); the history weighs each observation by its quality squared (the inverse
+   * of its variance). */
   float reference_quality{600.f};
 
   // ---- confidence
@@ -150,10 +150,16 @@ struct CylinderTrack {
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()}; ///< unit; sign: away from the support
   float radius{0.f};
   float lo{0.f}, hi{0.f};
-  float var_position{0.f}, var_axis{0.f}, var_radius{0.f}, var_extent{0.f};
+  float var_extent{0.f}; ///< of lo and hi
   std::size_t cylinder_hits{0}; ///< frames that gave a cylinder
-  std::vector<float> radii;     ///< the last observed radii (radius_window), oldest first
-  std::vector<float> radius_weights; ///< their qualities
+  /** One fitted cylinder of a frame, in the world frame. */
+  struct Fit {
+    Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()}; ///< unit, sign free
+    Eigen::Vector3f centre{Eigen::Vector3f::Zero()};
+    float radius{0.f};
+    float weight{0.f}; ///< quality squared (less in a frame without a support)
+  };
+  std::vector<Fit> fits; ///< the last observations (history), oldest first
   float log_odds{0.f};          ///< of being a cylinder, from every frame's evidence
 
   /** \brief The filtered probability that the object is a cylinder. */
@@ -230,7 +236,7 @@ struct TrackerFrameInfo {
  * camera's, so it moves with the camera. Each frame is re-anchored: its support's plane gives
  * the tilt and height of the camera, and the in-plane motion (a 2-D rigid transform about the
  * support's normal) is estimated robustly from the objects matched to tracks
- * (registerInPlane, with the previous frame's pose as prior). Objects are then matched to
+ * (registerInPlane, with the pose predicted from the last two frames as prior). Objects are then matched to
  * tracks by minimum cost (associationCost, assignMinimumCost) and filtered (filterPoint,
  * filterAxis, filterScalar, filterExtent; robust to a bad fit); a confidence is updated from
  * every frame's p_cylinder (updateLogOdds).
@@ -402,6 +408,10 @@ private:
   TrackerFrameInfo info_;
   Eigen::Affine3f frame_to_world_{Eigen::Affine3f::Identity()};
   Eigen::Affine3f sensor_pose_{Eigen::Affine3f::Identity()}; ///< of the last frame
+  /** The frame before the last one: with it, the camera's motion between two frames predicts
+   * the next pose (constant velocity), when both were anchored and consecutive. */
+  Eigen::Affine3f previous_frame_to_world_{Eigen::Affine3f::Identity()};
+  bool has_velocity_{false};
   bool has_pose_{false};       ///< frame_to_world_ holds a pose
   bool world_on_support_{false}; ///< the world frame is a support's plane
   int next_id_{0};

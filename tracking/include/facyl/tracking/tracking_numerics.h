@@ -91,17 +91,29 @@ struct PlanarRegistration {
  * the frame's support coordinates, x and y) against the tracks (\a tracks: world plane
  * coordinates) from \a candidates.
  *
- * The hypotheses are the prior, every candidate alone with the prior's yaw (a translation), and
+ * Candidates farther than search_radius under the prior are dropped first. Then, from the
+ * prior, each object's closest candidate is fitted (weighted Procrustes, fitPlanarRigid, with
+ * Huber weights on the residuals, in a shrinking radius, four times: ICP-like); when at least
+ * half of the objects with candidates, and two, agree, that is the answer. Otherwise (a jump)
+ * the hypotheses are the prior, every candidate alone with the prior's yaw (a translation), and
  * every two candidates of distinct objects and tracks whose distances agree (a full rigid
- * motion: rotation from the two directions); each is scored MSAC-like (truncated quadratic of
- * the residuals, each object and each track counted once), the best is refined by weighted
- * Procrustes (fitPlanarRigid) on its inliers, twice. Candidates farther than search_radius
- * under the prior are dropped first. Cost: O(c^2 (n + m)) for c candidates, bounded by
- * max_hypotheses. */
+ * motion: rotation from the two directions), each scored MSAC-like (truncated quadratic of the
+ * residuals, each object and each track counted once). The answer is refined by weighted
+ * Procrustes on its inliers, twice. Cost: O(c (n + m)) from the prior, O(c^2 (n + m)) for c
+ * candidates (at most max_hypotheses) after a jump.
+ *
+ * \a object_axes and \a track_axes (optional; unit or zero columns, one per object and track)
+ * give the horizontal directions of lying cylinders' axes: a candidate whose ends both have one
+ * agrees along a line (its residual is the distance across the track's axis and the angle
+ * between the axes as a distance at 30 cm; along the axis occlusion moves the visible centre),
+ * and its yaw counts in the fits: a lying cylinder fixes the rotation better than points a few
+ * centimetres apart. */
 PlanarRegistration
 registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
                 const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& prior,
-                const RegistrationSettings& settings = {});
+                const RegistrationSettings& settings = {},
+                const Eigen::Matrix2Xf& object_axes = Eigen::Matrix2Xf(),
+                const Eigen::Matrix2Xf& track_axes = Eigen::Matrix2Xf());
 
 // ----------------------------------------------------------------------------- association
 
@@ -184,6 +196,16 @@ median(std::vector<float> values);
  * positive. */
 float
 weightedMedian(const std::vector<float>& values, const std::vector<float>& weights);
+
+/** \brief The axis most of the weighted \a axes (unit, sign free) agree with: for each axis,
+ * the weight of the axes within \a inlier_angle (rad) of it; the best supported one's agreeing
+ * axes are averaged (signs aligned, weighted; the later one wins a tie). A wrong first fit is
+ * outvoted as soon as the right ones outweigh it, which a filter of the axis, robust or not,
+ * only approaches step by step. \a inliers (optional) flags the agreeing axes. Zero when
+ * \a axes is empty. Cost O(n^2). */
+Eigen::Vector3f
+consensusAxis(const std::vector<Eigen::Vector3f>& axes, const std::vector<float>& weights,
+              float inlier_angle, std::vector<char>* inliers = nullptr);
 
 /** \brief Log-odds of a probability, \a p clamped to [0.01, 0.99]. */
 float
