@@ -77,20 +77,39 @@ class Grid {
 public:
   Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
        const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr)
-  : cloud_(cloud), w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
+  : w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
     slot_(cloud.size(), -1)
   {
+    std::size_t valid = 0;
+    for (const auto& q : cloud)
+      valid += finite(q);
+    // The noise's half-width by range, every 5 mm up to 12 m.
+    constexpr float kBin = 0.005f;
+    constexpr std::size_t kBins = 2400;
+    std::vector<float> noise_half;
+    if (noise) {
+      noise_half.resize(kBins);
+      for (std::size_t b = 0; b < kBins; ++b)
+        noise_half[b] = noise->halfWidth((static_cast<float>(b) + 0.5f) * kBin);
+    }
+    pixel_.reserve(valid);
+    xyz_.reserve(valid);
+    u_.reserve(valid);
+    v_.reserve(valid);
+    range_.reserve(valid);
+    gap2_.reserve(valid);
     for (std::size_t i = 0; i < cloud.size(); ++i)
       if (finite(cloud[i])) {
         slot_[i] = static_cast<int>(pixel_.size());
         pixel_.push_back(i);
+        xyz_.push_back(cloud[i].getVector3fMap());
         u_.push_back(static_cast<int>(i % static_cast<std::size_t>(w_)));
         v_.push_back(static_cast<int>(i / static_cast<std::size_t>(w_)));
-        const float r = (cloud[i].getVector3fMap() - viewpoint).norm();
+        const float r = (xyz_.back() - viewpoint).norm();
         range_.push_back(r);
         float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
         if (noise) // neighbours on one surface differ by the sensor's noise: never a jump
-          gap = std::max(gap, noise->halfWidth(r));
+          gap = std::max(gap, noise_half[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
         gap2_.push_back(gap * gap);
       }
   }
@@ -123,10 +142,10 @@ public:
       return -1;
     return slot_[static_cast<std::size_t>(v) * w_ + u];
   }
-  Eigen::Vector3f
+  const Eigen::Vector3f&
   point(int c) const
   {
-    return cloud_[pixel(c)].getVector3fMap();
+    return xyz_[static_cast<std::size_t>(c)];
   }
   float
   range(int c) const
@@ -162,10 +181,10 @@ public:
   }
 
 private:
-  const pcl::PointCloud<pcl::PointXYZ>& cloud_;
   int w_, h_;
   std::vector<int> slot_;
   std::vector<std::size_t> pixel_;
+  std::vector<Eigen::Vector3f> xyz_; ///< per valid pixel: its point
   std::vector<int> u_, v_;
   std::vector<float> range_, gap2_;
 };
@@ -279,6 +298,8 @@ public:
     size_(static_cast<std::size_t>(count), 0), boundary_(static_cast<std::size_t>(count), 0)
   {
     std::iota(group_.begin(), group_.end(), 0);
+    // The pairs of neighbours across segment borders, then summed per pair of segments.
+    std::vector<std::pair<std::uint64_t, std::uint8_t>> pairs; // (labels, connected)
     for (int i = 0; i < static_cast<int>(grid_.size()); ++i) {
       const int a = label_[static_cast<std::size_t>(i)];
       ++size_[static_cast<std::size_t>(a)];
@@ -289,11 +310,17 @@ public:
           if (b == a)
             return;
           ++boundary_[static_cast<std::size_t>(a)];
-          auto& link = links_[key(a, b)];
-          ++link.all;
-          link.connected += grid_.linked(i, j);
+          pairs.emplace_back(key(a, b), static_cast<std::uint8_t>(grid_.linked(i, j)));
         },
         [&] { ++boundary_[static_cast<std::size_t>(a)]; });
+    }
+    std::sort(pairs.begin(), pairs.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (const auto& [k, connected] : pairs) {
+      if (links_.empty() || links_.back().first != k)
+        links_.emplace_back(k, Link{});
+      ++links_.back().second.all;
+      links_.back().second.connected += connected;
     }
   }
 
@@ -579,7 +606,7 @@ private:
   std::vector<int> label_; ///< per valid pixel
   std::vector<int> group_;
   std::vector<std::size_t> size_, boundary_;
-  std::unordered_map<std::uint64_t, Link> links_;
+  std::vector<std::pair<std::uint64_t, Link>> links_; ///< by pair of labels (key), ascending
 };
 
 } // namespace

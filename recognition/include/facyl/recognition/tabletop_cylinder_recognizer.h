@@ -226,7 +226,7 @@ private:
   usePriorFrameOf(int support);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
    * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
-   * that one, and recognizes the joined objects again. */
+   * that one, which keeps its fit and is classified again as a whole. */
   void
   joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */
@@ -238,11 +238,10 @@ private:
   fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
   Fit
   fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
-  /** Classifies, fits and decides one cluster: one object, or several (the recovery, when \a
-   * recover). */
+  /** Classifies, fits and decides one cluster: one object, or several (recovery). */
   void
   recognizeCluster(TabletopCluster cluster, float p_network,
-                   std::vector<RecognizedObject>& objects, bool recover = true);
+                   std::vector<RecognizedObject>& objects);
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
   std::vector<Fit>

@@ -288,8 +288,9 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
   }
   if (!any)
     return;
+  // The joined object keeps the cylinder fitted to the outer wall and its evidence (the fit
+  // already saw the wall); the classifier judges the whole.
   std::vector<RecognizedObject> kept, joined;
-  std::vector<TabletopCluster> merged;
   for (std::size_t a = 0; a < objects.size(); ++a) {
     if (host[a] >= 0)
       continue;
@@ -297,7 +298,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       kept.push_back(std::move(objects[a]));
       continue;
     }
-    TabletopCluster c = objects[a].cluster;
+    RecognizedObject o = std::move(objects[a]);
+    TabletopCluster& c = o.cluster;
     for (std::size_t b = 0; b < objects.size(); ++b)
       if (host[b] == static_cast<int>(a))
         c.indices.indices.insert(c.indices.indices.end(), objects[b].cluster.indices.indices.begin(),
@@ -309,18 +311,22 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     c.centroid = pts.rowwise().mean();
     c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
                                   : projectedBox(pts, camera_);
-    merged.push_back(std::move(c));
+    joined.push_back(std::move(o));
   }
   PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides or "
             "attachments\n",
-            merged.size());
-  const std::vector<float> p_network = classifyClusters(merged);
-  for (std::size_t k = 0; k < merged.size(); ++k) {
-    const std::size_t first = joined.size();
-    usePriorFrameOf(merged[k].support);
-    recognizeCluster(std::move(merged[k]), p_network[k], joined, false);
-    if (classifier_)
-      applyClassifier(joined, first, p_network[k]);
+            joined.size());
+  if (classifier_) {
+    std::vector<TabletopCluster> views;
+    for (const auto& o : joined)
+      views.push_back(o.cluster);
+    const std::vector<float> p = classifyClusters(views);
+    for (std::size_t k = 0; k < joined.size(); ++k) {
+      auto& e = joined[k].evidence;
+      e.p_network = p[k];
+      e.p_cylinder = classifier_->fuse(e.p_network, e, params_.decision);
+      joined[k].is_cylinder = acceptCylinder(e, params_.decision);
+    }
   }
   objects = std::move(kept);
   for (auto& o : joined)
@@ -390,8 +396,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
 template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, float p_network,
-                                                     std::vector<RecognizedObject>& objects,
-                                                     bool recover)
+                                                     std::vector<RecognizedObject>& objects)
 {
   using Clock = std::chrono::steady_clock;
   const auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -419,7 +424,7 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
   // does not see as a cylinder as a whole, may hold several objects (each part is then
   // classified on its own view).
   const bool doubted = classifier_ && p_network < params_.decision.min_probability;
-  if (recover && params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
+  if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {
@@ -503,15 +508,17 @@ TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluste
   const Eigen::Vector3f a = model.axis.normalized();
   const float d = model.distance_threshold;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
-  std::vector<std::uint8_t> in_cluster; // membership of the cluster's pixels near the inliers
   std::vector<Eigen::Vector3f> near;
-  const std::unordered_set<pcl::index_t> members(cluster.begin(), cluster.end());
+  // The cluster's indices are ascending: membership by binary search.
+  const auto member = [&cluster](pcl::index_t j) {
+    return std::binary_search(cluster.begin(), cluster.end(), j);
+  };
   for (const auto i : model.inliers) {
     const int u0 = static_cast<int>(i % w), v0 = static_cast<int>(i / w);
     for (int v = v0; v < std::min(h, v0 + stride); ++v)
       for (int u = u0; u < std::min(w, u0 + stride); ++u) {
         const auto j = static_cast<pcl::index_t>(v * w + u);
-        if (!members.count(j))
+        if (!member(j))
           continue;
         const Eigen::Vector3f p = (*input_)[j].getVector3fMap();
         const float rho = distanceToLine(p, model.base, a);
