@@ -1,7 +1,8 @@
 /*
  * facyl: fast cylinder detection for PCL.
+ * CylinderTracker, and explicit instantiations of trackerViewOf for the common point types.
  */
-#include <facyl/tracking/cylinder_tracker.h>
+#include <facyl/tracking/impl/cylinder_tracker.hpp>
 
 #include <pcl/console/print.h>
 
@@ -931,3 +932,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
 }
 
 } // namespace facyl
+
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZ)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGBA)
