@@ -463,6 +463,30 @@ TEST(CylinderTracker, FramesWithoutSupportOrFailedKeepTheTracks)
   EXPECT_EQ(tracker.getFrameInfo().frame, 14u);
 }
 
+TEST(CylinderTracker, UnanchoredStreamDoesNotPileUpTentativeTracks)
+{
+  // A long stream without any support (a moving camera, no table: nothing to anchor on) whose
+  // objects are somewhere else in every frame: each frame's new tracks are tentative and end
+  // when the next frame does not see them again, so the tracks stay as many as one frame's
+  // objects.
+  facyl::Random rng(13);
+  facyl::CylinderTracker tracker;
+  for (int k = 0; k < 50; ++k) {
+    std::vector<facyl::RecognizedObject> objects(5);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      auto& o = objects[i];
+      o.cluster.support = -1;
+      o.cluster.indices.indices.resize(800);
+      o.cluster.centroid = Eigen::Vector3f(rng.uniform(-2.f, 2.f), rng.uniform(-2.f, 2.f),
+                                           rng.uniform(1.f, 4.f));
+      o.evidence.p_cylinder = 0.3f;
+    }
+    ASSERT_TRUE(tracker.update({}, -1, objects));
+    EXPECT_FALSE(tracker.getFrameInfo().anchored);
+    EXPECT_LE(tracker.getTracks().size(), 2 * objects.size()) << "frame " << k;
+  }
+}
+
 TEST(CylinderTracker, SplitSegmentsAreFragmentsOfOneTrack)
 {
   // For three frames the recognizer reports a cylinder as two segments (its fit, and a piece

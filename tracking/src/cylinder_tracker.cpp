@@ -825,7 +825,12 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       continue;
     auto& t = tracks_[j];
     if (!info.anchored) {
-      t.status = TrackStatus::NotUpdated; // the frame cannot tell: nobody's misses count
+      // The frame cannot tell where it is: confirmed tracks' misses do not count. A tentative
+      // track must be seen again, anchored or not (else a stream without a support would pile
+      // up every frame's objects as tracks).
+      t.status = TrackStatus::NotUpdated;
+      if (!t.confirmed)
+        ++t.misses;
       continue;
     }
     int inside = -1;

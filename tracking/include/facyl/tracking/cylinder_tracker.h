@@ -248,7 +248,8 @@ struct TrackerFrameInfo {
  *   the sensor sees through its place (taken away). An object near one matched in the same
  *   frame is a fragment of it (a split) and starts no track.
  * - A frame without a support (no supports, objects with support -1) keeps the previous pose:
- *   its objects are matched and filtered with less weight, and nobody's misses count.
+ *   its objects are matched and filtered with less weight, and no confirmed track's misses
+ *   count (a tentative one unmatched ends, as in any frame).
  * - skipFrame() for a frame that could not be processed: nothing changes but the frame count.
  * - A frame whose support does not continue the tracks' plane and whose objects do not match
  *   them, or one that matches too few of the tracks expected in view (min_overlap), starts a
