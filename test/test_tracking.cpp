@@ -373,6 +373,32 @@ TEST(CylinderTracker, IdsStayUnderCameraMotionAndReanchoring)
   }
 }
 
+TEST(CylinderTracker, LoopedRecordingKeepsTheIds)
+{
+  // A recording played in a loop: the camera turns 0.15 rad a frame for 5 frames, then jumps
+  // back to where it started. The velocity predicts the path going on; the jump back is found
+  // from the last pose instead: the same scene, the same ids.
+  SyntheticTable table;
+  table.step = 0.15f;
+  facyl::CylinderTracker tracker;
+  std::map<std::size_t, int> first_id;
+  for (int k = 0; k < 10; ++k) {
+    const int f = k % 5;
+    const auto objects = table.objects(f);
+    ASSERT_TRUE(tracker.update(table.supports(f), 0, objects));
+    EXPECT_FALSE(tracker.getFrameInfo().new_scene) << "frame " << k;
+    if (k < 2)
+      continue;
+    for (std::size_t i = 0; i < table.items.size(); ++i) {
+      const int id = idNear(tracker, objects, table.camera(f), table.items[i].base);
+      if (k == 2)
+        first_id[i] = id;
+      else
+        EXPECT_EQ(id, first_id[i]) << "frame " << k << " object " << i;
+    }
+  }
+}
+
 TEST(CylinderTracker, OneFrameFalsePositiveIsNeverConfirmed)
 {
   SyntheticTable table;

@@ -661,8 +661,22 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
           candidates.push_back(c);
         }
       }
-      const PlanarRegistration reg =
+      PlanarRegistration reg =
         registerInPlane(from, to, candidates, prior, params_.registration, from_axes, to_axes);
+      // The camera's velocity predicts a smooth path; when it jumped instead (back to where it
+      // was: a looped recording, a dropped run of frames) and the prediction matched fewer than
+      // half of the objects, the last frame's pose is tried as the prior too, and the one that
+      // matches more objects is kept.
+      std::size_t valid = 0;
+      for (const auto& o : local)
+        valid += o.valid;
+      if (has_velocity_ && 2 * reg.matched_objects < valid) {
+        const PlanarRegistration still =
+          registerInPlane(from, to, candidates, inPlaneComponent(last_pose * plane_to_cloud),
+                          params_.registration, from_axes, to_axes);
+        if (still.matched_objects > reg.matched_objects)
+          reg = still;
+      }
       pose = reg.transform.asAffine() * cloud_to_plane;
       info.registration = reg.transform;
       info.registered = reg.matched_objects;
