@@ -4,7 +4,10 @@
  */
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
+#include <facyl/segmentation/tabletop_geometry.h>
 #include <facyl/simulation/cylinder_simulation.h>
+#include <facyl/simulation/random.h>
+#include <facyl/tracking/cylinder_tracker.h>
 
 #include <pcl/common/io.h>
 #include <pcl/features/normal_3d.h>
@@ -155,6 +158,93 @@ BM_PclRansac(benchmark::State& state)
   }
 }
 BENCHMARK(BM_PclRansac)->Arg(900)->Unit(benchmark::kMillisecond);
+
+/** What the recognizer reports of a table with \a n objects (three in four cylinders), seen by a
+ * camera swinging back and forth around it: the frames a tracker gets, with the sensor's view
+ * (intrinsics, and the depth of an empty table: every unmatched track is tested). */
+struct TrackerStream {
+  std::vector<std::vector<facyl::SupportPlane>> supports;
+  std::vector<std::vector<facyl::RecognizedObject>> objects;
+  std::vector<facyl::TrackerView> views;
+};
+
+TrackerStream
+makeTrackerStream(int n, int frames)
+{
+  TrackerStream s;
+  facyl::Random rng(17);
+  std::vector<Eigen::Vector3f> places;
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  for (int i = 0; i < n; ++i)
+    places.emplace_back(0.12f * static_cast<float>(i % side - side / 2),
+                        0.12f * static_cast<float>(i / side - side / 2), 0.f);
+  const facyl::PinholeCamera cam{525.f, 525.f, 319.5f, 239.5f, 640, 480};
+  for (int k = 0; k < frames; ++k) {
+    const float az = 0.6f * std::sin(6.2832f * static_cast<float>(k) / static_cast<float>(frames));
+    const Eigen::Vector3f eye =
+      1.2f * Eigen::Vector3f(std::sin(az) * 0.7f, -std::cos(az) * 0.7f, 0.71f);
+    Eigen::Affine3f pose = Eigen::Affine3f::Identity(); // camera to world
+    const Eigen::Vector3f f = (-eye).normalized();
+    const Eigen::Vector3f right = f.cross(Eigen::Vector3f::UnitZ()).normalized();
+    pose.linear().col(0) = right;
+    pose.linear().col(1) = f.cross(right);
+    pose.linear().col(2) = f;
+    pose.translation() = eye;
+    const Eigen::Affine3f to_camera = pose.inverse();
+    facyl::SupportPlane support;
+    support.plane.head<3>() = to_camera.linear() * Eigen::Vector3f::UnitZ();
+    support.plane[3] = -support.plane.head<3>().dot(to_camera * Eigen::Vector3f::Zero());
+    support.frame = facyl::planeFrame(support.plane, to_camera * Eigen::Vector3f(rng.uniform(-0.1f, 0.1f), 0.f, 0.f));
+    s.supports.push_back({support});
+    std::vector<facyl::RecognizedObject> objects;
+    for (int i = 0; i < n; ++i) {
+      if (rng.chance(0.1)) // missed now and then
+        continue;
+      facyl::RecognizedObject o;
+      o.cluster.support = 0;
+      o.cluster.indices.indices.resize(1000);
+      const Eigen::Vector3f jitter(0.002f * rng.normal(), 0.002f * rng.normal(), 0.f);
+      if (i % 4 != 3) {
+        o.is_cylinder = o.evidence.fitted = true;
+        o.cylinder.base = to_camera * (places[static_cast<std::size_t>(i)] + jitter);
+        o.cylinder.top = to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.1f));
+        o.cylinder.point_on_axis = o.cylinder.base;
+        o.cylinder.axis = (o.cylinder.top - o.cylinder.base).normalized();
+        o.cylinder.radius = 0.03f * (1.f + 0.02f * rng.normal());
+        o.cylinder.angular_coverage = 0.4f;
+      }
+      o.cluster.centroid = to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.05f));
+      objects.push_back(o);
+    }
+    s.objects.push_back(std::move(objects));
+    facyl::TrackerView view;
+    view.camera = cam;
+    view.depth = [pose, cam](int u, int v) {
+      const Eigen::Vector3f w = pose.linear() * Eigen::Vector3f((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.f);
+      return -pose.translation().z() / w.z();
+    };
+    s.views.push_back(view);
+  }
+  return s;
+}
+
+/** CylinderTracker::update per frame: re-anchoring (registration), association, filtering
+ * and the view tests of the tracks not seen, for a table of N objects. */
+void
+BM_TrackerUpdate(benchmark::State& state)
+{
+  const int n = static_cast<int>(state.range(0));
+  const TrackerStream s = makeTrackerStream(n, 60);
+  facyl::CylinderTracker tracker;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    tracker.update(s.supports[k], 0, s.objects[k], s.views[k]);
+    benchmark::DoNotOptimize(tracker.getTracks().data());
+    k = (k + 1) % s.objects.size();
+  }
+  state.counters["tracks"] = static_cast<double>(tracker.getTracks().size());
+}
+BENCHMARK(BM_TrackerUpdate)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMicrosecond);
 
 } // namespace
 

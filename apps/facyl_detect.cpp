@@ -6,9 +6,11 @@
 #include "detect_json.h"
 #include "pcd_input.h"
 #include "recognizer_options.h"
+#include "track_json.h"
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/simulation/frame_roll.h>
+#include <facyl/tracking/cylinder_tracker.h>
 
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
@@ -22,6 +24,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 namespace {
@@ -50,6 +53,18 @@ printHelp(const char* self)
     "  --roll DEG             each frame as a camera rolled by DEG (90, 180, 270) clockwise\n"
     "                         about its optical axis would have taken it (organized frames;\n"
     "                         boxes and overlays are in the rolled image)\n"
+    "Streams:\n"
+    "  --track                the scenes, in the order given, are one stream (frames of a\n"
+    "                         camera moving over a static table): objects are tracked\n"
+    "                         (facyl::CylinderTracker). Each object gets \"track_id\" (an\n"
+    "                         integer, stable across frames), \"is_cylinder\" and \"cylinder\"\n"
+    "                         become the track's decision and filtered estimate (in this\n"
+    "                         frame), \"is_cylinder_frame\" and \"cylinder_frame\" the frame's\n"
+    "                         own; each line adds \"stream\" and \"tracks\" (every live track).\n"
+    "                         A frame that fails (its line has \"error\") does not end the\n"
+    "                         stream; frames of a new scene start new tracks. docs/tracking.md\n"
+    "  --track-confirm-hits N frames a new track must be seen in to be confirmed (default 2)\n"
+    "  --track-max-misses N   missed frames a confirmed track survives (default 5)\n"
     "%s"
     "Exit status: 0 all scenes processed (warnings, e.g. no overlay for an unorganized cloud\n"
     "without --camera, go to standard error and do not change it), 1 a scene failed or an\n"
@@ -138,6 +153,14 @@ struct Settings {
   bool verbose{false}; ///< --verbose: PCL's debug messages (what the segmentation found)
   int roll{0};         ///< --roll: quarter turns of the camera about its optical axis
   facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
+  bool track{false};   ///< --track: the scenes are one stream
+  facyl::CylinderTrackerParameters tracking;
+};
+
+/** --track: the stream's tracker and what its frames looked like. */
+struct Stream {
+  facyl::CylinderTracker tracker;
+  std::uint32_t width{0}, height{0}; ///< the first organized frame's size
 };
 
 /** Camera for drawing: given, or estimated from an organized cloud (every 17th pixel). */
@@ -251,11 +274,15 @@ saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud
 
 bool
 processScene(const std::string& file, const std::string& name, const Settings& s,
-             std::ostream& out)
+             std::ostream& out, Stream* stream)
 {
   auto fail = [&](const std::string& why) {
-    out << "{\"file\":" << facyl_cli::quote(file) << ",\"error\":" << facyl_cli::quote(why) << "}"
-        << std::endl;
+    out << "{\"file\":" << facyl_cli::quote(file) << ",\"error\":" << facyl_cli::quote(why);
+    if (stream) { // the stream goes on: nothing is known of this frame, the tracks are kept
+      stream->tracker.skipFrame();
+      out << facyl_cli::streamJson(stream->tracker, nullptr);
+    }
+    out << "}" << std::endl;
     return false;
   };
   pcl::PCLPointCloud2 blob;
@@ -294,11 +321,29 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   // Median over the repetitions, by total.
   std::sort(timings.begin(), timings.end(),
             [](const auto& a, const auto& b) { return a.total < b.total; });
-  out << facyl_cli::sceneJson(file, *cloud, rec, objects, timings[timings.size() / 2]);
+  std::string warning, error;
+  if (stream) {
+    // Frames of another size are no error (the tracks are in the table's frame), but worth a
+    // word: a stream usually comes from one sensor.
+    if (cloud->isOrganized()) {
+      if (stream->width == 0) {
+        stream->width = cloud->width;
+        stream->height = cloud->height;
+      }
+      else if (cloud->width != stream->width || cloud->height != stream->height)
+        warning = "frame of " + std::to_string(cloud->width) + "x" + std::to_string(cloud->height) +
+                  " pixels in a stream of " + std::to_string(stream->width) + "x" +
+                  std::to_string(stream->height) + ": tracked on (the tracks are kept)";
+    }
+    stream->tracker.update(rec, objects);
+    out << facyl_cli::trackedSceneJson(file, *cloud, rec, objects, timings[timings.size() / 2],
+                                       stream->tracker);
+  }
+  else
+    out << facyl_cli::sceneJson(file, *cloud, rec, objects, timings[timings.size() / 2]);
 
   // Outputs: a warning (no overlay possible) goes to standard error and keeps the status; an
   // output that could not be written is an error of the scene.
-  std::string warning, error;
   if (!s.overlay.empty()) {
     const std::string path =
       s.many ? (std::filesystem::path(s.overlay) / (name + ".png")).string() : s.overlay;
@@ -306,7 +351,7 @@ processScene(const std::string& file, const std::string& name, const Settings& s
     if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects, why))
       error = why;
     else if (!why.empty())
-      warning = why;
+      warning += (warning.empty() ? "" : "; ") + why;
   }
   if (!s.clusters_dir.empty() && error.empty())
     error = saveClusters(s.clusters_dir, name, *cloud, has_colour, objects);
@@ -381,8 +426,9 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   const facyl_cli::Arguments args(
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll"}),
-    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose"}),
+                      {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll",
+                       "--track-confirm-hits", "--track-max-misses"}),
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose", "--track"}),
     facyl_cli::recognizerAliases());
   files = args.positional();
   if (files.empty())
@@ -410,6 +456,11 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
     throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
   s.roll = static_cast<int>(roll / 90);
   s.verbose = args.has("--verbose");
+  s.track = args.has("--track");
+  if (!s.track && (args.has("--track-confirm-hits") || args.has("--track-max-misses")))
+    throw std::invalid_argument("--track-confirm-hits and --track-max-misses need --track");
+  s.tracking.confirm_hits = static_cast<int>(args.integer("--track-confirm-hits", s.tracking.confirm_hits, 1, 100));
+  s.tracking.max_misses = static_cast<int>(args.integer("--track-max-misses", s.tracking.max_misses, 1, 1000));
   s.many = files.size() > 1;
   checkOutputs(s, files, args.text("--model", ""));
   return s;
@@ -435,16 +486,26 @@ main(int argc, char** argv)
   // errors that explain a failed scene stay.
   pcl::console::setVerbosityLevel(s.verbose ? pcl::console::L_DEBUG : pcl::console::L_ERROR);
   const std::vector<std::string> names = outputNames(files);
+  std::unique_ptr<Stream> stream;
+  if (s.track) {
+    stream = std::make_unique<Stream>();
+    stream->tracker.setParameters(s.tracking);
+    stream->tracker.setCamera(s.camera);
+  }
   bool all_ok = true;
   for (std::size_t k = 0; k < files.size(); ++k) {
     bool ok = false;
     try {
-      ok = processScene(files[k], names[k], s, std::cout);
+      ok = processScene(files[k], names[k], s, std::cout, stream.get());
     }
     catch (const std::exception& e) { // e.g. std::bad_alloc: this scene fails, the batch goes on
       std::cout << "{\"file\":" << facyl_cli::quote(files[k]) << ",\"error\":"
-                << facyl_cli::quote(std::string("unexpected failure: ") + e.what()) << "}"
-                << std::endl;
+                << facyl_cli::quote(std::string("unexpected failure: ") + e.what());
+      if (stream) {
+        stream->tracker.skipFrame();
+        std::cout << facyl_cli::streamJson(stream->tracker, nullptr);
+      }
+      std::cout << "}" << std::endl;
     }
     all_ok = ok && all_ok;
   }

@@ -11,6 +11,7 @@
 #include "scene_options.h"
 
 #include <facyl/simulation/tabletop_scene.h>
+#include <facyl/simulation/tabletop_sequence.h>
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/png_io.h>
@@ -48,6 +49,17 @@ printHelp(const char* self)
     "  --noise K          axial depth noise sigma = K z^2 (default: the sensor's; not with\n"
     "                     --sensor random)\n"
     "  --no-quantisation  no disparity quantisation (not with --sensor random)\n"
+    "  --sequence N       a stream of N frames (2..100000) instead of one: the camera moves\n"
+    "                     along a smooth path around the static scene (an orbit about the\n"
+    "                     point it looks at, slow changes of elevation and distance), so\n"
+    "                     objects occlude each other and leave or enter the view; writes\n"
+    "                     PREFIX_fNNNN.* per frame (PREFIX_SSSS_fNNNN.* with --count) and\n"
+    "                     PREFIX_sequence.json (camera pose and object ids present per frame;\n"
+    "                     object ids are the same in every frame's _ids.png and .json)\n"
+    "  --orbit RAD        --sequence: how far the camera turns over the sequence, in\n"
+    "                     [0, 6.3] (default 0.9)\n"
+    "  --change C         --sequence: none (default) | remove (an object is taken away\n"
+    "                     half-way) | add (an object is put down half-way)\n"
     "%s"
     "Class codes in PREFIX_class.png: 0 background, 1 table, 2 cylinder, 3 box, 4 sphere,\n"
     "5 cone, 6 bowl, 7 scenery (far furniture, robots: ids 1000+ in PREFIX_ids.png).\n"
@@ -73,6 +85,69 @@ checkPrefix(const std::string& prefix)
     throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
 }
 
+/** Writes one rendered frame as NAME.pcd, NAME_rgb.png, NAME_ids.png, NAME_class.png and
+ * NAME.json. \return false when NAME.pcd or NAME.json could not be written. */
+bool
+writeFrame(const std::string& name, const facyl::RenderedScene& scene)
+{
+  const int w = scene.camera.width, h = scene.camera.height;
+  std::vector<unsigned char> classes(scene.pixel_class.size());
+  for (std::size_t i = 0; i < classes.size(); ++i)
+    classes[i] = static_cast<unsigned char>(scene.pixel_class[i]);
+  const std::string json = facyl::groundTruthJson(scene);
+  std::ofstream js(name + ".json");
+  js << json << "\n";
+  if (pcl::io::savePCDFileBinaryCompressed(name + ".pcd", scene.cloud) < 0 || !js) {
+    std::fprintf(stderr, "facyl_synth: cannot write %s.pcd/.json\n", name.c_str());
+    return false;
+  }
+  std::vector<unsigned char> rgb(3 * scene.cloud.size());
+  for (std::size_t i = 0; i < scene.cloud.size(); ++i) {
+    rgb[3 * i] = scene.cloud[i].r;
+    rgb[3 * i + 1] = scene.cloud[i].g;
+    rgb[3 * i + 2] = scene.cloud[i].b;
+  }
+  pcl::io::saveRgbPNGFile(name + "_rgb.png", rgb.data(), w, h);
+  pcl::io::saveShortPNGFile(name + "_ids.png", scene.object_id.data(), w, h, 1);
+  pcl::io::saveCharPNGFile(name + "_class.png", classes.data(), w, h, 1);
+  return true;
+}
+
+/** --sequence: the frames of one sequence and its PREFIX_sequence.json. \return false when a
+ * file could not be written. */
+bool
+writeSequence(const std::string& name, const facyl::TabletopSceneParameters& p,
+              const facyl::TabletopSequenceParameters& sp)
+{
+  facyl::TabletopSceneParameters scene_params = p;
+  if (p.sensor.randomize) { // one sensor for the whole stream, drawn from the seed
+    const facyl::DrawnSensor drawn = facyl::drawSensor(p.camera, p.seed);
+    scene_params.sensor = drawn.sensor;
+    scene_params.camera = drawn.camera;
+  }
+  const facyl::TabletopSequence seq = facyl::generateTabletopSequence(scene_params, sp);
+  std::ofstream js(name + "_sequence.json");
+  js << facyl::sequenceJson(seq) << "\n";
+  if (!js) {
+    std::fprintf(stderr, "facyl_synth: cannot write %s_sequence.json\n", name.c_str());
+    return false;
+  }
+  for (std::size_t k = 0; k < seq.cameras.size(); ++k) {
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, "_f%04zu", k);
+    const facyl::RenderedScene frame = facyl::renderSequenceFrame(
+      seq, k, scene_params.camera, scene_params.sensor, facyl::sequenceFrameSeed(p.seed, k));
+    if (!writeFrame(name + suffix, frame))
+      return false;
+    std::size_t present = 0;
+    for (std::size_t i = 0; i < seq.scene.objects.size(); ++i)
+      present += seq.present(i, k);
+    std::cout << "{\"file\":" << facyl_cli::quote(name + suffix + ".pcd") << ",\"seed\":" << p.seed
+              << ",\"frame\":" << k << ",\"objects\":" << present << "}" << std::endl;
+  }
+  return true;
+}
+
 } // namespace
 
 int
@@ -83,12 +158,15 @@ main(int argc, char** argv)
   facyl::TabletopSceneParameters p;
   std::string prefix;
   std::size_t count = 1;
+  facyl::TabletopSequenceParameters sequence;
+  bool stream = false;
   try {
     const facyl_cli::Arguments args(
       argc, argv,
       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                         {"--seed", "--count", "--objects", "--cylinder-share", "--lying-share",
-                         "--noise", "--layout", "--sensor"}),
+                         "--noise", "--layout", "--sensor", "--sequence", "--orbit",
+                         "--change"}),
       {"--no-quantisation"});
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
@@ -120,6 +198,18 @@ main(int argc, char** argv)
     const std::string why = facyl::validate(p);
     if (!why.empty())
       throw std::invalid_argument(why);
+    stream = args.has("--sequence");
+    if (!stream && (args.has("--orbit") || args.has("--change")))
+      throw std::invalid_argument("--orbit and --change need --sequence N");
+    if (stream) {
+      sequence.frames = static_cast<std::size_t>(args.integer("--sequence", 30, 2, 100000));
+      sequence.orbit = static_cast<float>(args.number("--orbit", sequence.orbit, 0.0, 6.3));
+      if (!facyl::parseSequenceChange(args.text("--change", "none"), sequence.change))
+        throw std::invalid_argument("--change must be none, remove or add");
+      const std::string bad = facyl::validate(sequence);
+      if (!bad.empty())
+        throw std::invalid_argument(bad);
+    }
   }
   catch (const std::exception& e) {
     std::fprintf(stderr, "facyl_synth: %s\n", e.what());
@@ -134,27 +224,14 @@ main(int argc, char** argv)
       std::snprintf(suffix, sizeof suffix, "_%04zu", k);
       name += suffix;
     }
+    if (stream) {
+      if (!writeSequence(name, p, sequence))
+        return 1;
+      continue;
+    }
     const facyl::RenderedScene scene = facyl::simulateTabletopScene(p);
-    const int w = scene.camera.width, h = scene.camera.height;
-    std::vector<unsigned char> classes(scene.pixel_class.size());
-    for (std::size_t i = 0; i < classes.size(); ++i)
-      classes[i] = static_cast<unsigned char>(scene.pixel_class[i]);
-    const std::string json = facyl::groundTruthJson(scene);
-    std::ofstream js(name + ".json");
-    js << json << "\n";
-    if (pcl::io::savePCDFileBinaryCompressed(name + ".pcd", scene.cloud) < 0 || !js) {
-      std::fprintf(stderr, "facyl_synth: cannot write %s.pcd/.json\n", name.c_str());
+    if (!writeFrame(name, scene))
       return 1;
-    }
-    std::vector<unsigned char> rgb(3 * scene.cloud.size());
-    for (std::size_t i = 0; i < scene.cloud.size(); ++i) {
-      rgb[3 * i] = scene.cloud[i].r;
-      rgb[3 * i + 1] = scene.cloud[i].g;
-      rgb[3 * i + 2] = scene.cloud[i].b;
-    }
-    pcl::io::saveRgbPNGFile(name + "_rgb.png", rgb.data(), w, h);
-    pcl::io::saveShortPNGFile(name + "_ids.png", scene.object_id.data(), w, h, 1);
-    pcl::io::saveCharPNGFile(name + "_class.png", classes.data(), w, h, 1);
     std::size_t cylinders = 0;
     for (const auto& o : scene.scene.objects)
       cylinders += o.cls == facyl::SceneClass::Cylinder;

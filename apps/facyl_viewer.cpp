@@ -8,6 +8,7 @@
  */
 #include "cli.h"
 #include "cylinder_fit.h"
+#include "frame_stream.h"
 #include "json_value.h"
 #include "pcd_input.h"
 #include "pcl_baseline.h"
@@ -18,6 +19,7 @@
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 #include <facyl/sample_consensus_alt/orientation_accumulator.h>
+#include <facyl/tracking/cylinder_tracker.h>
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/common/common.h>
@@ -53,8 +55,23 @@ printHelp(const char* self)
 {
   std::printf(
     "Usage: %s [options] SCENE.pcd...\n"
+    "       %s --stream SOURCE [--rate FPS] [--loop] [--frames N] [options]\n"
     "Shows each cloud with its table and cylinders (green: accepted, finite from base to top;\n"
     "red boxes: objects that are not cylinders; a label per object).\n"
+    "  --stream SOURCE       a stream, tracked live (facyl::CylinderTracker): SOURCE is a\n"
+    "                        folder of PCD frames played in name order by pcl::PCDGrabber,\n"
+    "                        or openni2 / openni2:DEVICE (pcl::io::OpenNI2Grabber, when PCL\n"
+    "                        has OpenNI2 and a device is present). Each track is drawn in its\n"
+    "                        own colour with its id (\"#7\"): confirmed cylinders as meshes\n"
+    "                        (faint while hidden or missed), other objects as boxes. One JSON\n"
+    "                        line per frame on standard output: its tracks and their ids.\n"
+    "                        Unreadable frames are skipped with a message; the tracks are kept\n"
+    "  --rate FPS            --stream of PCD frames: play at FPS frames per second (frames\n"
+    "                        that arrive while one is processed are dropped, as from a\n"
+    "                        sensor); 0 (default): every frame, as fast as processed\n"
+    "  --loop                --stream of PCD frames: start again after the last\n"
+    "  --frames N            --stream: stop after N frames (with --screenshot: the last one\n"
+    "                        is rendered)\n"
     "  --detect              run the recognizer (default unless --detections)\n"
     "  --detections F.jsonl  show facyl_detect's output instead (one JSON line per scene,\n"
     "                        matched by \"file\", else by order)\n"
@@ -79,8 +96,8 @@ printHelp(const char* self)
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
     "l labels.\n%s"
     "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage (nothing written).\n",
-    self, kOrientations, kDefaultWidth, kDefaultHeight, facyl_cli::recognizerOptionsHelp(),
-    facyl_cli::commonHelp());
+    self, self, kOrientations, kDefaultWidth, kDefaultHeight,
+    facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
 }
 
 // ------------------------------------------------------------------------------- scene
@@ -115,6 +132,10 @@ struct Settings {
   std::string screenshot;
   int width{kDefaultWidth}, height{kDefaultHeight};
   facyl::ShapeClassifier::Ptr classifier;
+  std::string stream;     ///< --stream SOURCE
+  float rate{0.f};        ///< --rate
+  bool loop{false};       ///< --loop
+  long long frames{0};    ///< --frames; 0: all
 };
 
 /** The file as an XYZRGBA cloud (grey without colour). \throws std::runtime_error. */
@@ -706,19 +727,241 @@ private:
   mutable bool lines_loaded_{false};
 };
 
+// ------------------------------------------------------------------------------- streams
+
+/** A colour of its own for each track id (golden-ratio hues). */
+std::array<double, 3>
+trackColour(int id)
+{
+  const double h = std::fmod(0.13 + 0.618034 * id, 1.0) * 6.0;
+  const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
+  const int sector = static_cast<int>(h);
+  const std::array<std::array<double, 3>, 6> rgb{{{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}}};
+  auto c = rgb[static_cast<std::size_t>(sector % 6)];
+  for (auto& v : c)
+    v = 0.25 + 0.75 * v;
+  return c;
+}
+
+/** One frame of --stream: the cloud, the table, every confirmed track in its colour with its
+ * id (cylinders as meshes, faint when the frame did not see them; other objects as the box of
+ * their points), tentative ones as thin boxes. */
+void
+drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cloud,
+            const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
+            const std::vector<facyl::RecognizedObject>& objects,
+            const facyl::CylinderTracker& tracker, const std::string& title, const Layers& layers)
+{
+  viewer.removeAllPointClouds();
+  viewer.removeAllShapes();
+  const Cloud::ConstPtr drawn = drawnCloud(*cloud);
+  pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(drawn);
+  viewer.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud");
+  if (layers.table) {
+    Scene scene;
+    scene.table_outline = tableOutline(rec);
+    drawTable(viewer, scene, "s_", 0);
+  }
+  for (const auto& t : tracker.getTracks()) {
+    const auto c = trackColour(t.id);
+    const std::string id = "t" + std::to_string(t.id);
+    const bool seen = t.status == facyl::TrackStatus::Seen;
+    Eigen::Vector3f label_at = tracker.centroidInFrame(t);
+    std::string label;
+    char buf[160];
+    if (tracker.isCylinder(t)) {
+      const facyl::CylinderModel m = tracker.cylinderInFrame(t);
+      if (layers.cylinders) {
+        drawCylinder(viewer, m, id + "_cyl", 0, c[0], c[1], c[2]);
+        viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY,
+                                                seen ? 0.85 : 0.3, id + "_cyl", 0);
+      }
+      std::snprintf(buf, sizeof buf, "#%d r=%.1fmm h=%.1fmm p=%.2f%s", t.id, m.radius * 1e3f,
+                    m.height * 1e3f, t.pCylinder(), seen ? "" : (" " + facyl::toString(t.status)).c_str());
+      label_at = m.top;
+    }
+    else if (seen && t.object >= 0 && static_cast<std::size_t>(t.object) < objects.size()) {
+      ViewObject o;
+      boxOf(*cloud, objects[static_cast<std::size_t>(t.object)].cluster.indices.indices, o);
+      if (layers.boxes) {
+        viewer.addCube(o.box_min.x(), o.box_max.x(), o.box_min.y(), o.box_max.y(), o.box_min.z(),
+                       o.box_max.z(), c[0], c[1], c[2], id + "_box");
+        viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
+                                           pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME,
+                                           id + "_box");
+        viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH,
+                                           t.confirmed ? 2 : 1, id + "_box");
+      }
+      std::snprintf(buf, sizeof buf, "#%d%s", t.id, t.confirmed ? "" : " (new)");
+      label_at = o.box_min;
+    }
+    else
+      continue;
+    label = buf;
+    if (layers.labels)
+      viewer.addText3D(label, pcl::PointXYZ(label_at.x(), label_at.y(), label_at.z()), 0.008, c[0],
+                       c[1], c[2], id + "_label");
+  }
+  viewer.addText(title, 10, 10, 14, 0.8, 0.8, 0.8, "title");
+}
+
+/** The frame's tracks as one JSON line: {"frame", "file", "objects", "tracks": [{"track_id",
+ * "confirmed", "is_cylinder", "status", "object"}]}, or {"frame", "file", "error"}. */
+std::string
+streamLine(std::size_t frame, const std::string& file, const facyl::CylinderTracker* tracker,
+           std::size_t objects, const std::string& error = {})
+{
+  std::string out = "{\"frame\":" + std::to_string(frame) + ",\"file\":" + facyl_cli::quote(file);
+  if (!error.empty())
+    return out + ",\"error\":" + facyl_cli::quote(error) + "}";
+  out += ",\"objects\":" + std::to_string(objects) + ",\"tracks\":[";
+  bool first = true;
+  for (const auto& t : tracker->getTracks()) {
+    out += std::string(first ? "" : ",") + "{\"track_id\":" + std::to_string(t.id) +
+           ",\"confirmed\":" + (t.confirmed ? "true" : "false") +
+           ",\"is_cylinder\":" + (tracker->isCylinder(t) ? "true" : "false") + ",\"status\":\"" +
+           facyl::toString(t.status) + "\",\"object\":" +
+           (t.object >= 0 ? std::to_string(t.object) : "null") + "}";
+    first = false;
+  }
+  return out + "]}";
+}
+
+/** --stream: frames from a grabber, recognized and tracked, drawn as they come. */
+int
+runStream(const Settings& s)
+{
+  facyl_cli::FrameStream stream(s.stream, s.rate, s.loop);
+  for (const auto& r : stream.rejected())
+    std::fprintf(stderr, "facyl_viewer: %s: left out of the stream\n", r.c_str());
+  pcl::visualization::PCLVisualizer viewer("facyl_viewer: " + stream.description());
+  viewer.setSize(s.width, s.height);
+  viewer.setBackgroundColor(0.05, 0.05, 0.08);
+  viewer.setShowFPS(false);
+  Layers layers;
+  bool redraw = false;
+  viewer.registerKeyboardCallback([&](const pcl::visualization::KeyboardEvent& e) {
+    if (!e.keyDown())
+      return;
+    const std::string key = e.getKeySym();
+    bool* layer = key == "t" ? &layers.table : key == "c" ? &layers.cylinders
+                  : key == "b" ? &layers.boxes : key == "l" ? &layers.labels : nullptr;
+    if (layer) {
+      *layer = !*layer;
+      redraw = true;
+    }
+  });
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setParameters(s.params);
+  rec.setUpDirection(s.up);
+  rec.setClassifier(s.classifier);
+  facyl::CylinderTracker tracker;
+  std::vector<facyl::RecognizedObject> objects;
+  Cloud::ConstPtr shown;
+  std::string title;
+  std::size_t processed = 0, number = 0;
+  while (!viewer.wasStopped() && !(s.frames > 0 && static_cast<long long>(processed) >= s.frames)) {
+    facyl_cli::StreamFrame frame;
+    if (!stream.next(frame, 0.05)) {
+      if (stream.timedOut()) { // a live source between frames
+        viewer.spinOnce(20);
+        continue;
+      }
+      break; // the end of the frames
+    }
+    for (const auto& why : frame.skipped) { // unreadable: nothing known, the tracks are kept
+      std::fprintf(stderr, "facyl_viewer: %s\n", why.c_str());
+      tracker.skipFrame();
+      std::cout << streamLine(number++, why.substr(0, why.find(": ")), nullptr, 0,
+                              "PCL's reader could not read it")
+                << std::endl;
+    }
+    const Cloud::ConstPtr& cloud = frame.cloud;
+    std::string error;
+    if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))
+      error = "the cloud has no finite point";
+    else {
+      rec.setInputCloud(cloud);
+      if (!rec.recognize(objects))
+        error = "recognition failed (see the message above)";
+    }
+    if (!error.empty()) {
+      tracker.skipFrame();
+      std::fprintf(stderr, "facyl_viewer: %s: %s (the tracks are kept)\n", frame.name.c_str(),
+                   error.c_str());
+      std::cout << streamLine(number++, frame.name, nullptr, 0, error) << std::endl;
+      ++processed;
+      continue;
+    }
+    tracker.update(rec, objects);
+    std::cout << streamLine(number++, frame.name, &tracker, objects.size()) << std::endl;
+    title = frame.name + "  (frame " + std::to_string(frame.index) + ", " +
+            std::to_string(tracker.getTracks().size()) + " tracks)";
+    drawTracked(viewer, cloud, rec, objects, tracker, title, layers);
+    if (!shown)
+      sensorCamera(viewer, *cloud, 0); // the sensor's view once; the user may move it then
+    shown = cloud;
+    ++processed;
+    viewer.spinOnce(1, true);
+  }
+  if (stream.dropped() > 0)
+    std::fprintf(stderr, "facyl_viewer: %zu frames arrived while one was processed and were "
+                         "dropped\n", stream.dropped());
+  if (!shown) {
+    std::fprintf(stderr, "facyl_viewer: --stream %s: no frame could be shown\n", s.stream.c_str());
+    return 1;
+  }
+  if (!s.screenshot.empty()) {
+    viewer.spinOnce(1, true);
+    viewer.saveScreenshot(s.screenshot);
+    std::printf("{\"stream\":%s,\"frames\":%zu,\"screenshot\":%s}\n",
+                facyl_cli::quote(s.stream).c_str(), processed, facyl_cli::quote(s.screenshot).c_str());
+    return 0;
+  }
+  while (!viewer.wasStopped()) { // the last frame stays on screen
+    if (redraw) {
+      drawTracked(viewer, shown, rec, objects, tracker, title, layers);
+      redraw = false;
+    }
+    viewer.spinOnce(50);
+  }
+  return 0;
+}
+
 Settings
 parseSettings(int argc, char** argv)
 {
   const facyl_cli::Arguments args(
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      {"--detections", "--accumulator", "--screenshot", "--size"}),
-    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--detect", "--compare-pcl"}),
+                      {"--detections", "--accumulator", "--screenshot", "--size", "--stream",
+                       "--rate", "--frames"}),
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--detect", "--compare-pcl", "--loop"}),
     facyl_cli::recognizerAliases());
   Settings s;
   s.files = args.positional();
-  if (s.files.empty())
-    throw std::invalid_argument("give at least one scene (see -h)");
+  s.stream = args.text("--stream", "");
+  if (args.has("--stream")) {
+    if (s.stream.empty())
+      throw std::invalid_argument("--stream needs a source: a folder of PCD frames, or openni2");
+    if (!s.files.empty())
+      throw std::invalid_argument("--stream and scene files exclude each other (the stream's "
+                                  "frames come from its source)");
+    if (args.has("--detections") || args.has("--compare-pcl") || args.has("--accumulator"))
+      throw std::invalid_argument("--stream runs the recognizer and the tracker; it excludes "
+                                  "--detections, --compare-pcl and --accumulator");
+    s.rate = static_cast<float>(args.number("--rate", 0.0, 0.0, 1000.0));
+    s.loop = args.has("--loop");
+    s.frames = args.integer("--frames", 0, 0, 100000000);
+    if (s.loop && s.frames == 0 && args.has("--screenshot"))
+      throw std::invalid_argument("--loop with --screenshot needs --frames N (a loop never ends)");
+  }
+  else {
+    if (args.has("--rate") || args.has("--loop") || args.has("--frames"))
+      throw std::invalid_argument("--rate, --loop and --frames need --stream");
+    if (s.files.empty())
+      throw std::invalid_argument("give at least one scene (see -h)");
+  }
   facyl_cli::applyRecognizerOptions(args, s.params, s.up);
   s.detections = args.text("--detections", "");
   if (!s.detections.empty() && args.has("--detect"))
@@ -775,6 +1018,19 @@ main(int argc, char** argv)
     return 1;
   }
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+  if (!s.stream.empty()) {
+    try {
+      return runStream(s);
+    }
+    catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "facyl_viewer: %s\n", e.what());
+      return 2;
+    }
+    catch (const std::exception& e) {
+      std::fprintf(stderr, "facyl_viewer: %s\n", e.what());
+      return 1;
+    }
+  }
   try {
     Viewer viewer(s);
     if (!s.screenshot.empty()) {

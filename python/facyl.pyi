@@ -101,3 +101,48 @@ def simulate_cylinder(
 def render_tabletop_scene(
     *, seed: int = 0, layout: str = "spread", sensor: str = "kinect"
 ) -> Dict[str, Any]: ...
+
+def render_sequence_frame(
+    *,
+    seed: int = 0,
+    frame: int = 0,
+    frames: int = 30,
+    layout: str = "cluttered",
+    sensor: str = "kinect",
+    change: str = "none",  # "none" | "remove" | "add"
+    orbit: float = 0.9,
+) -> Dict[str, Any]:
+    """Frame `frame` of a simulated stream (facyl_synth --sequence): render_tabletop_scene's keys
+    plus "sequence" (the change; per frame the camera pose and the object ids present)."""
+    ...
+
+class Tracker:
+    """Objects and cylinders tracked across the frames of one stream (facyl_detect --track)."""
+    def __init__(
+        self,
+        *,
+        camera: Optional[Sequence[float]] = None,
+        up: Optional[Sequence[float]] = None,
+        model: str = "default",
+        track_confirm_hits: int = 2,
+        track_max_misses: int = 5,
+        **options: Any,  # detect()'s recognizer options
+    ) -> None: ...
+    def update(
+        self,
+        points: npt.NDArray[np.floating[Any]],
+        colors: Optional[npt.NDArray[np.uint8]] = None,
+    ) -> Dict[str, Any]:
+        """facyl_detect --track's JSON line as a dict (objects with "track_id", "track", "cylinder"
+        tracked and "cylinder_frame"; "stream"; "tracks"); ValueError skips the frame."""
+        ...
+    def skip(self) -> None:
+        """A frame that could not be had: counted, the tracks are kept."""
+        ...
+    def reset(self) -> None:
+        """Ends every track; ids go on."""
+        ...
+    @property
+    def tracks(self) -> List[Dict[str, Any]]: ...
+    @property
+    def frame(self) -> int: ...

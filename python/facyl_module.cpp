@@ -7,6 +7,7 @@
 #include "../apps/detect_json.h"
 #include "../apps/fit_options.h"
 #include "../apps/recognizer_options.h"
+#include "../apps/track_json.h"
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_classifier.h>
@@ -15,6 +16,8 @@
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/simulation/cylinder_simulation.h>
 #include <facyl/simulation/tabletop_scene.h>
+#include <facyl/simulation/tabletop_sequence.h>
+#include <facyl/tracking/cylinder_tracker.h>
 
 #include <pcl/ModelCoefficients.h>
 #include <pcl/console/print.h>
@@ -27,6 +30,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <optional>
 #include <regex>
 #include <string>
@@ -459,6 +463,149 @@ detect(const py::object& points, const py::object& colors,
   return out;
 }
 
+// ------------------------------------------------------------------------------ Tracker
+
+/** facyl.Tracker: the recognizer and a CylinderTracker over the frames of one stream. */
+class PyTracker {
+public:
+  PyTracker(const std::optional<std::vector<double>>& camera, const py::object& up,
+            const std::string& model, int confirm_hits, int max_misses, const py::kwargs& options)
+  {
+    if (camera) {
+      const auto& c = *camera;
+      if (c.size() != 4 || !(c[0] > 0 && c[0] <= 1e5 && c[1] > 0 && c[1] <= 1e5 && c[2] >= 0 &&
+                             c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
+        throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
+                              "0 <= cx, cy <= 4000 (pixels)");
+      camera_ = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]),
+                 static_cast<float>(c[3]), static_cast<int>(std::ceil(2 * c[2] + 1)),
+                 static_cast<int>(std::ceil(2 * c[3] + 1))};
+    }
+    py::dict all(options);
+    all["up"] = up;
+    all["model"] = model;
+    std::vector<std::string> words;
+    appendOptions(words, all);
+    facyl::TabletopRecognizerParameters params;
+    Eigen::Vector3f up_direction = Eigen::Vector3f::Zero();
+    facyl::ShapeClassifier::Ptr classifier;
+    try {
+      const facyl_cli::Arguments args(words, facyl_cli::recognizerValueOptions(),
+                                      facyl_cli::recognizerSwitches(),
+                                      facyl_cli::recognizerAliases());
+      if (!args.positional().empty())
+        throw std::invalid_argument("unexpected value " + args.positional()[0]);
+      facyl_cli::applyRecognizerOptions(args, params, up_direction);
+      classifier = facyl_cli::classifierFromOptions(args);
+    }
+    catch (const std::invalid_argument& e) {
+      throw py::value_error(pythonWords(e.what()));
+    }
+    facyl::CylinderTrackerParameters tp;
+    tp.confirm_hits = confirm_hits;
+    tp.max_misses = max_misses;
+    const std::string why = facyl::validate(tp);
+    if (!why.empty())
+      throw py::value_error(std::regex_replace(
+        std::regex_replace(why, std::regex("confirm_hits"), "track_confirm_hits"),
+        std::regex("max_misses"), "track_max_misses"));
+    tracker_.setParameters(tp);
+    tracker_.setCamera(camera_);
+    rec_.setParameters(params);
+    rec_.setCamera(camera_);
+    rec_.setClassifier(classifier);
+    rec_.setUpDirection(up_direction);
+  }
+
+  py::dict
+  update(const py::object& points, const py::object& colors)
+  {
+    bool organized = false;
+    RgbCloud::Ptr cloud;
+    try {
+      cloud = frameCloud(points, colors, organized);
+    }
+    catch (...) { // a frame that cannot be used: the stream goes on, the tracks are kept
+      skip();
+      throw;
+    }
+    std::string json;
+    bool ok = false;
+    std::vector<std::int64_t> flat;
+    std::vector<std::size_t> sizes;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      rec_.setInputCloud(cloud);
+      std::vector<facyl::RecognizedObject> objects;
+      ok = rec_.recognize(objects);
+      if (ok) {
+        tracker_.update(rec_, objects);
+        json = facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9) + "}";
+        for (const auto& o : objects) {
+          sizes.push_back(o.cluster.indices.indices.size());
+          flat.insert(flat.end(), o.cluster.indices.indices.begin(), o.cluster.indices.indices.end());
+        }
+      }
+      else
+        tracker_.skipFrame();
+    }
+    if (!ok)
+      throw py::value_error("Tracker.update: recognition failed (see the message printed above); "
+                            "the frame is skipped, the tracks are kept");
+    py::dict out = py::module_::import("json").attr("loads")(json);
+    py::list list = out["objects"];
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < sizes.size(); ++i) {
+      list[i]["indices"] =
+        py::array_t<std::int64_t>(static_cast<py::ssize_t>(sizes[i]), flat.data() + at);
+      at += sizes[i];
+    }
+    return out;
+  }
+
+  void
+  skip()
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    tracker_.skipFrame();
+  }
+
+  void
+  reset()
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    tracker_.reset();
+  }
+
+  py::list
+  tracks()
+  {
+    std::string json;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      json = "{" + facyl_cli::streamJson(tracker_, nullptr, 9).substr(1) + "}";
+    }
+    return py::module_::import("json").attr("loads")(json)["tracks"];
+  }
+
+  std::size_t
+  frame()
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return tracker_.getFrameInfo().frame;
+  }
+
+private:
+  facyl::PinholeCamera camera_;
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec_;
+  facyl::CylinderTracker tracker_;
+  std::mutex mutex_; ///< one update at a time (the GIL is released while it runs)
+};
+
 // ---------------------------------------------------------------------------- simulation
 
 py::dict
@@ -547,6 +694,63 @@ renderTabletopScene(long long seed, const std::string& layout, const std::string
   out["colors"] = rgb;
   out["object_id"] = ids;
   out["truth"] = py::module_::import("json").attr("loads")(facyl::groundTruthJson(scene));
+  out["camera"] = std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
+  return out;
+}
+
+py::dict
+renderSequenceFrame(long long seed, long long frame, long long frames, const std::string& layout,
+                    const std::string& sensor, const std::string& change, double orbit)
+{
+  if (seed < 0)
+    throw py::value_error("seed: must be >= 0");
+  if (frames < 2 || frames > 100000)
+    throw py::value_error("frames: must be in [2, 100000]");
+  if (frame < 0 || frame >= frames)
+    throw py::value_error("frame: must be in [0, frames - 1]");
+  if (layout != "spread" && layout != "cluttered")
+    throw py::value_error("layout: '" + layout + "' is not spread or cluttered");
+  facyl::TabletopSceneParameters p =
+    layout == "cluttered" ? facyl::clutteredSceneParameters() : facyl::TabletopSceneParameters{};
+  if (sensor == "random" || !facyl::parseSensorPreset(sensor, p.sensor, p.camera))
+    throw py::value_error("sensor: '" + sensor + "' is not kinect or stereo");
+  facyl::TabletopSequenceParameters sp;
+  sp.frames = static_cast<std::size_t>(frames);
+  sp.orbit = static_cast<float>(orbit);
+  if (!facyl::parseSequenceChange(change, sp.change))
+    throw py::value_error("change: '" + change + "' is not none, remove or add");
+  const std::string why = facyl::validate(sp);
+  if (!why.empty())
+    throw py::value_error(why);
+  p.seed = static_cast<std::uint64_t>(seed);
+  facyl::RenderedScene scene;
+  std::string sequence;
+  {
+    py::gil_scoped_release release;
+    const facyl::TabletopSequence seq = facyl::generateTabletopSequence(p, sp);
+    scene = facyl::renderSequenceFrame(seq, static_cast<std::size_t>(frame), p.camera, p.sensor,
+                                       facyl::sequenceFrameSeed(p.seed, static_cast<std::size_t>(frame)));
+    sequence = facyl::sequenceJson(seq);
+  }
+  const py::ssize_t h = scene.cloud.height, w = scene.cloud.width;
+  py::array_t<float> xyz({h, w, py::ssize_t(3)});
+  py::array_t<std::uint8_t> rgb({h, w, py::ssize_t(3)});
+  py::array_t<std::uint16_t> ids({h, w});
+  float* x = xyz.mutable_data();
+  std::uint8_t* c = rgb.mutable_data();
+  std::uint16_t* id = ids.mutable_data();
+  for (std::size_t i = 0; i < scene.cloud.size(); ++i) {
+    const auto& q = scene.cloud[i];
+    x[3 * i] = q.x, x[3 * i + 1] = q.y, x[3 * i + 2] = q.z;
+    c[3 * i] = q.r, c[3 * i + 1] = q.g, c[3 * i + 2] = q.b;
+    id[i] = scene.object_id[i];
+  }
+  py::dict out;
+  out["points"] = xyz;
+  out["colors"] = rgb;
+  out["object_id"] = ids;
+  out["truth"] = py::module_::import("json").attr("loads")(facyl::groundTruthJson(scene));
+  out["sequence"] = py::module_::import("json").attr("loads")(sequence);
   out["camera"] = std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
   return out;
 }
@@ -711,6 +915,45 @@ sector). Returns {"points": (N, 3), "normals": (N, 3), "is_lid": (N,), "truth": 
 "kinect" or "stereo". Returns {"points": (480, 640, 3) float32 (NaN without depth), "colors":
 (480, 640, 3) uint8, "object_id": (480, 640) uint16 (0 background, 1 table, 2+ objects),
 "truth": the ground truth (dict), "camera": [fx, fy, cx, cy]}.)");
+
+  m.def("render_sequence_frame", &renderSequenceFrame, py::kw_only(), py::arg("seed") = 0,
+        py::arg("frame") = 0, py::arg("frames") = 30, py::arg("layout") = "cluttered",
+        py::arg("sensor") = "kinect", py::arg("change") = "none", py::arg("orbit") = 0.9,
+        R"(Frame `frame` of a simulated stream (facyl_synth --sequence): a camera moving along a
+smooth path around a static table of `layout` ("cluttered" or "spread"), seen by `sensor`
+("kinect" or "stereo"), `frames` frames turning by `orbit` rad; change "remove" / "add" takes
+an object away / puts one down half-way. The same keys as render_tabletop_scene (object_id:
+2 + i is the sequence's object i in every frame), plus "sequence": the change and, per frame,
+the camera pose and the object ids present.)");
+
+  py::class_<PyTracker>(m, "Tracker", R"(Objects and cylinders tracked across the frames of one stream
+(facyl_detect --track; C++ facyl::CylinderTracker): a camera moving over a static table.
+
+Tracker(camera=None, up=None, model="default", track_confirm_hits=2, track_max_misses=5,
+**options): camera, up, model and the other keywords as in detect() (facyl_detect's recognizer
+options, '_' for '-'); track_confirm_hits: frames a new track must be seen in before it is
+confirmed (a cylinder seen in one frame only never becomes a track); track_max_misses: missed
+frames a confirmed track survives (occlusion; longer when the frame shows it hidden or out of
+view). update() is serialised: one frame at a time, from any thread (the GIL is released).)")
+    .def(py::init<const std::optional<std::vector<double>>&, const py::object&, const std::string&,
+                  int, int, const py::kwargs&>(),
+         py::kw_only(), py::arg("camera") = py::none(), py::arg("up") = py::none(),
+         py::arg("model") = "default", py::arg("track_confirm_hits") = 2,
+         py::arg("track_max_misses") = 5)
+    .def("update", &PyTracker::update, py::arg("points"), py::arg("colors") = py::none(),
+         R"(The next frame of the stream (points and colors as for detect()). Returns facyl_detect
+--track's JSON line as a dict: detect()'s fields, with per object "track_id" (int, stable across
+frames), "is_cylinder" and "cylinder" the track's decision and filtered estimate in this frame,
+"is_cylinder_frame" and "cylinder_frame" the frame's own, "role", "merged", "track" (its state),
+"indices"; and "stream" (frame, scene, anchored, ...) and "tracks" (every live track). A frame
+that cannot be used raises ValueError and is skipped: the tracks are kept.)")
+    .def("skip", &PyTracker::skip,
+         "A frame that could not be had (dropped, unreadable): counted, the tracks are kept.")
+    .def("reset", &PyTracker::reset, "Ends every track (a new stream); ids go on.")
+    .def_property_readonly("tracks", &PyTracker::tracks,
+                           "The live tracks (list of dicts: track_id, object, merged_into, state, "
+                           "centroid, cylinder in the last frame).")
+    .def_property_readonly("frame", &PyTracker::frame, "Frames given (update() and skip()).");
 
   m.def("_time_fit_in_cpp", &timeFitInCpp, py::arg("points"), py::arg("repeats") = 50,
         py::arg("k") = 16,

@@ -394,3 +394,58 @@ def test_open3d_example():
                           "--no-window"], check=True, capture_output=True, text=True,
                          env=dict(os.environ)).stdout
     assert "Cylinder(radius=0.040" in out
+
+
+# ------------------------------------------------------------------------------ Tracker
+
+def _truth_of(frame, obj):
+    ids, counts = np.unique(frame["object_id"].ravel()[obj["indices"]], return_counts=True)
+    return int(ids[np.argmax(counts)])
+
+
+def test_tracker_keeps_ids_on_a_simulated_stream():
+    # facyl.Tracker on 8 frames of a moving camera: the tracked objects keep their ids, and the
+    # result has facyl_detect --track's fields.
+    tracker = facyl.Tracker()
+    ids_of = {}
+    for k in range(8):
+        frame = facyl.render_sequence_frame(seed=11, frame=k, frames=8)
+        out = tracker.update(frame["points"], frame["colors"])
+        assert out["stream"]["frame"] == k and out["stream"]["anchored"]
+        for o in out["objects"]:
+            assert isinstance(o["track_id"], int)
+            assert {"cylinder_frame", "is_cylinder_frame", "track", "role", "indices"} <= o.keys()
+            if o["track"]["confirmed"] and o["role"] == "matched":
+                ids_of.setdefault(_truth_of(frame, o), set()).add(o["track_id"])
+    assert len(ids_of) >= 3
+    assert all(len(ids) == 1 for ids in ids_of.values()), ids_of
+    assert tracker.frame == 8
+    cylinders = [t for t in tracker.tracks if t["state"]["is_cylinder"]]
+    assert cylinders and all(t["cylinder"]["radius"] > 0 for t in cylinders)
+
+
+def test_tracker_bad_frames_keep_the_tracks():
+    tracker = facyl.Tracker()
+    for k in range(3):
+        frame = facyl.render_sequence_frame(seed=11, frame=k, frames=8)
+        tracker.update(frame["points"], frame["colors"])
+    before = {t["track_id"] for t in tracker.tracks}
+    with pytest.raises(ValueError, match="fewer than 3 finite points"):
+        tracker.update(np.full((480, 640, 3), np.nan, np.float32))
+    with pytest.raises(TypeError):
+        tracker.update(np.zeros((480, 640, 3), np.int32))
+    tracker.skip()
+    assert {t["track_id"] for t in tracker.tracks} == before
+    assert tracker.frame == 6
+    frame = facyl.render_sequence_frame(seed=11, frame=3, frames=8)
+    out = tracker.update(frame["points"], frame["colors"])
+    assert out["stream"]["frame"] == 6
+    assert before <= {t["track_id"] for t in out["tracks"]}
+    tracker.reset()
+    assert tracker.tracks == []
+    with pytest.raises(ValueError, match="track_confirm_hits"):
+        facyl.Tracker(track_confirm_hits=0)
+    with pytest.raises(ValueError, match="unknown option radius_limit"):
+        facyl.Tracker(radius_limit=(0.01, 0.2))
+    with pytest.raises(ValueError, match="change"):
+        facyl.render_sequence_frame(change="shake")

@@ -1,0 +1,775 @@
+/*
+ * facyl: tracking across frames (CylinderTracker, its numerics, simulated streams, the PCD
+ * grabber stream).
+ */
+#include "../apps/frame_stream.h"
+
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/tabletop_geometry.h>
+#include <facyl/simulation/random.h>
+#include <facyl/simulation/tabletop_sequence.h>
+#include <facyl/tracking/cylinder_tracker.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <numeric>
+#include <set>
+
+namespace {
+
+constexpr float kPi = 3.14159265f;
+
+// ------------------------------------------------------------------ a synthetic stream
+
+/** What a recognizer would report of a static table seen by a camera orbiting it: one support
+ * (its frame's origin at a jittered "centre of the visible points", its x from the camera's, as
+ * TabletopSegmentation makes it) and noisy objects, in the camera's frame. Fast and exact: the
+ * tracker's behaviour without the recognizer's. */
+struct SyntheticTable {
+  struct Item {
+    bool cylinder{true};
+    Eigen::Vector3f base{Eigen::Vector3f::Zero()}; ///< world; cylinders: the base centre
+    float radius{0.04f}, height{0.12f};
+  };
+  std::vector<Item> items;
+  float distance{1.1f}, elevation{0.75f}, azimuth0{-0.3f}, step{0.03f};
+  facyl::Random rng{7};
+
+  SyntheticTable()
+  {
+    items = {{true, {0.f, 0.f, 0.f}, 0.04f, 0.12f},
+             {true, {0.18f, 0.05f, 0.f}, 0.03f, 0.10f},
+             {true, {-0.15f, 0.12f, 0.f}, 0.06f, 0.08f},
+             {false, {0.05f, -0.16f, 0.04f}, 0.f, 0.f},
+             {true, {-0.1f, -0.12f, 0.f}, 0.025f, 0.15f}};
+  }
+  /** Camera to world of frame \a k (x right, y down, z forward). */
+  Eigen::Affine3f
+  camera(int k) const
+  {
+    const float az = azimuth0 + step * static_cast<float>(k);
+    const Eigen::Vector3f eye = distance * Eigen::Vector3f(std::sin(az) * std::cos(elevation),
+                                                           -std::cos(az) * std::cos(elevation),
+                                                           std::sin(elevation));
+    const Eigen::Vector3f f = (-eye).normalized();
+    const Eigen::Vector3f right = f.cross(Eigen::Vector3f::UnitZ()).normalized();
+    Eigen::Affine3f pose = Eigen::Affine3f::Identity();
+    pose.linear().col(0) = right;
+    pose.linear().col(1) = f.cross(right);
+    pose.linear().col(2) = f;
+    pose.translation() = eye;
+    return pose;
+  }
+  std::vector<facyl::SupportPlane>
+  supports(int k)
+  {
+    const Eigen::Affine3f to_camera = camera(k).inverse();
+    Eigen::Vector4f plane;
+    plane.head<3>() = to_camera.linear() * Eigen::Vector3f::UnitZ();
+    plane[3] = -plane.head<3>().dot(to_camera * Eigen::Vector3f::Zero());
+    facyl::SupportPlane s;
+    s.plane = plane;
+    const Eigen::Vector3f hint(rng.uniform(-0.15f, 0.15f), rng.uniform(-0.15f, 0.15f), 0.f);
+    s.frame = facyl::planeFrame(plane, to_camera * hint);
+    return {s};
+  }
+  facyl::RecognizedObject
+  observe(const Item& it, const Eigen::Affine3f& to_camera, bool noise = true)
+  {
+    facyl::RecognizedObject o;
+    o.cluster.support = 0;
+    o.cluster.indices.indices.resize(1500);
+    const float n = noise ? 1.f : 0.f;
+    if (it.cylinder) {
+      const Eigen::Vector3f axis =
+        (Eigen::Vector3f::UnitZ() + n * 0.015f * Eigen::Vector3f(rng.normal(), rng.normal(), 0.f))
+          .normalized();
+      const Eigen::Vector3f shift = n * 0.002f * Eigen::Vector3f(rng.normal(), rng.normal(), 0.f);
+      o.cylinder.base = to_camera * (it.base + shift);
+      o.cylinder.top = to_camera * (it.base + shift + it.height * axis);
+      o.cylinder.point_on_axis = o.cylinder.base;
+      o.cylinder.axis = (o.cylinder.top - o.cylinder.base).normalized();
+      o.cylinder.radius = it.radius * (1.f + n * 0.02f * rng.normal());
+      o.cylinder.height = it.height;
+      o.cylinder.angular_coverage = 0.4f;
+      o.evidence.fitted = true;
+      o.is_cylinder = true;
+      o.cluster.centroid = to_camera * (it.base + Eigen::Vector3f(0, 0, 0.5f * it.height));
+    }
+    else
+      o.cluster.centroid =
+        to_camera * (it.base + n * 0.01f * Eigen::Vector3f(rng.normal(), rng.normal(), rng.normal()));
+    return o;
+  }
+  std::vector<facyl::RecognizedObject>
+  objects(int k, const std::vector<int>& hidden = {})
+  {
+    const Eigen::Affine3f to_camera = camera(k).inverse();
+    std::vector<facyl::RecognizedObject> out;
+    for (std::size_t i = 0; i < items.size(); ++i)
+      if (std::find(hidden.begin(), hidden.end(), static_cast<int>(i)) == hidden.end())
+        out.push_back(observe(items[i], to_camera));
+    // Reported in another order each frame: ids must not depend on it.
+    for (std::size_t i = out.size(); i > 1; --i)
+      std::swap(out[i - 1], out[static_cast<std::size_t>(rng.integer(0, static_cast<int>(i) - 1))]);
+    return out;
+  }
+};
+
+/** The track id of the object nearest \a world_point (its centroid), -1 when none is within
+ * 5 cm. */
+int
+idNear(const facyl::CylinderTracker& tracker, const std::vector<facyl::RecognizedObject>& objects,
+       const Eigen::Affine3f& camera_to_world, const Eigen::Vector3f& world_point)
+{
+  int best = -1;
+  float nearest = 0.05f;
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const Eigen::Vector3f p = camera_to_world * objects[k].cluster.centroid;
+    const float d = (p.head<2>() - world_point.head<2>()).norm();
+    if (d < nearest) {
+      nearest = d;
+      best = tracker.getAssignments()[k].track_id;
+    }
+  }
+  return best;
+}
+
+} // namespace
+
+// ----------------------------------------------------------------------------- numerics
+
+TEST(TrackingNumerics, PlanarRigidFromNoisyPoints)
+{
+  // Weighted Procrustes: the error of the yaw falls with the points' spread and count as the
+  // noise over their extent (sigma / (sqrt(n) * spread)); bound at 5 such sigmas.
+  facyl::Random rng(3);
+  const facyl::PlanarRigid truth{0.4f, Eigen::Vector2f(0.3f, -0.2f)};
+  const int n = 40;
+  const float sigma = 0.002f, spread = 0.2f;
+  Eigen::Matrix2Xf from(2, n), to(2, n);
+  for (int i = 0; i < n; ++i) {
+    from.col(i) = Eigen::Vector2f(rng.uniform(-spread, spread), rng.uniform(-spread, spread));
+    to.col(i) = truth.apply(from.col(i)) + sigma * Eigen::Vector2f(rng.normal(), rng.normal());
+  }
+  const auto fit = facyl::fitPlanarRigid(from, to, Eigen::VectorXf::Ones(n), 0.f);
+  const float yaw_sigma = sigma / (std::sqrt(static_cast<float>(n)) * spread * 0.58f);
+  EXPECT_NEAR(fit.yaw, truth.yaw, 5.f * yaw_sigma);
+  EXPECT_LT((fit.t - truth.t).norm(), 5.f * sigma);
+  // One point: the rotation cannot be observed; the fallback is kept.
+  const auto one = facyl::fitPlanarRigid(from.leftCols(1), to.leftCols(1), Eigen::VectorXf::Ones(1), 0.25f);
+  EXPECT_FLOAT_EQ(one.yaw, 0.25f);
+  EXPECT_LT((one.apply(from.col(0)) - to.col(0)).norm(), 1e-5f);
+  // inPlaneComponent of a planar motion is itself.
+  const auto back = facyl::inPlaneComponent(truth.asAffine());
+  EXPECT_NEAR(back.yaw, truth.yaw, 1e-5f);
+  EXPECT_LT((back.t - truth.t).norm(), 1e-6f);
+}
+
+TEST(TrackingNumerics, RegistrationIgnoresWrongCandidates)
+{
+  // Six landmarks, every object a candidate of every track (the worst case: no attribute
+  // tells them apart), a prior 5 cm and 0.1 rad off: the robust registration finds the motion.
+  facyl::Random rng(11);
+  const facyl::PlanarRigid truth{-0.35f, Eigen::Vector2f(0.12f, 0.07f)};
+  const int n = 6;
+  Eigen::Matrix2Xf objects(2, n), tracks(2, n);
+  for (int i = 0; i < n; ++i) {
+    objects.col(i) = Eigen::Vector2f(rng.uniform(-0.25f, 0.25f), rng.uniform(-0.25f, 0.25f));
+    tracks.col(i) = truth.apply(objects.col(i)) + 0.001f * Eigen::Vector2f(rng.normal(), rng.normal());
+  }
+  std::vector<facyl::RegistrationCandidate> candidates;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      candidates.push_back({i, j, 1.f, 0.02f});
+  const facyl::PlanarRigid prior{truth.yaw + 0.1f, truth.t + Eigen::Vector2f(0.05f, 0.f)};
+  const auto reg = facyl::registerInPlane(objects, tracks, candidates, prior);
+  EXPECT_EQ(reg.matched_objects, static_cast<std::size_t>(n));
+  EXPECT_FALSE(reg.from_prior);
+  EXPECT_NEAR(reg.transform.yaw, truth.yaw, 0.01f);
+  EXPECT_LT((reg.transform.t - truth.t).norm(), 0.004f);
+  for (const int c : reg.inliers)
+    EXPECT_EQ(candidates[static_cast<std::size_t>(c)].object, candidates[static_cast<std::size_t>(c)].track);
+  // No candidate: the prior.
+  const auto none = facyl::registerInPlane(objects, tracks, {}, prior);
+  EXPECT_TRUE(none.from_prior);
+  EXPECT_FLOAT_EQ(none.transform.yaw, prior.yaw);
+}
+
+TEST(TrackingNumerics, AssignmentIsOptimalAgainstBruteForce)
+{
+  facyl::Random rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int rows = rng.integer(0, 5), cols = rng.integer(0, 5);
+    Eigen::MatrixXf cost(rows, cols);
+    for (int i = 0; i < rows; ++i)
+      for (int j = 0; j < cols; ++j)
+        cost(i, j) = rng.chance(0.2) ? std::numeric_limits<float>::infinity() : rng.uniform(0.f, 12.f);
+    const float gate = 9.f;
+    const std::vector<int> a = facyl::assignMinimumCost(cost, gate);
+    ASSERT_EQ(a.size(), static_cast<std::size_t>(rows));
+    // Brute force: the most admissible pairs, then the least cost.
+    std::vector<int> perm(static_cast<std::size_t>(std::max(rows, cols)));
+    std::iota(perm.begin(), perm.end(), 0);
+    int best_pairs = -1;
+    float best_cost = 0.f;
+    do {
+      int pairs = 0;
+      float sum = 0.f;
+      for (int i = 0; i < rows; ++i) {
+        const int j = perm[static_cast<std::size_t>(i)];
+        if (j < cols && cost(i, j) <= gate) {
+          ++pairs;
+          sum += cost(i, j);
+        }
+      }
+      if (pairs > best_pairs || (pairs == best_pairs && sum < best_cost)) {
+        best_pairs = pairs;
+        best_cost = sum;
+      }
+    } while (std::next_permutation(perm.begin(), perm.end()));
+    int pairs = 0;
+    float sum = 0.f;
+    std::set<int> used;
+    for (int i = 0; i < rows; ++i)
+      if (a[static_cast<std::size_t>(i)] >= 0) {
+        EXPECT_LE(cost(i, a[static_cast<std::size_t>(i)]), gate);
+        EXPECT_TRUE(used.insert(a[static_cast<std::size_t>(i)]).second);
+        ++pairs;
+        sum += cost(i, a[static_cast<std::size_t>(i)]);
+      }
+    EXPECT_EQ(pairs, std::max(best_pairs, 0));
+    EXPECT_NEAR(sum, best_cost, 1e-3f);
+  }
+}
+
+TEST(TrackingNumerics, FiltersAreRobustAndSignFree)
+{
+  // An outlier moves a scalar by at most huber_k sigmas of the innovation, times var / var_z.
+  float x = 1.f, var = 0.01f;
+  facyl::filterScalar(x, var, 100.f, 0.01f, 2.f);
+  EXPECT_LT(x - 1.f, 2.f * std::sqrt(0.02f) * (0.01f / 0.01f) + 1e-4f);
+  EXPECT_GT(x - 1.f, 0.f);
+  // The axis has no sign: z and -z update it alike.
+  Eigen::Vector3f a = Eigen::Vector3f::UnitZ(), b = a;
+  float va = 0.01f, vb = 0.01f;
+  const Eigen::Vector3f z = Eigen::Vector3f(0.05f, 0.f, 1.f).normalized();
+  facyl::filterAxis(a, va, z, 0.01f);
+  facyl::filterAxis(b, vb, -z, 0.01f);
+  EXPECT_LT((a - b).norm(), 1e-6f);
+  EXPECT_NEAR(std::acos(a.z()), 0.5f * std::acos(z.z()), 1e-3f); // equal variances: half way
+  // Extent: an end seen inside (occluded) pulls less than one seen beyond.
+  float lo = -0.05f, hi = 0.05f, ve = 1e-4f;
+  facyl::filterExtent(lo, hi, ve, -0.02f, 0.08f, 1e-4f, 0.3f);
+  EXPECT_GT(hi - 0.05f, lo + 0.05f); // hi moved out more than lo moved in
+  // Confidence: clamped log-odds; medians.
+  float l = 0.f;
+  for (int i = 0; i < 50; ++i)
+    l = facyl::updateLogOdds(l, 0.95f, 4.6f);
+  EXPECT_FLOAT_EQ(l, 4.6f);
+  l = facyl::updateLogOdds(l, 0.05f, 4.6f);
+  l = facyl::updateLogOdds(l, 0.05f, 4.6f);
+  EXPECT_LT(facyl::probability(l), 0.5f); // a long history is overturned by two frames
+  EXPECT_FLOAT_EQ(facyl::median({3.f, 1.f, 2.f}), 2.f);
+  EXPECT_FLOAT_EQ(facyl::weightedMedian({1.f, 2.f, 10.f}, {1.f, 5.f, 1.f}), 2.f);
+  // The consensus axis: a wrong first fit is outvoted by the agreeing later ones, whatever
+  // their signs; the flags say which agreed.
+  {
+    const Eigen::Vector3f wrong = Eigen::Vector3f(1.f, 0.f, 0.2f).normalized();
+    const Eigen::Vector3f up1 = Eigen::Vector3f(0.02f, 0.f, 1.f).normalized();
+    const Eigen::Vector3f up2 = Eigen::Vector3f(-0.02f, 0.f, -1.f).normalized();
+    std::vector<char> agree;
+    const Eigen::Vector3f c =
+      facyl::consensusAxis({wrong, up1, up2}, {2.f, 1.5f, 1.5f}, 0.14f, &agree);
+    EXPECT_GT(std::abs(c.z()), 0.999f);
+    EXPECT_NEAR(c.norm(), 1.f, 1e-5f);
+    EXPECT_EQ(agree, (std::vector<char>{0, 1, 1}));
+    EXPECT_EQ(facyl::consensusAxis({}, {}, 0.14f), Eigen::Vector3f::Zero());
+  }
+  // Association: an occluded end (the visible centre moves along the axis) costs nothing.
+  facyl::AssociationGeometry t, o;
+  t.cylinder = o.cylinder = true;
+  t.radius = o.radius = 0.04f;
+  t.height = 0.12f;
+  o.height = 0.06f;
+  o.centre = Eigen::Vector3f(0.f, 0.f, 0.03f);
+  t.centroid = o.centroid = Eigen::Vector3f::Zero();
+  EXPECT_NEAR(facyl::associationCost(t, o), 0.f, 1e-6f);
+  o.centre.x() = 0.06f; // beside it: 3 sigmas
+  EXPECT_GT(facyl::associationCost(t, o), 8.f);
+}
+
+TEST(CylinderTracker, ParametersAreChecked)
+{
+  facyl::CylinderTrackerParameters p;
+  EXPECT_TRUE(facyl::validate(p).empty());
+  p.confirm_hits = 0;
+  p.min_probability = 2.f;
+  const std::string why = facyl::validate(p);
+  EXPECT_NE(why.find("confirm_hits"), std::string::npos);
+  EXPECT_NE(why.find("min_probability"), std::string::npos);
+  facyl::CylinderTracker tracker;
+  try {
+    tracker.setParameters(p);
+    FAIL() << "invalid parameters were accepted";
+  }
+  catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("CylinderTracker::setParameters"), std::string::npos);
+  }
+}
+
+// ------------------------------------------------------------------- tracker behaviour
+
+TEST(CylinderTracker, IdsStayUnderCameraMotionAndReanchoring)
+{
+  // 40 frames, the camera turning 70 degrees around the table; the support frame's origin
+  // jumps with what the camera sees of the table. Every object keeps its id, and the tracked
+  // positions stay where the objects are (within a few mm): re-anchoring works.
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  std::map<std::size_t, int> first_id;
+  for (int k = 0; k < 40; ++k) {
+    const auto supports = table.supports(k);
+    const auto objects = table.objects(k);
+    ASSERT_TRUE(tracker.update(supports, 0, objects));
+    EXPECT_TRUE(tracker.getFrameInfo().anchored);
+    EXPECT_FALSE(tracker.getFrameInfo().new_scene);
+    for (std::size_t i = 0; i < table.items.size(); ++i) {
+      const int id = idNear(tracker, objects, table.camera(k), table.items[i].base);
+      ASSERT_GE(id, 0) << "frame " << k << " object " << i;
+      if (k == 0)
+        first_id[i] = id;
+      else
+        EXPECT_EQ(id, first_id[i]) << "frame " << k << " object " << i;
+    }
+  }
+  EXPECT_EQ(tracker.getTracks().size(), table.items.size());
+  // The tracked cylinders, in the last frame, where they are.
+  const Eigen::Affine3f to_world = table.camera(39);
+  for (const auto& t : tracker.getTracks()) {
+    EXPECT_TRUE(t.confirmed);
+    if (!t.has_cylinder)
+      continue;
+    EXPECT_TRUE(tracker.isCylinder(t));
+    const facyl::CylinderModel m = tracker.cylinderInFrame(t);
+    const Eigen::Vector3f base = to_world * m.base;
+    float nearest = 1.f;
+    for (const auto& it : table.items)
+      if (it.cylinder) {
+        nearest = std::min(nearest, (base.head<2>() - it.base.head<2>()).norm());
+        if ((base.head<2>() - it.base.head<2>()).norm() < 0.01f) {
+          EXPECT_NEAR(m.radius, it.radius, 0.02f * it.radius); // 2% noise per frame, averaged
+        }
+      }
+    EXPECT_LT(nearest, 0.006f);
+    EXPECT_GT((to_world.linear() * m.axis).z(), std::cos(0.02f)); // upright, away from the table
+  }
+}
+
+TEST(CylinderTracker, LoopedRecordingKeepsTheIds)
+{
+  // A recording played in a loop: the camera turns 0.15 rad a frame for 5 frames, then jumps
+  // back to where it started. The velocity predicts the path going on; the jump back is found
+  // from the last pose instead: the same scene, the same ids.
+  SyntheticTable table;
+  table.step = 0.15f;
+  facyl::CylinderTracker tracker;
+  std::map<std::size_t, int> first_id;
+  for (int k = 0; k < 10; ++k) {
+    const int f = k % 5;
+    const auto objects = table.objects(f);
+    ASSERT_TRUE(tracker.update(table.supports(f), 0, objects));
+    EXPECT_FALSE(tracker.getFrameInfo().new_scene) << "frame " << k;
+    if (k < 2)
+      continue;
+    for (std::size_t i = 0; i < table.items.size(); ++i) {
+      const int id = idNear(tracker, objects, table.camera(f), table.items[i].base);
+      if (k == 2)
+        first_id[i] = id;
+      else
+        EXPECT_EQ(id, first_id[i]) << "frame " << k << " object " << i;
+    }
+  }
+}
+
+TEST(CylinderTracker, OneFrameFalsePositiveIsNeverConfirmed)
+{
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  SyntheticTable::Item ghost{true, {0.25f, -0.2f, 0.f}, 0.05f, 0.1f};
+  int ghost_id = -1;
+  for (int k = 0; k < 12; ++k) {
+    auto objects = table.objects(k);
+    if (k == 5)
+      objects.push_back(table.observe(ghost, table.camera(k).inverse()));
+    tracker.update(table.supports(k), 0, objects);
+    if (k == 5) {
+      ghost_id = tracker.getAssignments().back().track_id;
+      EXPECT_EQ(tracker.getAssignments().back().role, facyl::TrackAssignment::Role::Started);
+      const auto* t = tracker.findTrack(ghost_id);
+      ASSERT_NE(t, nullptr);
+      EXPECT_FALSE(t->confirmed);
+      EXPECT_FALSE(tracker.isCylinder(*t)); // not reported
+    }
+    if (k > 5) {
+      EXPECT_EQ(tracker.findTrack(ghost_id), nullptr) << "frame " << k;
+    }
+  }
+  EXPECT_EQ(tracker.getTracks().size(), table.items.size());
+}
+
+TEST(CylinderTracker, OneFrameMissKeepsTheTrack)
+{
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  int id = -1;
+  for (int k = 0; k < 12; ++k) {
+    const auto objects = table.objects(k, k == 6 ? std::vector<int>{1} : std::vector<int>{});
+    tracker.update(table.supports(k), 0, objects);
+    if (k == 5)
+      id = idNear(tracker, objects, table.camera(k), table.items[1].base);
+    if (k == 6) {
+      const auto* t = tracker.findTrack(id);
+      ASSERT_NE(t, nullptr) << "a one-frame miss ended the track";
+      EXPECT_EQ(t->status, facyl::TrackStatus::Missed);
+      EXPECT_TRUE(tracker.isCylinder(*t)); // still reported, from its history
+    }
+    if (k == 7) {
+      EXPECT_EQ(idNear(tracker, objects, table.camera(k), table.items[1].base), id);
+    }
+  }
+}
+
+TEST(CylinderTracker, FramesWithoutSupportOrFailedKeepTheTracks)
+{
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  std::vector<int> ids;
+  for (int k = 0; k < 14; ++k) {
+    auto objects = table.objects(k);
+    if (k == 5) { // no support: objects with support -1
+      for (auto& o : objects)
+        o.cluster.support = -1;
+      ASSERT_TRUE(tracker.update({}, -1, objects));
+      EXPECT_FALSE(tracker.getFrameInfo().anchored);
+      for (const auto& t : tracker.getTracks())
+        EXPECT_EQ(t.misses, 0);
+    }
+    else if (k == 6)
+      tracker.skipFrame(); // unreadable, empty, failed
+    else if (k == 7) { // an empty frame: no support, no object
+      ASSERT_TRUE(tracker.update({}, -1, {}));
+      for (const auto& t : tracker.getTracks())
+        EXPECT_EQ(t.status, facyl::TrackStatus::NotUpdated);
+    }
+    else if (k == 8) { // a table index out of range: refused, nothing lost
+      EXPECT_FALSE(tracker.update(table.supports(k), 3, objects));
+      EXPECT_TRUE(tracker.getFrameInfo().skipped);
+    }
+    else
+      ASSERT_TRUE(tracker.update(table.supports(k), 0, objects));
+    if (k == 4 || k == 13) {
+      std::vector<int> now;
+      for (const auto& it : table.items)
+        now.push_back(idNear(tracker, objects, table.camera(k), it.base));
+      if (ids.empty())
+        ids = now;
+      else
+        EXPECT_EQ(now, ids);
+    }
+    EXPECT_EQ(tracker.getTracks().size(), table.items.size()) << "frame " << k;
+  }
+  EXPECT_EQ(tracker.getFrameInfo().frame, 14u);
+}
+
+TEST(CylinderTracker, UnanchoredStreamDoesNotPileUpTentativeTracks)
+{
+  // A long stream without any support (a moving camera, no table: nothing to anchor on) whose
+  // objects are somewhere else in every frame: each frame's new tracks are tentative and end
+  // when the next frame does not see them again, so the tracks stay as many as one frame's
+  // objects.
+  facyl::Random rng(13);
+  facyl::CylinderTracker tracker;
+  for (int k = 0; k < 50; ++k) {
+    std::vector<facyl::RecognizedObject> objects(5);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      auto& o = objects[i];
+      o.cluster.support = -1;
+      o.cluster.indices.indices.resize(800);
+      o.cluster.centroid = Eigen::Vector3f(rng.uniform(-2.f, 2.f), rng.uniform(-2.f, 2.f),
+                                           rng.uniform(1.f, 4.f));
+      o.evidence.p_cylinder = 0.3f;
+    }
+    ASSERT_TRUE(tracker.update({}, -1, objects));
+    EXPECT_FALSE(tracker.getFrameInfo().anchored);
+    EXPECT_LE(tracker.getTracks().size(), 2 * objects.size()) << "frame " << k;
+  }
+}
+
+TEST(CylinderTracker, SplitSegmentsAreFragmentsOfOneTrack)
+{
+  // For three frames the recognizer reports a cylinder as two segments (its fit, and a piece
+  // beside it): the piece gets the cylinder's id and starts no track.
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  for (int k = 0; k < 10; ++k) {
+    auto objects = table.objects(k);
+    if (k >= 4 && k < 7) {
+      facyl::RecognizedObject piece;
+      piece.cluster.support = 0;
+      piece.cluster.indices.indices.resize(300);
+      piece.cluster.centroid =
+        table.camera(k).inverse() * (table.items[0].base + Eigen::Vector3f(0.03f, 0.f, 0.1f));
+      objects.push_back(piece);
+    }
+    tracker.update(table.supports(k), 0, objects);
+    if (k >= 4 && k < 7) {
+      const auto& a = tracker.getAssignments().back();
+      EXPECT_EQ(a.role, facyl::TrackAssignment::Role::Fragment) << "frame " << k;
+      EXPECT_EQ(a.track_id, idNear(tracker, objects, table.camera(k), table.items[0].base));
+    }
+    EXPECT_EQ(tracker.getTracks().size(), table.items.size());
+  }
+}
+
+TEST(CylinderTracker, TakenAwayObjectEndsWhenTheSensorSeesThroughItsPlace)
+{
+  // With the sensor's depth (an empty table where the object stood), a taken-away object's
+  // track ends within two frames; without it, after max_misses.
+  SyntheticTable table;
+  facyl::PinholeCamera cam{525.f, 525.f, 319.5f, 239.5f, 640, 480};
+  for (const bool with_depth : {true, false}) {
+    facyl::CylinderTracker tracker;
+    int id = -1, last_seen = -1;
+    for (int k = 0; k < 14; ++k) {
+      const auto objects = table.objects(k, k >= 6 ? std::vector<int>{2} : std::vector<int>{});
+      facyl::TrackerView view;
+      view.camera = cam;
+      if (with_depth) {
+        const Eigen::Affine3f pose = table.camera(k);
+        view.depth = [pose, cam](int u, int v) { // the table plane along the pixel's ray
+          const Eigen::Vector3f d((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.f);
+          const Eigen::Vector3f w = pose.linear() * d;
+          return -pose.translation().z() / w.z();
+        };
+      }
+      tracker.update(table.supports(k), 0, objects, view);
+      if (k == 5)
+        id = idNear(tracker, objects, table.camera(k), table.items[2].base);
+      if (id >= 0 && tracker.findTrack(id))
+        last_seen = k;
+    }
+    if (with_depth)
+      EXPECT_LE(last_seen, 7);
+    else
+      EXPECT_EQ(last_seen, 6 + facyl::CylinderTrackerParameters{}.max_misses - 1);
+  }
+}
+
+TEST(CylinderTracker, NewSceneStartsNewTracks)
+{
+  // Another table, seen from elsewhere (its plane does not continue the tracks' and its
+  // objects match none): every track ends, new ones start.
+  SyntheticTable first, second;
+  second.items = {{true, {0.3f, 0.3f, 0.f}, 0.09f, 0.05f}, {false, {-0.2f, 0.25f, 0.06f}, 0.f, 0.f},
+                  {true, {0.f, 0.35f, 0.f}, 0.02f, 0.2f}};
+  second.distance = 0.7f;
+  second.elevation = 1.2f;
+  facyl::CylinderTracker tracker;
+  std::set<int> first_ids;
+  for (int k = 0; k < 6; ++k)
+    tracker.update(first.supports(k), 0, first.objects(k));
+  for (const auto& t : tracker.getTracks())
+    first_ids.insert(t.id);
+  tracker.update(second.supports(0), 0, second.objects(0));
+  EXPECT_TRUE(tracker.getFrameInfo().new_scene);
+  EXPECT_EQ(tracker.getFrameInfo().scene, 1u);
+  for (const auto& t : tracker.getTracks())
+    EXPECT_EQ(first_ids.count(t.id), 0u);
+  EXPECT_EQ(tracker.getTracks().size(), second.items.size());
+}
+
+// ------------------------------------------------------------------- simulated streams
+
+TEST(TabletopSequence, KeepsTheSceneAndMovesSmoothly)
+{
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 42;
+  facyl::TabletopSequenceParameters sp;
+  sp.frames = 20;
+  sp.change = facyl::TabletopSequenceParameters::Change::Remove;
+  const auto seq = facyl::generateTabletopSequence(p, sp);
+  const auto single = facyl::generateTabletopScene(p); // the same scene as a single frame
+  ASSERT_EQ(seq.scene.objects.size(), single.objects.size());
+  for (std::size_t i = 0; i < single.objects.size(); ++i)
+    EXPECT_TRUE(seq.scene.objects[i].pose.matrix().isApprox(single.objects[i].pose.matrix()));
+  EXPECT_TRUE(seq.cameras.front().matrix().isApprox(single.camera_to_world.matrix()));
+  for (std::size_t k = 1; k < seq.cameras.size(); ++k) {
+    const Eigen::AngleAxisf turn(seq.cameras[k - 1].linear().transpose() * seq.cameras[k].linear());
+    EXPECT_LT(std::abs(turn.angle()), 0.1f); // smooth: under 6 degrees a frame
+    EXPECT_LT((seq.cameras[k].translation() - seq.cameras[k - 1].translation()).norm(), 0.1f);
+  }
+  ASSERT_GE(seq.changed_object, 0);
+  const auto gone = static_cast<std::size_t>(seq.changed_object);
+  EXPECT_TRUE(seq.present(gone, seq.change_frame - 1));
+  EXPECT_FALSE(seq.present(gone, seq.change_frame));
+  // Ids keep the sequence's numbering in a frame without the object.
+  const auto r = facyl::renderSequenceFrame(seq, seq.change_frame, p.camera, p.sensor, 1);
+  EXPECT_EQ(r.visible_pixels.size(), seq.scene.objects.size());
+  EXPECT_EQ(r.visible_pixels[gone], 0u);
+  EXPECT_EQ(std::count(r.object_id.begin(), r.object_id.end(), static_cast<std::uint16_t>(2 + gone)), 0);
+  for (std::size_t i = 0; i < seq.scene.objects.size(); ++i)
+    EXPECT_EQ(static_cast<std::size_t>(std::count(r.object_id.begin(), r.object_id.end(),
+                                                  static_cast<std::uint16_t>(2 + i))) >= r.visible_pixels[i],
+              true);
+  // Deterministic.
+  const auto again = facyl::generateTabletopSequence(p, sp);
+  EXPECT_TRUE(again.cameras.back().matrix().isApprox(seq.cameras.back().matrix()));
+  EXPECT_EQ(again.changed_object, seq.changed_object);
+}
+
+TEST(CylinderTracker, IdsAreStableOnASimulatedStream)
+{
+  // The recognizer on 12 rendered frames of a cluttered table, the camera moving: each
+  // cylinder seen well keeps one id (the id most of its frames carry covers at least 80% of
+  // them), and the tracked report loses no cylinder the frames found and adds no false one.
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 3003;
+  facyl::TabletopSequenceParameters sp;
+  sp.frames = 12;
+  const auto seq = facyl::generateTabletopSequence(p, sp);
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  facyl::CylinderTracker tracker;
+  std::map<int, std::map<int, int>> ids_of; // true object -> track id -> frames
+  std::size_t frame_found = 0, tracked_found = 0, frame_false = 0, tracked_false = 0;
+  for (std::size_t f = 0; f < sp.frames; ++f) {
+    const auto r = facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(p.seed, f));
+    pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGBA>(r.cloud));
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    ASSERT_TRUE(rec.recognize(objects));
+    ASSERT_TRUE(tracker.update(rec, objects));
+    // Which true cylinder a reported cylinder is (its axis centre within r/2 + 2 cm).
+    const auto truthOf = [&](const facyl::CylinderModel& m) {
+      for (std::size_t i = 0; i < seq.scene.objects.size(); ++i) {
+        const auto& o = seq.scene.objects[i];
+        if (o.cls != facyl::SceneClass::Cylinder)
+          continue;
+        const auto c = facyl::cylinderTruth(r.scene, o);
+        const Eigen::Vector3f centre = 0.5f * (m.base + m.top), a = c.base, b = c.base + c.height * c.axis;
+        const float t = std::clamp((centre - a).dot(b - a) / (b - a).squaredNorm(), 0.f, 1.f);
+        if ((centre - (a + t * (b - a))).norm() < 0.5f * c.radius + 0.02f)
+          return static_cast<int>(i);
+      }
+      return -1;
+    };
+    std::set<int> by_frame, by_track;
+    for (const auto& o : objects)
+      if (o.is_cylinder) {
+        const int g = truthOf(o.cylinder);
+        g >= 0 ? (void)by_frame.insert(g) : (void)++frame_false;
+      }
+    for (const auto& t : tracker.getTracks())
+      if (tracker.isCylinder(t) && t.status != facyl::TrackStatus::OutOfView) {
+        const int g = truthOf(tracker.cylinderInFrame(t));
+        if (g < 0) {
+          ++tracked_false;
+          continue;
+        }
+        by_track.insert(g);
+        if (r.visible_pixels[static_cast<std::size_t>(g)] >= 800)
+          ++ids_of[g][t.id];
+      }
+    if (f + 1 >= static_cast<std::size_t>(tracker.getParameters().confirm_hits)) {
+      frame_found += by_frame.size(); // from the first frame a track can be confirmed in
+      tracked_found += by_track.size();
+    }
+  }
+  EXPECT_GE(tracked_found, frame_found);
+  EXPECT_LE(tracked_false, frame_false);
+  ASSERT_FALSE(ids_of.empty());
+  for (const auto& [object, ids] : ids_of) {
+    int total = 0, most = 0;
+    for (const auto& [id, n] : ids) {
+      total += n;
+      most = std::max(most, n);
+    }
+    if (total >= 5) {
+      EXPECT_GE(most, 0.8 * total) << "object " << object << " changed ids";
+    }
+  }
+}
+
+TEST(FrameStream, PcdGrabberPlaysAFolderOfFrames)
+{
+  // A temporary folder: four frames of a simulated stream, a file that is not a PCD, an empty
+  // cloud and a truncated file. The grabber plays the four in order, the others are left out
+  // with their reasons; the tracker keeps its ids over them.
+  const auto dir = std::filesystem::temp_directory_path() / "facyl_test_frame_stream";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 21;
+  facyl::TabletopSequenceParameters sp;
+  sp.frames = 4;
+  const auto seq = facyl::generateTabletopSequence(p, sp);
+  for (std::size_t f = 0; f < sp.frames; ++f) {
+    const auto r = facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, f);
+    pcl::io::savePCDFileBinaryCompressed((dir / ("frame" + std::to_string(f) + ".pcd")).string(), r.cloud);
+  }
+  { std::ofstream((dir / "frame1_notes.pcd").string()) << "not a point cloud\n"; }
+  std::ofstream((dir / "frame2_empty.pcd").string())
+    << "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 0\nHEIGHT 1\n"
+       "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n";
+  {
+    const auto full = (dir / "frame0.pcd").string();
+    std::ifstream in(full, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream((dir / "frame3_truncated.pcd").string(), std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+  }
+  facyl_cli::FrameStream stream(dir.string(), 0.f, false);
+  EXPECT_EQ(stream.rejected().size(), 3u);
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  facyl::CylinderTracker tracker;
+  facyl_cli::StreamFrame frame;
+  std::vector<std::string> names;
+  std::set<int> confirmed_ids;
+  while (stream.next(frame)) {
+    names.push_back(std::filesystem::path(frame.name).filename().string());
+    ASSERT_EQ(frame.cloud->width, 640u);
+    rec.setInputCloud(frame.cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    ASSERT_TRUE(rec.recognize(objects));
+    tracker.update(rec, objects);
+    if (frame.index == 1)
+      for (const auto& t : tracker.getTracks())
+        if (t.confirmed)
+          confirmed_ids.insert(t.id);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"frame0.pcd", "frame1.pcd", "frame2.pcd", "frame3.pcd"}));
+  ASSERT_FALSE(confirmed_ids.empty());
+  std::size_t kept = 0;
+  for (const int id : confirmed_ids)
+    kept += tracker.findTrack(id) != nullptr;
+  EXPECT_GE(kept, confirmed_ids.size() - 1); // the camera moved a little: ids persist
+
+  { // Looping at a rate: the grabber's thread publishes; at least one frame arrives.
+    facyl_cli::FrameStream live(dir.string(), 50.f, true);
+    EXPECT_TRUE(live.next(frame, 5.0));
+    EXPECT_EQ(frame.cloud->width, 640u);
+  }
+  // No usable frame, no such folder: clear errors.
+  const auto bad = dir / "bad";
+  std::filesystem::create_directories(bad);
+  { std::ofstream((bad / "x.pcd").string()) << "junk\n"; }
+  EXPECT_THROW(facyl_cli::FrameStream(bad.string(), 0.f, false), std::invalid_argument);
+  EXPECT_THROW(facyl_cli::FrameStream((dir / "missing").string(), 0.f, false), std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
