@@ -53,10 +53,16 @@ printHelp(const char* self)
       "  --threads T          threads for normals (default: all)\n"
       "  --outward-normals    inliers' normals must point away from the axis (normals towards\n"
       "                       a sensor outside the cylinder: excludes a cup's inner wall)\n"
+      "  --point-candidates N candidates refined and compared on the points (default %zu;\n"
+      "                       0: the best alone, refined on its inliers, as facyl 0.1 did)\n"
+      "  --coarse-scale S     at high noise, cues again from neighbours within S radii\n"
+      "                       (default %g; 0: never)\n"
       "  -h, --help           this help\n\n"
       "Normals are estimated unless the file has normal_x/y/z. Exit status: 0 if every file\n"
       "was processed, 1 if some file failed (its object holds \"error\"), 2 on bad options.\n",
-      self, default_orientations, default_accumulators, default_max_cylinders, default_k);
+      self, default_orientations, default_accumulators, default_max_cylinders, default_k,
+      facyl::HoughCylinderParameters{}.point_candidates,
+      static_cast<double>(facyl::HoughCylinderParameters{}.coarse_scale));
 }
 
 struct Settings : facyl_cli::HoughSettings {
@@ -182,7 +188,7 @@ main(int argc, char** argv)
         argc, argv,
         {"--method", "--prior", "--up", "--orientations", "--accumulators", "--radius-min",
          "--radius-max", "--distance-threshold", "--max-cylinders", "--k", "--seed",
-         "--threads"},
+         "--threads", "--point-candidates", "--coarse-scale"},
         {"--outward-normals"});
     files = args.positional();
     s.method = args.text("--method", default_method);
@@ -209,6 +215,10 @@ main(int argc, char** argv)
     s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
     s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0, 256));
     s.params.outward_normals = args.has("--outward-normals");
+    s.params.point_candidates = static_cast<std::size_t>(args.integer(
+        "--point-candidates", static_cast<long long>(s.params.point_candidates), 0, 64));
+    s.params.coarse_scale = static_cast<float>(
+        args.number("--coarse-scale", static_cast<double>(s.params.coarse_scale), 0.0, 2.0));
     const std::string why = facyl::validate(s.params);
     if (!why.empty())
       throw std::invalid_argument(why);
