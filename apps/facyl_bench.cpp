@@ -306,8 +306,8 @@ printHelp(const char* self)
       "  --threads T    threads (default: all cores)\n"
       "  --out DIR      output folder (default bench_out): fits.csv, summary.md\n"
       "  --dump SETTING,SWEEP,LEVEL,SCENE  write that scene to DIR/scene.pcd (to rerun one fit\n"
-      "                 with facyl_fit) and stop; LEVEL as in fits.csv\n",
-      self);
+      "                 with facyl_fit) and stop; LEVEL as in fits.csv\n%s",
+      self, facyl_cli::commonHelp());
 }
 
 } // namespace
@@ -315,10 +315,8 @@ printHelp(const char* self)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_bench", printHelp); rc >= 0)
+    return rc;
   int scenes = 1000, threads = 0;
   std::uint64_t seed = 1;
   std::string out = "bench_out", dump;
@@ -338,6 +336,7 @@ main(int argc, char** argv)
     seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0, facyl_cli::kMaxSeed));
     threads = static_cast<int>(args.integer("--threads", 0, 0, 256));
     out = args.text("--out", out);
+    facyl_cli::checkOutputFolder("--out", out, [](const std::string&) { return false; }, {});
     const std::string list = args.text("--settings", "paper,practical");
     settings.clear();
     std::stringstream ss(list);

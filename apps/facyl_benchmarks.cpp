@@ -15,6 +15,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <string>
+
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
@@ -155,4 +158,20 @@ BENCHMARK(BM_PclRansac)->Arg(900)->Unit(benchmark::kMillisecond);
 
 } // namespace
 
-BENCHMARK_MAIN();
+// Google Benchmark's main, plus --version as every facyl tool answers it (-h lists
+// Google Benchmark's own options, --benchmark_filter=REGEX and the like).
+int
+main(int argc, char** argv)
+{
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--version") {
+      std::printf("facyl_benchmarks (facyl) %s\n", FACYL_VERSION);
+      return 0;
+    }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+    return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

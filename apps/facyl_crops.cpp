@@ -61,8 +61,10 @@ printHelp(const char* self)
     "                     the category is the file name up to _<digit>)\n"
     "  --size S           image size (default %d)\n"
     "  --model M          none (default) | default | PATH.onnx: adds the network's probability\n"
-    "Exit status: 0, 1 when a scene or file failed, 2 for bad usage.\n",
-    self, static_cast<unsigned long long>(kDefaultSeed), kDefaultSize);
+    "OUT is a folder that exists; it gets rgb.u8, depth.u8 and objects.csv (refused when\n"
+    "one of them is an input).\n%s"
+    "Exit status: 0, 1 when a scene or file failed, 2 for bad usage (nothing written).\n",
+    self, static_cast<unsigned long long>(kDefaultSeed), kDefaultSize, facyl_cli::commonHelp());
 }
 
 struct Settings {
@@ -311,11 +313,24 @@ parseSettings(int argc, char** argv)
   if (!s.uw.empty() && !std::filesystem::is_directory(s.uw))
     throw std::invalid_argument("--uw: folder '" + s.uw + "' does not exist");
   s.size = static_cast<int>(args.integer("--size", kDefaultSize, 8, 512));
-  s.classifier = facyl_cli::classifierFromOptions(args, "none");
   if (s.sim == 0 && s.uw.empty())
     throw std::invalid_argument("give --sim N and/or --uw DIR");
   if (!std::filesystem::is_directory(s.out))
     throw std::invalid_argument("folder '" + s.out + "' does not exist");
+  std::vector<std::string> inputs;
+  if (!s.uw.empty())
+    for (const auto& e : std::filesystem::directory_iterator(s.uw))
+      inputs.push_back(e.path().string());
+  const std::string model = args.text("--model", "none");
+  if (model != "default" && model != "none") {
+    inputs.push_back(model);
+    inputs.push_back(std::filesystem::path(model).replace_extension(".cfg").string());
+  }
+  facyl_cli::checkOutputFolder(
+    "output folder", s.out,
+    [](const std::string& f) { return f == "rgb.u8" || f == "depth.u8" || f == "objects.csv"; },
+    inputs);
+  s.classifier = facyl_cli::classifierFromOptions(args, "none");
   return s;
 }
 
@@ -324,10 +339,8 @@ parseSettings(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_crops", printHelp); rc >= 0)
+    return rc;
   Settings s;
   try {
     s = parseSettings(argc, argv);

@@ -3,6 +3,7 @@
  * One JSON object per scene on stdout.
  */
 #include "cli.h"
+#include "detect_json.h"
 #include "pcd_input.h"
 #include "recognizer_options.h"
 
@@ -37,19 +38,23 @@ printHelp(const char* self)
     "accepted.\n%s"
     "Output:\n"
     "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
-    "  --overlay PATH         RGB image with boxes (green: cylinder, red: not) and fitted\n"
-    "                         outlines; with several scenes PATH is a folder (<stem>.png;\n"
-    "                         <stem>-<k>.png when scenes share a name, k from 1)\n"
-    "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png)\n"
+    "  --overlay OUT.png      RGB image with boxes (green: cylinder, red: not) and fitted\n"
+    "                         outlines; with several scenes a folder (<stem>.png;\n"
+    "                         <stem>-<k>.png when scenes share a name, k from 1). A path not\n"
+    "                         ending in .png, or one that is an input, is refused\n"
+    "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png);\n"
+    "                         refused when a name it would write is an input\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
     "  --verbose              what each step found (PCL's debug messages, on standard\n"
     "                         output between the JSON lines)\n"
     "  --roll DEG             each frame as a camera rolled by DEG (90, 180, 270) clockwise\n"
     "                         about its optical axis would have taken it (organized frames;\n"
     "                         boxes and overlays are in the rolled image)\n"
-    "Exit status: 0 all scenes processed, 1 a scene failed (its JSON has \"error\"), 2 bad "
-    "usage.\n",
-    self, facyl_cli::recognizerOptionsHelp());
+    "%s"
+    "Exit status: 0 all scenes processed (warnings, e.g. no overlay for an unorganized cloud\n"
+    "without --camera, go to standard error and do not change it), 1 a scene failed or an\n"
+    "output could not be written (its JSON has \"error\"), 2 bad usage (nothing written).\n",
+    self, facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
 }
 
 // ---- drawing on an RGB buffer ----
@@ -157,77 +162,15 @@ drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
   return camera;
 }
 
-/** One object of the JSON output. */
-void
-writeObject(std::ostream& out, std::size_t id, const facyl::RecognizedObject& o)
-{
-  const auto& b = o.cluster.box;
-  const auto& e = o.evidence;
-  const auto optional = [](float v) {
-    return std::isfinite(v) ? facyl_cli::number(v) : std::string("null");
-  };
-  out << "{\"id\":" << id << ",\"support\":" << o.cluster.support
-      << ",\"centroid\":" << facyl_cli::vector(o.cluster.centroid)
-      << ",\"n_points\":" << o.cluster.indices.indices.size() << ",\"bbox\":";
-  if (b[0] < 0)
-    out << "null";
-  else
-    out << "[" << b[0] << "," << b[1] << "," << b[2] << "," << b[3] << "]";
-  out << ",\"p_cylinder\":" << optional(e.p_cylinder) << ",\"p_network\":" << optional(e.p_network)
-      << ",\"inlier_ratio\":" << facyl_cli::number(e.inlier_ratio)
-      << ",\"surface_ratio\":" << facyl_cli::number(e.surface_ratio)
-      << ",\"curvature_ratio\":" << optional(e.curvature_ratio)
-      << ",\"taper\":" << optional(e.taper) << ",\"arc_gap\":" << optional(e.arc_gap)
-      << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
-  if (e.fitted)
-    out << "{\"point_on_axis\":" << facyl_cli::vector(o.cylinder.base)
-        << ",\"axis\":" << facyl_cli::vector(o.cylinder.axis)
-        << ",\"radius\":" << facyl_cli::number(o.cylinder.radius)
-        << ",\"height\":" << facyl_cli::number(o.cylinder.height)
-        << ",\"angular_coverage\":" << facyl_cli::number(o.cylinder.angular_coverage) << "}";
-  else
-    out << "null";
-  out << "}";
-}
-
-/** The scene's JSON object, without its closing brace (a warning may follow). */
-void
-writeScene(std::ostream& out, const std::string& file, const Cloud& cloud,
-           const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
-           const std::vector<facyl::RecognizedObject>& objects,
-           const facyl::RecognitionTiming& t)
-{
-  const auto plane = [](const Eigen::Vector4f& c) {
-    return "[" + facyl_cli::number(c[0]) + "," + facyl_cli::number(c[1]) + "," +
-           facyl_cli::number(c[2]) + "," + facyl_cli::number(c[3]) + "]";
-  };
-  const auto& supports = rec.getSupports();
-  const auto& tc = rec.getTableCoefficients().values;
-  out << "{\"file\":" << facyl_cli::quote(file) << ",\"organized\":"
-      << (cloud.isOrganized() ? "true" : "false") << ",\"table\":{\"coefficients\":"
-      << (tc.size() == 4 ? plane(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3])) : "null")
-      << ",\"found\":" << (rec.tableFound() ? "true" : "false") << "},\"supports\":[";
-  for (std::size_t k = 0; k < supports.size(); ++k)
-    out << (k ? "," : "") << "{\"coefficients\":" << plane(supports[k].plane)
-        << ",\"objects\":" << supports[k].objects << "}";
-  out << "],\"objects\":[";
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    out << (k ? "," : "");
-    writeObject(out, k, objects[k]);
-  }
-  out << "],\"timing_ms\":{\"segmentation\":" << facyl_cli::number(t.segmentation)
-      << ",\"classification\":" << facyl_cli::number(t.classification)
-      << ",\"fitting\":" << facyl_cli::number(t.fitting) << ",\"total\":"
-      << facyl_cli::number(t.total) << "}";
-}
-
 /** The overlay image: the RGB frame (or the points projected with the camera) with a box per
  * object (green: cylinder, red: not) and the fitted cylinders' outlines.
- * \return an empty string, or why there is no overlay. */
-std::string
+ * \return false when the image could not be written (\a why says so); true with \a why set
+ * when there is no overlay to draw (a warning), true with \a why empty when it was written. */
+bool
 drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCamera& camera,
-            const std::vector<facyl::RecognizedObject>& objects)
+            const std::vector<facyl::RecognizedObject>& objects, std::string& why)
 {
+  why.clear();
   Canvas canvas;
   if (cloud.isOrganized()) {
     canvas.width = static_cast<int>(cloud.width);
@@ -248,8 +191,10 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
                    {p.r, p.g, p.b});
       }
   }
-  if (canvas.rgb.empty())
-    return "no overlay: an unorganized cloud needs --camera";
+  if (canvas.rgb.empty()) {
+    why = "no overlay: an unorganized cloud needs --camera fx,fy,cx,cy";
+    return true;
+  }
   const std::array<unsigned char, 3> green{0, 230, 0}, red{230, 0, 0}, yellow{255, 230, 0};
   for (const auto& o : objects) {
     const auto& b = o.cluster.box;
@@ -262,10 +207,14 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
     if (o.is_cylinder && camera.valid())
       drawCylinder(canvas, camera, o.cylinder, yellow);
   }
+  std::error_code ec;
+  std::filesystem::remove(path, ec); // so that a stale image does not pass for this one
   pcl::io::saveRgbPNGFile(path, canvas.rgb.data(), canvas.width, canvas.height);
-  if (!std::filesystem::exists(path))
-    return "cannot write the overlay " + path;
-  return {};
+  if (!std::filesystem::exists(path)) {
+    why = "cannot write the overlay " + path;
+    return false;
+  }
+  return true;
 }
 
 /** Each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png) in \a dir.
@@ -293,6 +242,8 @@ saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud
           q[0] = p.r, q[1] = p.g, q[2] = p.b;
         }
       pcl::io::saveRgbPNGFile(base + ".png", crop.data(), w, h);
+      if (!std::filesystem::exists(base + ".png"))
+        return "cannot write " + base + ".png";
     }
   }
   return {};
@@ -343,22 +294,83 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   // Median over the repetitions, by total.
   std::sort(timings.begin(), timings.end(),
             [](const auto& a, const auto& b) { return a.total < b.total; });
-  writeScene(out, file, *cloud, rec, objects, timings[timings.size() / 2]);
+  out << facyl_cli::sceneJson(file, *cloud, rec, objects, timings[timings.size() / 2]);
 
-  std::string warning;
+  // Outputs: a warning (no overlay possible) goes to standard error and keeps the status; an
+  // output that could not be written is an error of the scene.
+  std::string warning, error;
   if (!s.overlay.empty()) {
     const std::string path =
       s.many ? (std::filesystem::path(s.overlay) / (name + ".png")).string() : s.overlay;
-    warning = drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects);
+    std::string why;
+    if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects, why))
+      error = why;
+    else if (!why.empty())
+      warning = why;
+  }
+  if (!s.clusters_dir.empty() && error.empty())
+    error = saveClusters(s.clusters_dir, name, *cloud, has_colour, objects);
+  if (!warning.empty()) {
+    facyl_cli::warn("facyl_detect", file + ": " + warning);
+    out << ",\"warning\":" << facyl_cli::quote(warning);
+  }
+  if (!error.empty()) {
+    std::fprintf(stderr, "facyl_detect: %s: %s\n", file.c_str(), error.c_str());
+    out << ",\"error\":" << facyl_cli::quote(error);
+  }
+  out << "}" << std::endl;
+  return error.empty();
+}
+
+/** Refuses outputs that would replace an input or are not of the kind asked for (before
+ * anything is read or written). \throws std::invalid_argument. */
+void
+checkOutputs(const Settings& s, const std::vector<std::string>& files, const std::string& model)
+{
+  std::vector<std::string> inputs = files;
+  if (!model.empty() && model != "default" && model != "none") {
+    inputs.push_back(model);
+    inputs.push_back(std::filesystem::path(model).replace_extension(".cfg").string());
+  }
+  const std::vector<std::string> names = outputNames(files);
+  const auto isName = [&names](const std::string& filename, const std::string& suffix_pattern) {
+    for (const auto& n : names)
+      if (filename.size() > n.size() && filename.compare(0, n.size(), n) == 0) {
+        const std::string rest = filename.substr(n.size());
+        if (suffix_pattern == ".png" && rest == ".png")
+          return true;
+        // "_obj<k>.pcd" or "_obj<k>.png"
+        if (suffix_pattern == "_obj" && rest.size() > 8 && rest.compare(0, 4, "_obj") == 0) {
+          const std::string ext = rest.substr(rest.size() - 4);
+          const std::string k = rest.substr(4, rest.size() - 8);
+          if ((ext == ".pcd" || ext == ".png") && !k.empty() &&
+              k.find_first_not_of("0123456789") == std::string::npos)
+            return true;
+        }
+      }
+    return false;
+  };
+  if (!s.overlay.empty()) {
+    if (s.many) {
+      if (!std::filesystem::is_directory(s.overlay))
+        throw std::invalid_argument("--overlay " + s.overlay + ": with several scenes, a folder "
+                                    "that exists (one <stem>.png per scene). Nothing was written.");
+      facyl_cli::checkOutputFolder("--overlay", s.overlay,
+                                   [&](const std::string& f) { return isName(f, ".png"); }, inputs);
+    }
+    else {
+      facyl_cli::checkOutputFile("--overlay", s.overlay, {".png"}, "PNG image", inputs);
+      const auto parent = std::filesystem::path(s.overlay).parent_path();
+      if (!parent.empty() && !std::filesystem::is_directory(parent))
+        throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
+    }
   }
   if (!s.clusters_dir.empty()) {
-    const std::string w = saveClusters(s.clusters_dir, name, *cloud, has_colour, objects);
-    warning = warning.empty() ? w : warning;
+    if (!std::filesystem::is_directory(s.clusters_dir))
+      throw std::invalid_argument("folder '" + s.clusters_dir + "' does not exist");
+    facyl_cli::checkOutputFolder("--save-clusters", s.clusters_dir,
+                                 [&](const std::string& f) { return isName(f, "_obj"); }, inputs);
   }
-  if (!warning.empty())
-    out << ",\"warning\":" << facyl_cli::quote(warning);
-  out << "}" << std::endl;
-  return warning.empty();
 }
 
 /** Settings from the command line. \throws std::invalid_argument for bad usage. */
@@ -370,7 +382,8 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
     argc, argv,
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
                       {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll"}),
-    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose"}));
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose"}),
+    facyl_cli::recognizerAliases());
   files = args.positional();
   if (files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
@@ -398,14 +411,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.roll = static_cast<int>(roll / 90);
   s.verbose = args.has("--verbose");
   s.many = files.size() > 1;
-  if (!s.many && !s.overlay.empty()) {
-    const auto parent = std::filesystem::path(s.overlay).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent))
-      throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
-  }
-  for (const std::string& dir : {s.clusters_dir, s.many ? s.overlay : std::string()})
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-      throw std::invalid_argument("folder '" + dir + "' does not exist");
+  checkOutputs(s, files, args.text("--model", ""));
   return s;
 }
 
@@ -414,10 +420,8 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_detect", printHelp); rc >= 0)
+    return rc;
   Settings s;
   std::vector<std::string> files;
   try {

@@ -25,18 +25,17 @@ printHelp(const char* self)
               "  --noise S         noise std. dev. relative to the radius (default 0)\n"
               "  --occlusion O     occlusion of eq. 6 in [0, 1) (default 0)\n"
               "  --seed S          seed (default 0)\n"
-              "  --with-normals    also write the exact normals\n",
-              self);
+              "  --with-normals    also write the exact normals\n"
+              "OUT.pcd must end in .pcd (anything else is refused, nothing written).\n%s",
+              self, facyl_cli::commonHelp());
 }
 } // namespace
 
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_simulate", printHelp); rc >= 0)
+    return rc;
   facyl::CylinderSimulationParameters p;
   std::string out;
   bool normals = false;
@@ -48,6 +47,7 @@ main(int argc, char** argv)
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output file (see -h)");
     out = args.positional()[0];
+    facyl_cli::checkOutputFile("", out, {".pcd"}, "PCD point cloud", {});
     p.radius = static_cast<float>(args.number("--radius", 0.05, 1e-4, 100.0));
     p.height = static_cast<float>(args.number("--height", 0.2, 1e-4, 1000.0));
     p.axis = args.vector3("--axis", Eigen::Vector3f::UnitZ());

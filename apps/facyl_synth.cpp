@@ -16,6 +16,7 @@
 #include <pcl/io/png_io.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -49,18 +50,36 @@ printHelp(const char* self)
     "  --no-quantisation  no disparity quantisation (not with --sensor random)\n"
     "%s"
     "Class codes in PREFIX_class.png: 0 background, 1 table, 2 cylinder, 3 box, 4 sphere,\n"
-    "5 cone, 6 bowl, 7 scenery (far furniture, robots: ids 1000+ in PREFIX_ids.png).\n",
-    self, facyl_cli::sceneImageOptionsHelp());
+    "5 cone, 6 bowl, 7 scenery (far furniture, robots: ids 1000+ in PREFIX_ids.png).\n"
+    "PREFIX is a name without extension in a folder that exists (a PREFIX ending in .pcd,\n"
+    ".png or .json, or naming a folder, is refused).\n%s",
+    self, facyl_cli::sceneImageOptionsHelp(), facyl_cli::commonHelp());
 }
+/** PREFIX names files to write (PREFIX.pcd, PREFIX_rgb.png, ...): a name without an
+ * extension of those files, not a folder. \throws std::invalid_argument. */
+void
+checkPrefix(const std::string& prefix)
+{
+  const std::string ext = facyl_cli::lowerExtension(prefix);
+  if (prefix.empty() || prefix.back() == '/' || std::filesystem::is_directory(prefix))
+    throw std::invalid_argument("PREFIX '" + prefix + "' is a folder; give DIR/NAME (writes "
+                                "DIR/NAME.pcd, DIR/NAME_rgb.png, ...). Nothing was written.");
+  if (ext == ".pcd" || ext == ".png" || ext == ".json")
+    throw std::invalid_argument("PREFIX '" + prefix + "' ends in " + ext + "; give the name "
+                                "without extension (facyl_synth adds .pcd, _rgb.png, _ids.png, "
+                                "_class.png and .json). Nothing was written.");
+  const auto parent = std::filesystem::path(prefix).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    throw std::invalid_argument("folder '" + parent.string() + "' does not exist");
+}
+
 } // namespace
 
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_synth", printHelp); rc >= 0)
+    return rc;
   facyl::TabletopSceneParameters p;
   std::string prefix;
   std::size_t count = 1;
@@ -74,6 +93,7 @@ main(int argc, char** argv)
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
     prefix = args.positional()[0];
+    checkPrefix(prefix);
     if (!facyl::parseLayoutPreset(args.text("--layout", "spread"), p))
       throw std::invalid_argument("--layout must be spread, cluttered or realistic");
     if (!facyl::parseSensorPreset(args.text("--sensor", "kinect"), p.sensor, p.camera))

@@ -662,8 +662,10 @@ printHelp(const char* self)
     "detected cylinders, and the stage timing. Output objects mostly on simulated scenery (far\n"
     "furniture, robots of --layout realistic) are neither true nor false detections. --csv\n"
     "writes one row per object. --roll turns every frame (and its ground truth) as a camera\n"
-    "rolled by 90, 180 or 270 degrees clockwise about its optical axis would have taken it.\n%s",
-    self, facyl_cli::recognizerOptionsHelp());
+    "rolled by 90, 180 or 270 degrees clockwise about its optical axis would have taken it.\n"
+    "--csv FILE must end in .csv and lie outside the --mosd folder (refused otherwise,\n"
+    "nothing written).\n%s%s",
+    self, facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
 }
 
 Options
@@ -676,7 +678,7 @@ parseOptions(int argc, char** argv)
                       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                                         {"--sim", "--first-seed", "--layout", "--sensor",
                                          "--mosd", "--csv", "--roll"})),
-    facyl_cli::recognizerSwitches());
+    facyl_cli::recognizerSwitches(), facyl_cli::recognizerAliases());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
   opt.sim = static_cast<std::size_t>(args.integer("--sim", 0, 0, 100000));
@@ -690,6 +692,26 @@ parseOptions(int argc, char** argv)
   facyl_cli::applySceneImageOptions(args, opt.scene);
   opt.mosd = args.text("--mosd", "");
   opt.csv = args.text("--csv", "");
+  if (args.has("--csv")) {
+    std::vector<std::string> inputs;
+    const std::string model = args.text("--model", "");
+    if (!model.empty() && model != "default" && model != "none") {
+      inputs.push_back(model);
+      inputs.push_back(std::filesystem::path(model).replace_extension(".cfg").string());
+    }
+    facyl_cli::checkOutputFile("--csv", opt.csv, {".csv"}, "CSV table", inputs);
+    // Never into the data set being read (its labels.csv, its scenes).
+    if (!opt.mosd.empty()) {
+      std::error_code ec;
+      const auto data = std::filesystem::weakly_canonical(opt.mosd, ec);
+      const auto csv = std::filesystem::weakly_canonical(opt.csv, ec).parent_path();
+      const auto rel = csv.lexically_relative(data);
+      if (!rel.empty() && rel.native().rfind("..", 0) != 0)
+        throw std::invalid_argument("--csv " + opt.csv + ": lies in the --mosd folder " +
+                                    opt.mosd + ", which is an input; facyl never writes into "
+                                    "the data it reads. Nothing was written.");
+    }
+  }
   const long long roll = args.integer("--roll", 0, 0, 270);
   if (roll % 90 != 0)
     throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
@@ -706,10 +728,8 @@ parseOptions(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_tabletop_eval", printHelp); rc >= 0)
+    return rc;
   Options opt;
   try {
     opt = parseOptions(argc, argv);

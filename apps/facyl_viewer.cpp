@@ -27,10 +27,15 @@
 #include <pcl/conversions.h>
 #include <pcl/visualization/pcl_visualizer.h>
 
+#include <vtkCamera.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -62,13 +67,20 @@ printHelp(const char* self)
     "                        principal-curvature directions (yellow)\n"
     "  --screenshot OUT.png  render the first scene to OUT.png and exit (needs an X display:\n"
     "                        run under xvfb-run without a screen)\n"
+    "                        (a path not ending in .png, or one that is an input, is\n"
+    "                        refused)\n"
     "  --size W,H            window / screenshot size (default %d,%d)\n"
-    "  --model M             shape classifier for --detect: default | none | PATH.onnx\n"
+    "The cloud, the table and the cylinders are drawn in the cloud's own frame, seen from its\n"
+    "sensor (the VIEWPOINT; a pose that puts the points behind the sensor, as PCL's grabber\n"
+    "frames store, is taken as the identity rotation, as the recognizer does). A frame\n"
+    "without any support is shown with its objects and no table outline.\n"
+    "The recognizer's options (--detect; as in facyl_detect):\n%s"
     "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
-    "l labels.\n"
-    "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage.\n",
-    self, kOrientations, kDefaultWidth, kDefaultHeight);
+    "l labels.\n%s"
+    "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage (nothing written).\n",
+    self, kOrientations, kDefaultWidth, kDefaultHeight, facyl_cli::recognizerOptionsHelp(),
+    facyl_cli::commonHelp());
 }
 
 // ------------------------------------------------------------------------------- scene
@@ -94,6 +106,8 @@ struct Scene {
 
 struct Settings {
   std::vector<std::string> files;
+  facyl::TabletopRecognizerParameters params; ///< the recognizer's options
+  Eigen::Vector3f up{Eigen::Vector3f::Zero()};
   bool detect{true};
   std::string detections;
   bool compare_pcl{false};
@@ -159,6 +173,8 @@ void
 detectObjects(const Settings& s, Scene& scene)
 {
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setParameters(s.params);
+  rec.setUpDirection(s.up);
   rec.setClassifier(s.classifier);
   rec.setInputCloud(scene.cloud);
   std::vector<facyl::RecognizedObject> objects;
@@ -212,8 +228,14 @@ objectsFromJson(const facyl_cli::JsonValue& line, Scene& scene)
       o.cylinder.axis = jsonVector(c->get("axis")).normalized();
       o.cylinder.radius = static_cast<float>(c->get("radius") ? c->get("radius")->number : 0.0);
       o.cylinder.height = static_cast<float>(c->get("height") ? c->get("height")->number : 0.0);
-      o.cylinder.base = o.cylinder.point_on_axis;
-      o.cylinder.top = o.cylinder.base + o.cylinder.height * o.cylinder.axis;
+      if (c->get("base") && c->get("top")) { // facyl_detect's JSON since 0.1: the extent
+        o.cylinder.base = jsonVector(c->get("base"));
+        o.cylinder.top = jsonVector(c->get("top"));
+      }
+      else {
+        o.cylinder.base = o.cylinder.point_on_axis;
+        o.cylinder.top = o.cylinder.base + o.cylinder.height * o.cylinder.axis;
+      }
     }
     o.box_min = o.centroid - Eigen::Vector3f::Constant(0.03f);
     o.box_max = o.centroid + Eigen::Vector3f::Constant(0.03f);
@@ -358,16 +380,67 @@ drawTable(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const s
   viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3, tag + "table", viewport);
 }
 
-/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does. */
+/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does.
+ * The pose is the one the recognizer uses (facyl::plausibleSensorPose): PCL's grabber frames
+ * store a 180-degree turn about x with the points in the camera's frame, and the camera must
+ * then look along +z to see them. An organized frame is seen with its own intrinsics
+ * (estimated from its points and pixels: field of view from fy, the principal point as the
+ * window centre), so that a screenshot of its size lies on the frame's image; other clouds
+ * with a Kinect's field of view. */
 void
 sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int viewport)
 {
-  const Eigen::Vector3f o = cloud.sensor_origin_.head<3>();
-  const Eigen::Matrix3f r = cloud.sensor_orientation_.toRotationMatrix();
+  const Eigen::Affine3f pose = facyl::plausibleSensorPose(cloud);
+  const Eigen::Vector3f o = pose.translation();
+  const Eigen::Matrix3f r = pose.linear();
   const Eigen::Vector3f look = o + r.col(2), up = -r.col(1);
   viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(), up.z(), viewport);
-  viewer.setCameraFieldOfView(49.0 * M_PI / 180.0, viewport); // a Kinect's vertical field of view
+  double fov = 49.0 * M_PI / 180.0; // a Kinect's vertical field of view
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  if (cloud.isOrganized() && cloud.height > 1) {
+    const Eigen::Affine3f to_sensor = pose.inverse();
+    const std::size_t step = std::max<std::size_t>(1, cloud.size() / 4000);
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(cloud.size() / step + 1));
+    Eigen::Matrix2Xf px(2, pts.cols());
+    Eigen::Index n = 0;
+    for (std::size_t i = 0; i < cloud.size(); i += step)
+      if (pcl::isFinite(cloud[i])) {
+        pts.col(n) = to_sensor * cloud[i].getVector3fMap();
+        px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud.width),
+                                      static_cast<float>(i / cloud.width));
+      }
+    facyl::PinholeCamera camera;
+    const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
+    if (facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), w, h, camera) &&
+        camera.fy > 0.f) {
+      fov = 2.0 * std::atan(0.5 * h / camera.fy);
+      // VTK moves the optical axis to -WindowCenter in normalized device coordinates.
+      centre = Eigen::Vector2d(1.0 - 2.0 * (camera.cx + 0.5) / w, 2.0 * (camera.cy + 0.5) / h - 1.0);
+    }
+  }
+  viewer.setCameraFieldOfView(fov, viewport);
   viewer.setCameraClipDistances(0.01, 50.0, viewport);
+  auto renderers = viewer.getRendererCollection();
+  renderers->InitTraversal();
+  int i = 0;
+  while (vtkRenderer* renderer = renderers->GetNextItem()) {
+    if (viewport == 0 || viewport == i)
+      renderer->GetActiveCamera()->SetWindowCenter(centre.x(), centre.y());
+    ++i;
+  }
+}
+
+/** The cloud as drawn: its points in its own frame. PCLVisualizer would move a cloud by its
+ * sensor pose (sensor_origin_, sensor_orientation_), while the recognizer's table, cylinders
+ * and boxes are in the cloud's frame: drawn with the pose, a grabber frame (VIEWPOINT
+ * 0 0 0 0 1 0 0) ends up turned away from everything found on it. */
+Cloud::ConstPtr
+drawnCloud(const Cloud& cloud)
+{
+  Cloud::Ptr drawn(new Cloud(cloud));
+  drawn->sensor_origin_ = Eigen::Vector4f::Zero();
+  drawn->sensor_orientation_ = Eigen::Quaternionf::Identity();
+  return drawn;
 }
 
 // ------------------------------------------------------------------------ PCL comparison
@@ -543,7 +616,8 @@ private:
   void
   draw()
   {
-    pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(scene_.cloud);
+    const Cloud::ConstPtr drawn = drawnCloud(*scene_.cloud);
+    pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(drawn);
     if (s_.accumulator >= 0) {
       if (static_cast<std::size_t>(s_.accumulator) >= scene_.objects.size() ||
           scene_.objects[static_cast<std::size_t>(s_.accumulator)].indices.empty()) {
@@ -565,7 +639,7 @@ private:
       viewer_.createViewPort(0.0, 0.0, 0.5, 1.0, left);
       viewer_.createViewPort(0.5, 0.0, 1.0, 1.0, right);
     }
-    viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud", left);
+    viewer_.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud", left);
     if (layers_.table)
       drawTable(viewer_, scene_, "f_", left);
     drawObjects(viewer_, scene_, layers_, "f_", left);
@@ -573,7 +647,7 @@ private:
     if (s_.compare_pcl) {
       Scene pcl_scene;
       const double pcl_ms = pclObjects(scene_, pcl_scene);
-      viewer_.addPointCloud<pcl::PointXYZRGBA>(scene_.cloud, rgb, "cloud_pcl", right);
+      viewer_.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud_pcl", right);
       drawObjects(viewer_, pcl_scene, layers_, "p_", right);
       sensorCamera(viewer_, *scene_.cloud, right);
       char text[200];
@@ -635,13 +709,17 @@ private:
 Settings
 parseSettings(int argc, char** argv)
 {
-  const facyl_cli::Arguments args(argc, argv,
-                                  {"--detections", "--accumulator", "--screenshot", "--size", "--model"},
-                                  {"--detect", "--compare-pcl"});
+  const facyl_cli::Arguments args(
+    argc, argv,
+    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                      {"--detections", "--accumulator", "--screenshot", "--size"}),
+    facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--detect", "--compare-pcl"}),
+    facyl_cli::recognizerAliases());
   Settings s;
   s.files = args.positional();
   if (s.files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
+  facyl_cli::applyRecognizerOptions(args, s.params, s.up);
   s.detections = args.text("--detections", "");
   if (!s.detections.empty() && args.has("--detect"))
     throw std::invalid_argument("--detect and --detections exclude each other");
@@ -653,6 +731,16 @@ parseSettings(int argc, char** argv)
   if (s.compare_pcl && s.accumulator >= 0)
     throw std::invalid_argument("--compare-pcl and --accumulator exclude each other");
   s.screenshot = args.text("--screenshot", "");
+  if (args.has("--screenshot")) {
+    std::vector<std::string> inputs = s.files;
+    inputs.push_back(s.detections);
+    const std::string model = args.text("--model", "");
+    if (!model.empty() && model != "default" && model != "none") {
+      inputs.push_back(model);
+      inputs.push_back(std::filesystem::path(model).replace_extension(".cfg").string());
+    }
+    facyl_cli::checkOutputFile("--screenshot", s.screenshot, {".png"}, "PNG image", inputs);
+  }
   const auto size = facyl_cli::pairOption(args, "--size", kDefaultWidth, kDefaultHeight);
   if (!(size.first >= 64 && size.second >= 64 && size.first <= 8192 && size.second <= 8192))
     throw std::invalid_argument("--size: expected W,H with 64 <= W, H <= 8192");
@@ -668,10 +756,8 @@ parseSettings(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (facyl_cli::wantsHelp(argc, argv)) {
-    printHelp(argv[0]);
-    return 0;
-  }
+  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_viewer", printHelp); rc >= 0)
+    return rc;
   Settings s;
   try {
     s = parseSettings(argc, argv);

@@ -23,14 +23,22 @@ recognizerValueOptions()
           "--prior", "--radius-limits", "--orientations", "--max-fit-points", "--neighbours",
           "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
           "--cluster-size", "--up", "--clustering", "--support", "--max-cylinders-per-cluster",
-          "--model", "--reject-below", "--min-probability"};
+          "--model", "--reject-below", "--min-probability", "--voting",
+          "--distance-threshold"};
 }
 
 /** Switches that applyRecognizerOptions reads. */
 inline std::set<std::string>
 recognizerSwitches()
 {
-  return {"--no-retry", "--retry-inside", "--any-normal-sign"};
+  return {"--no-retry", "--retry-inside", "--any-normal-sign", "--outward-normals"};
+}
+
+/** Old spellings kept for a release (the bare fit's names, so both tools read the same). */
+inline Arguments::Aliases
+recognizerAliases()
+{
+  return {{"--k", "--neighbours"}};
 }
 
 /** The help lines of those options. */
@@ -57,14 +65,19 @@ recognizerOptionsHelp()
          "  --no-retry             no second fit with upright/lying priors when the first fails\n"
          "  --retry-inside         a last retry also fits concave clusters (the inside of an\n"
          "                         open container; bowls too)\n"
-         "  --any-normal-sign      inliers' normals may point at the axis (default: away)\n"
+         "  --outward-normals      inliers' normals must point away from the axis (default:\n"
+         "                         normals face the sensor, a cup's inner wall is no inlier)\n"
+         "  --any-normal-sign      inliers' normals may point at the axis\n"
          "Fit:\n"
          "  --prior P              orientation prior in the table frame: uniform | vertical\n"
          "                         (default) | vertical-strong | horizontal\n"
-         "  --radius-limits A,B    radius interval in m (default 0.01,0.25)\n"
+         "  --radius-limits A,B    radius interval in m (default 0.01,0.25: objects on a table)\n"
+         "  --voting V             soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
+         "  --distance-threshold D inlier distance in m (default: estimated from the residuals)\n"
          "  --orientations N       accumulator cells (default 450)\n"
          "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
-         "  --neighbours K         k of the normal/curvature estimation (default 16)\n"
+         "  --neighbours K         k of the normal/curvature estimation (default 16; old\n"
+         "                         spelling --k)\n"
          "  --seed S               accumulator seed (default 0)\n"
          "  --max-cylinders-per-cluster N  cylinders extracted from a cluster the best fit\n"
          "                         does not explain (touching, stacked objects; default 3;\n"
@@ -105,7 +118,15 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   d.max_taper = static_cast<float>(args.number("--max-taper", d.max_taper, 1e-6, 1.0));
   p.retry_upright_lying = !args.has("--no-retry");
   p.retry_any_normal_sign = args.has("--retry-inside");
+  if (args.has("--outward-normals") && args.has("--any-normal-sign"))
+    throw std::invalid_argument("--outward-normals and --any-normal-sign exclude each other");
   p.hough.outward_normals = !args.has("--any-normal-sign");
+  if (args.has("--voting") &&
+      !facyl::parseVotingMode(args.text("--voting", ""), p.hough.voting_mode))
+    throw std::invalid_argument("option --voting: '" + args.text("--voting", "") +
+                                "' is not soft-curvature, soft-normal or rabbani");
+  p.hough.distance_threshold = static_cast<float>(
+    args.number("--distance-threshold", p.hough.distance_threshold, 0.0, 1.0));
   if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
     throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
   const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);

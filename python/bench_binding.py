@@ -56,7 +56,7 @@ def main():
             t, inner = [], []
             for _ in range(REPEATS):
                 t0 = time.perf_counter()
-                found = facyl.fit_cylinders(p)
+                found = facyl.fit_cylinders(p, radius_limits=(0.01, 0.25))
                 t.append((time.perf_counter() - t0) * 1e3)
                 inner.append(facyl._time_fit_in_cpp(p, 1))
             py_ms.append(float(np.median(t)))
@@ -66,8 +66,8 @@ def main():
             path = os.path.join(tmp, f"c{k}.pcd")
             write_pcd(path, p)
             out = json.loads(subprocess.run(
-                [facyl_fit, "--method", "pcl-ransac", "--radius-min", "0.01", "--radius-max",
-                 "0.25", "--seed", "0", path], check=True, capture_output=True, text=True).stdout)
+                [facyl_fit, "--method", "pcl-ransac", "--radius-limits", "0.01,0.25", "--seed", "0",
+                 path], check=True, capture_output=True, text=True).stdout)
             pcl_ms.append(out["timing_ms"]["normals"] + out["timing_ms"]["fit"])
             if out["cylinders"]:
                 r = out["cylinders"][0]

@@ -1,9 +1,11 @@
 """facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.
 
-Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), metres; NaN rows are
-missing points. Functions release the GIL while they compute.
+Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), or Open3D Vector3dVector;
+metres (fit_cylinders: units="mm" converts); NaN rows are missing points. Keywords are the
+tools' option names with '_' for '-', with their defaults. Functions release the GIL while
+they compute.
 """
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +29,8 @@ class Cylinder:
     @property
     def inliers(self) -> npt.NDArray[np.int64]: ...
     @property
+    def n_inliers(self) -> int: ...
+    @property
     def inlier_ratio(self) -> float: ...
     @property
     def confidence(self) -> float: ...
@@ -34,27 +38,35 @@ class Cylinder:
     def rms_error(self) -> float: ...
     @property
     def angular_coverage(self) -> float: ...
+    def as_dict(self) -> Dict[str, Any]:
+        """facyl_fit's fields for this cylinder."""
+        ...
     @property
     def coefficients(self) -> npt.NDArray[np.float32]:
         """PCL's SACMODEL_CYLINDER layout: point on axis (3), axis direction (3), radius."""
         ...
 
 def fit_cylinders(
-    points: npt.NDArray[np.floating[Any]],
-    normals: Optional[npt.NDArray[np.floating[Any]]] = None,
+    points: Any,  # (N, 3) float array or open3d.utility.Vector3dVector
+    normals: Optional[Any] = None,
     *,
-    radius_limits: Tuple[float, float] = (0.01, 0.25),
-    prior: str = "uniform",
+    radius_limits: Union[Tuple[float, float], str, None] = None,  # None: (0.01, 0.25); "auto"
+    prior: Optional[str] = None,  # None: "vertical" with up, else "uniform"
     up: Optional[Sequence[float]] = None,
-    max_cylinders: int = 1,
     voting: str = "soft-curvature",
-    k: int = 16,
+    neighbours: int = 16,
+    orientations: int = 450,
+    accumulators: int = 1,
     distance_threshold: Optional[float] = None,
+    max_cylinders: int = 1,
+    outward_normals: bool = False,
     seed: int = 0,
+    units: str = "auto",  # "auto" | "m" | "mm"
+    k: Optional[int] = None,  # old spelling of neighbours
 ) -> List[Cylinder]: ...
 
 def estimate_normals_curvatures(
-    points: npt.NDArray[np.floating[Any]], k: int = 16
+    points: Any, neighbours: int = 16, *, k: Optional[int] = None
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.float32],
            npt.NDArray[np.float32]]:
     """(normals, principal_directions, k_max, k_min); k_* are PCL's pc1/pc2 (dimensionless)."""
@@ -67,7 +79,10 @@ def detect(
     camera: Optional[Sequence[float]] = None,
     up: Optional[Sequence[float]] = None,
     model: str = "default",
-) -> Dict[str, Any]: ...
+    **options: Any,  # facyl_detect's recognizer options, '_' for '-': radius_limits=(0.01, 0.25), ...
+) -> Dict[str, Any]:
+    """facyl_detect's JSON object as a dict (plus "indices" per object)."""
+    ...
 
 def simulate_cylinder(
     *,

@@ -4,6 +4,9 @@
  * argument's name, never a crash.
  */
 #include "../apps/cylinder_fit.h"
+#include "../apps/detect_json.h"
+#include "../apps/fit_options.h"
+#include "../apps/recognizer_options.h"
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_classifier.h>
@@ -25,6 +28,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -42,10 +46,13 @@ using Cues = pcl::PointCloud<facyl::NormalCurvature>;
 py::array_t<double, py::array::c_style | py::array::forcecast>
 floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame = false)
 {
-  if (!py::isinstance<py::array>(obj))
-    throw py::type_error(std::string(name) + ": expected a numpy array, got " +
+  // numpy arrays, and anything with the buffer protocol (Open3D's Vector3dVector, memoryview).
+  if (!py::isinstance<py::array>(obj) && !py::isinstance<py::buffer>(obj))
+    throw py::type_error(std::string(name) + ": expected a numpy array (or an Open3D "
+                         "Vector3dVector), got " +
                          std::string(py::str(py::type::of(obj).attr("__name__"))));
-  const auto a = py::reinterpret_borrow<py::array>(obj);
+  const auto a = py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
+                                                : py::array(py::reinterpret_borrow<py::buffer>(obj));
   const auto kind = a.dtype().kind();
   if (kind != 'f')
     throw py::type_error(std::string(name) + ": expected float32 or float64 values, got dtype " +
@@ -64,10 +71,11 @@ floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 
-/** Rows of \a a (N x 3, float64) as PCL points; NaN rows stay (as missing points). Raises
- * when no row is finite. */
+/** Rows of \a a (N x 3, float64) times \a scale as PCL points; NaN rows stay (as missing
+ * points). Raises when no row is finite. */
 Cloud::Ptr
-toCloud(const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name)
+toCloud(const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name,
+        double scale = 1.0)
 {
   const auto n = static_cast<std::size_t>(a.size() / 3);
   Cloud::Ptr cloud(new Cloud);
@@ -76,9 +84,9 @@ toCloud(const py::array_t<double, py::array::c_style | py::array::forcecast>& a,
   std::size_t finite = 0;
   for (std::size_t i = 0; i < n; ++i) {
     auto& p = (*cloud)[i];
-    p.x = static_cast<float>(d[3 * i]);
-    p.y = static_cast<float>(d[3 * i + 1]);
-    p.z = static_cast<float>(d[3 * i + 2]);
+    p.x = static_cast<float>(scale * d[3 * i]);
+    p.y = static_cast<float>(scale * d[3 * i + 1]);
+    p.z = static_cast<float>(scale * d[3 * i + 2]);
     finite += std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
   }
   cloud->is_dense = finite == n;
@@ -95,18 +103,70 @@ vector3(const Eigen::Vector3f& v)
   return a;
 }
 
-std::optional<Eigen::Vector3f>
-optionalVector(const std::optional<std::vector<double>>& v, const char* name)
+// ------------------------------------------------------------------- one vocabulary
+
+/** A Python keyword value as a command-line value: numbers exactly, sequences as "a,b,c". */
+std::string
+optionText(const py::handle& v)
 {
-  if (!v)
-    return std::nullopt;
-  if (v->size() != 3 || !std::isfinite((*v)[0]) || !std::isfinite((*v)[1]) ||
-      !std::isfinite((*v)[2]))
-    throw py::value_error(std::string(name) + ": expected 3 finite numbers");
-  const Eigen::Vector3f u((*v)[0], (*v)[1], (*v)[2]);
-  if (!(u.norm() > 0.f))
-    throw py::value_error(std::string(name) + ": must not be the zero vector");
-  return u;
+  const auto one = [](const py::handle& x) -> std::string {
+    if (py::isinstance<py::bool_>(x))
+      return x.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::int_>(x))
+      return std::string(py::str(x));
+    if (py::isinstance<py::float_>(x)) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", x.cast<double>());
+      return buf;
+    }
+    if (py::isinstance<py::str>(x))
+      return x.cast<std::string>();
+    // numpy scalars and the like
+    return std::string(py::str(x));
+  };
+  if (py::isinstance<py::str>(v) || !py::isinstance<py::sequence>(v))
+    return one(v);
+  std::string out;
+  for (const auto& x : py::reinterpret_borrow<py::sequence>(v))
+    out += (out.empty() ? "" : ",") + one(x);
+  return out;
+}
+
+/** Keyword arguments as the tools' words: name_with_underscores=value becomes
+ * --name-with-underscores=value; True a switch, False and None nothing. */
+void
+appendOptions(std::vector<std::string>& words, const py::dict& options)
+{
+  for (const auto& [key, value] : options) {
+    const std::string name = "--" + std::regex_replace(key.cast<std::string>(), std::regex("_"), "-");
+    if (value.is_none())
+      continue;
+    if (py::isinstance<py::bool_>(value)) {
+      if (value.cast<bool>())
+        words.push_back(name);
+      continue;
+    }
+    words.push_back(name + "=" + optionText(value));
+  }
+}
+
+/** A tool's message in Python's words: --radius-limits is radius_limits. */
+std::string
+pythonWords(std::string message)
+{
+  message = std::regex_replace(message, std::regex("--units mm"), "units=\"mm\"");
+  message = std::regex_replace(message, std::regex("--units m\\b"), "units=\"m\"");
+  message = std::regex_replace(message, std::regex(" \\(see -h\\)"), "");
+  std::string out;
+  const std::regex option("--([a-z][a-z0-9-]*)");
+  auto begin = std::sregex_iterator(message.begin(), message.end(), option);
+  std::size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    out += message.substr(last, static_cast<std::size_t>(it->position()) - last);
+    out += std::regex_replace(it->str(1), std::regex("-"), "_");
+    last = static_cast<std::size_t>(it->position() + it->length());
+  }
+  return out + message.substr(last);
 }
 
 // ---------------------------------------------------------------------------- results
@@ -116,32 +176,24 @@ struct PyCylinder {
   facyl::CylinderModel model;
 };
 
-py::dict
-cylinderDict(const facyl::CylinderModel& m)
-{
-  py::dict d;
-  d["point_on_axis"] = vector3(m.point_on_axis);
-  d["axis"] = vector3(m.axis);
-  d["radius"] = m.radius;
-  d["height"] = m.height;
-  return d;
-}
-
 // ------------------------------------------------------------------- normals, curvatures
 
 void
 checkK(int k, std::size_t points)
 {
   if (k < 3 || k > 1000)
-    throw py::value_error("k: " + std::to_string(k) + " is not in [3, 1000]");
+    throw py::value_error("neighbours: " + std::to_string(k) + " is not in [3, 1000]");
   if (points < static_cast<std::size_t>(k))
     throw py::value_error("points: " + std::to_string(points) + " rows are fewer than k = " +
-                          std::to_string(k));
+                          std::to_string(k) + " neighbours");
 }
 
 py::tuple
-estimateNormalsCurvatures(const py::object& points, int k)
+estimateNormalsCurvatures(const py::object& points, int neighbours, const std::optional<int>& k_alias)
 {
+  if (k_alias && neighbours != 16 && *k_alias != neighbours)
+    throw py::value_error("give neighbours once (k is its old spelling)");
+  const int k = k_alias ? *k_alias : neighbours;
   const auto a = floatArray(points, "points", 3);
   const Cloud::Ptr cloud = toCloud(a, "points");
   checkK(k, cloud->size());
@@ -175,54 +227,44 @@ estimateNormalsCurvatures(const py::object& points, int k)
 
 // ------------------------------------------------------------------------------- fitting
 
-/** facyl_fit's settings (its defaults but the radius limits) and k. */
-struct FitSettings : facyl_cli::HoughSettings {
-  int k{16};
-};
+using FitSettings = facyl_cli::FitSettings;
 
+/** facyl_fit's settings from the keywords (facyl_fit's options, same names with '_', same
+ * defaults, same checks). \throws py::value_error. */
 FitSettings
-fitSettings(const std::pair<double, double>& radius_limits, const std::string& prior,
-            const std::optional<std::vector<double>>& up, int max_cylinders,
-            const std::string& voting, int k, const std::optional<double>& distance_threshold,
-            long long seed)
+fitSettings(const py::dict& options)
 {
+  std::vector<std::string> words;
+  appendOptions(words, options);
   FitSettings s;
-  if (!facyl::parseOrientationPrior(prior, s.prior))
-    throw py::value_error("prior: '" + prior +
-                          "' is not uniform, vertical, vertical-strong or horizontal");
-  if (!facyl::parseVotingMode(voting, s.params.voting_mode))
-    throw py::value_error("voting: '" + voting + "' is not soft-curvature, soft-normal or rabbani");
-  if (const auto u = optionalVector(up, "up"))
-    s.up = *u;
-  if (!(radius_limits.first >= 0.0 && radius_limits.second > radius_limits.first &&
-        radius_limits.second <= 1e4))
-    throw py::value_error("radius_limits: expected (min, max) with 0 <= min < max <= 1e4 (m)");
-  s.params.radius_min = static_cast<float>(radius_limits.first);
-  s.params.radius_max = static_cast<float>(radius_limits.second);
-  if (max_cylinders < 1 || max_cylinders > 100)
-    throw py::value_error("max_cylinders: " + std::to_string(max_cylinders) + " is not in [1, 100]");
-  s.params.max_cylinders = static_cast<std::size_t>(max_cylinders);
-  if (distance_threshold) {
-    if (!(*distance_threshold > 0.0 && *distance_threshold < 1e4))
-      throw py::value_error("distance_threshold: expected a positive number of metres or None");
-    s.params.distance_threshold = static_cast<float>(*distance_threshold);
+  try {
+    const facyl_cli::Arguments args(words, facyl_cli::fitValueOptions(), facyl_cli::fitSwitches(),
+                                    facyl_cli::fitAliases());
+    if (!args.positional().empty())
+      throw std::invalid_argument("unexpected value " + args.positional()[0]);
+    if (args.has("--method") || args.has("--threads") || args.has("--radius-min") ||
+        args.has("--radius-max"))
+      throw std::invalid_argument("unknown option --" +
+                                  std::string(args.has("--method")    ? "method"
+                                              : args.has("--threads") ? "threads"
+                                              : args.has("--radius-min") ? "radius-min"
+                                                                         : "radius-max") +
+                                  " (facyl_fit only; here: radius_limits=(min, max))");
+    facyl_cli::applyFitOptions(args, s);
   }
-  if (seed < 0)
-    throw py::value_error("seed: must be >= 0");
-  s.seed = static_cast<std::uint64_t>(seed);
-  s.k = k;
-  const std::string why = facyl::validate(s.params);
-  if (!why.empty())
-    throw py::value_error(why);
+  catch (const std::invalid_argument& e) {
+    throw py::value_error(pythonWords(e.what()));
+  }
   return s;
 }
 
-/** The fit of facyl_fit (apps/cylinder_fit.h): cues estimated unless \a normals. */
+/** The fit of facyl_fit (apps/cylinder_fit.h) on \a cloud (already in metres): cues estimated
+ * unless \a normals. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
          const FitSettings& s)
 {
-  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.k, 0, normals);
+  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, 0, normals);
   if (cues->size() != cloud->size())
     return {};
   return facyl_cli::houghFit(cloud, cues, s);
@@ -250,31 +292,34 @@ toNormals(const py::object& normals, std::size_t rows)
 }
 
 std::vector<PyCylinder>
-fitCylinders(const py::object& points, const py::object& normals,
-             const std::pair<double, double>& radius_limits, const std::string& prior,
-             const std::optional<std::vector<double>>& up, int max_cylinders,
-             const std::string& voting, int k, const std::optional<double>& distance_threshold,
-             long long seed)
+fitCylinders(const py::object& points, const py::object& normals, const py::dict& options)
 {
   const auto a = floatArray(points, "points", 3);
-  const Cloud::Ptr cloud = toCloud(a, "points");
+  const FitSettings s = fitSettings(options);
+  // Millimetres are converted in double precision, before the points become floats.
+  const float to_metres = facyl_cli::metresPerUnit(s.units);
+  const Cloud::Ptr cloud = toCloud(a, "points", s.units == facyl_cli::Units::Millimetres ? 1e-3 : 1.0);
   const auto given = toNormals(normals, cloud->size());
-  checkK(k, cloud->size());
-  const FitSettings s = fitSettings(radius_limits, prior, up, max_cylinders, voting, k,
-                                    distance_threshold, seed);
+  checkK(s.neighbours, cloud->size());
+  const std::string units = facyl_cli::unitsProblem(*cloud, s.units, "units=\"mm\"", "units=\"m\"");
+  if (!units.empty())
+    throw py::value_error("points: " + units);
   std::vector<facyl::CylinderModel> models;
   {
     py::gil_scoped_release release;
     models = fitCloud(cloud, given, s);
   }
   std::vector<PyCylinder> out;
-  for (auto& m : models)
+  for (auto& m : models) {
+    facyl_cli::scaleModel(m, 1.f / to_metres);
     out.push_back({std::move(m)});
+  }
   return out;
 }
 
 /** Median milliseconds of \a repeats calls of the same fit inside C++ (no Python between
- * them): the reference for the binding's overhead. */
+ * them): the reference for the binding's overhead (radius limits 0.01-0.25 m, as
+ * python/bench_binding.py calls fit_cylinders). */
 double
 timeFitInCpp(const py::object& points, int repeats, int k)
 {
@@ -283,8 +328,10 @@ timeFitInCpp(const py::object& points, int repeats, int k)
   checkK(k, cloud->size());
   if (repeats < 1 || repeats > 100000)
     throw py::value_error("repeats: must be in [1, 100000]");
-  const FitSettings s = fitSettings({0.01, 0.25}, "uniform", std::nullopt, 1, "soft-curvature",
-                                    k, std::nullopt, 0);
+  py::dict options;
+  options["radius_limits"] = py::make_tuple(0.01, 0.25);
+  options["neighbours"] = k;
+  const FitSettings s = fitSettings(options);
   std::vector<double> ms;
   py::gil_scoped_release release;
   for (int r = 0; r < repeats; ++r) {
@@ -347,35 +394,9 @@ frameCloud(const py::object& points, const py::object& colors, bool& organized)
 }
 
 py::dict
-objectDict(const facyl::RecognizedObject& o, std::size_t id)
-{
-  const auto& e = o.evidence;
-  const auto optional = [](float v) -> py::object {
-    return std::isfinite(v) ? py::object(py::float_(v)) : py::object(py::none());
-  };
-  py::dict d;
-  d["id"] = id;
-  d["support"] = o.cluster.support;
-  d["centroid"] = vector3(o.cluster.centroid);
-  d["n_points"] = o.cluster.indices.indices.size();
-  d["indices"] = py::array_t<std::int64_t>(
-    static_cast<py::ssize_t>(o.cluster.indices.indices.size()),
-    std::vector<std::int64_t>(o.cluster.indices.indices.begin(), o.cluster.indices.indices.end()).data());
-  d["bbox"] = std::vector<int>(o.cluster.box.begin(), o.cluster.box.end());
-  d["p_cylinder"] = optional(e.p_cylinder);
-  d["p_network"] = optional(e.p_network);
-  d["inlier_ratio"] = e.inlier_ratio;
-  d["surface_ratio"] = e.surface_ratio;
-  d["curvature_ratio"] = optional(e.curvature_ratio);
-  d["is_cylinder"] = o.is_cylinder;
-  d["cylinder"] = e.fitted ? py::object(cylinderDict(o.cylinder)) : py::object(py::none());
-  return d;
-}
-
-py::dict
 detect(const py::object& points, const py::object& colors,
-       const std::optional<std::vector<double>>& camera,
-       const std::optional<std::vector<double>>& up, const std::string& model)
+       const std::optional<std::vector<double>>& camera, const py::object& up,
+       const std::string& model, const py::kwargs& options)
 {
   bool organized = false;
   const RgbCloud::Ptr cloud = frameCloud(points, colors, organized);
@@ -390,26 +411,33 @@ detect(const py::object& points, const py::object& colors,
            static_cast<float>(c[3]), static_cast<int>(std::ceil(2 * c[2] + 1)),
            static_cast<int>(std::ceil(2 * c[3] + 1))};
   }
+  // The recognizer's options: facyl_detect's, by the same parser.
+  py::dict all(options);
+  all["up"] = up;
+  all["model"] = model;
+  std::vector<std::string> words;
+  appendOptions(words, all);
+  facyl::TabletopRecognizerParameters params;
+  Eigen::Vector3f up_direction = Eigen::Vector3f::Zero();
   facyl::ShapeClassifier::Ptr classifier;
-  if (model != "none") {
-    const std::string path = model == "default" ? facyl::CylinderClassifier::defaultModelPath() : model;
-    if (path.empty())
-      throw py::value_error("model: the shipped model is not installed; give a path or 'none'");
-    auto c = std::make_shared<facyl::CylinderClassifier>();
-    try {
-      c->load(path);
-    }
-    catch (const std::runtime_error& e) {
-      throw py::value_error(std::string("model: ") + e.what());
-    }
-    classifier = c;
+  try {
+    const facyl_cli::Arguments args(words, facyl_cli::recognizerValueOptions(),
+                                    facyl_cli::recognizerSwitches(),
+                                    facyl_cli::recognizerAliases());
+    if (!args.positional().empty())
+      throw std::invalid_argument("unexpected value " + args.positional()[0]);
+    facyl_cli::applyRecognizerOptions(args, params, up_direction);
+    classifier = facyl_cli::classifierFromOptions(args);
+  }
+  catch (const std::invalid_argument& e) {
+    throw py::value_error(pythonWords(e.what()));
   }
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setParameters(params);
   rec.setInputCloud(cloud);
   rec.setCamera(cam);
   rec.setClassifier(classifier);
-  if (const auto u = optionalVector(up, "up"))
-    rec.setUpDirection(*u);
+  rec.setUpDirection(up_direction);
   std::vector<facyl::RecognizedObject> objects;
   bool ok = false;
   {
@@ -418,31 +446,16 @@ detect(const py::object& points, const py::object& colors,
   }
   if (!ok)
     throw py::value_error("detect: recognition failed (see the message printed above)");
-  py::dict out;
-  const auto& t = rec.getTableCoefficients().values;
-  py::dict table;
-  table["coefficients"] = std::vector<float>(t.begin(), t.end());
-  table["found"] = rec.tableFound();
-  out["table"] = table;
-  py::list supports;
-  for (const auto& s : rec.getSupports()) {
-    py::dict sd;
-    sd["coefficients"] = std::vector<float>(s.plane.data(), s.plane.data() + 4);
-    supports.append(sd);
+  // facyl_detect's JSON, parsed: the same fields with the same meanings (9 digits: floats
+  // exactly).
+  py::dict out = py::module_::import("json").attr("loads")(
+    facyl_cli::sceneJson("", *cloud, rec, objects, rec.getTiming(), 9) + "}");
+  py::list list = out["objects"];
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const auto& idx = objects[i].cluster.indices.indices;
+    list[i]["indices"] = py::array_t<std::int64_t>(
+      static_cast<py::ssize_t>(idx.size()), std::vector<std::int64_t>(idx.begin(), idx.end()).data());
   }
-  out["supports"] = supports;
-  py::list list;
-  for (std::size_t i = 0; i < objects.size(); ++i)
-    list.append(objectDict(objects[i], i));
-  out["objects"] = list;
-  const auto& tm = rec.getTiming();
-  py::dict timing;
-  timing["segmentation"] = tm.segmentation;
-  timing["classification"] = tm.classification;
-  timing["fitting"] = tm.fitting;
-  timing["total"] = tm.total;
-  out["timing_ms"] = timing;
-  out["organized"] = organized;
   return out;
 }
 
@@ -543,17 +556,19 @@ renderTabletopScene(long long seed, const std::string& layout, const std::string
 PYBIND11_MODULE(facyl, m)
 {
   m.doc() = "facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.\n\n"
-            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), metres; NaN rows "
-            "are missing points. Functions release the GIL while they compute.";
+            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), or Open3D "
+            "Vector3dVector; metres (fit_cylinders: units=\"mm\" converts); NaN rows are missing "
+            "points. Keywords are the tools' option names with '_' for '-', with their defaults. "
+            "Functions release the GIL while they compute.";
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
 
   py::class_<PyCylinder>(m, "Cylinder", "A fitted finite cylinder (metres).")
     .def_property_readonly("point_on_axis", [](const PyCylinder& c) { return vector3(c.model.point_on_axis); },
-                           "(3,) float32: the base centre")
+                           "(3,) float32: a point on the axis (the base centre)")
     .def_property_readonly("axis", [](const PyCylinder& c) { return vector3(c.model.axis); },
                            "(3,) float32: unit axis, base to top")
-    .def_property_readonly("radius", [](const PyCylinder& c) { return c.model.radius; }, "radius (m)")
-    .def_property_readonly("height", [](const PyCylinder& c) { return c.model.height; }, "|top - base| (m)")
+    .def_property_readonly("radius", [](const PyCylinder& c) { return c.model.radius; }, "radius (the cloud's units: metres)")
+    .def_property_readonly("height", [](const PyCylinder& c) { return c.model.height; }, "|top - base|")
     .def_property_readonly("base", [](const PyCylinder& c) { return vector3(c.model.base); },
                            "(3,) float32: centre of the lowest inlier section")
     .def_property_readonly("top", [](const PyCylinder& c) { return vector3(c.model.top); },
@@ -562,12 +577,14 @@ PYBIND11_MODULE(facyl, m)
         std::vector<std::int64_t> v(c.model.inliers.begin(), c.model.inliers.end());
         return py::array_t<std::int64_t>(static_cast<py::ssize_t>(v.size()), v.data());
       }, "(K,) int64: row indices of the inliers in points, ascending")
+    .def_property_readonly("n_inliers", [](const PyCylinder& c) { return c.model.inliers.size(); },
+                           "number of inliers (len(inliers))")
     .def_property_readonly("inlier_ratio", [](const PyCylinder& c) { return c.model.inlier_ratio; },
                            "inliers / rows given (paper eq. 4)")
     .def_property_readonly("confidence", [](const PyCylinder& c) { return c.model.confidence; },
                            "share of the orientation evidence its inliers carry, in [0, 1]")
     .def_property_readonly("rms_error", [](const PyCylinder& c) { return c.model.rms_error; },
-                           "RMS distance of the inliers to the surface (m)")
+                           "RMS distance of the inliers to the surface")
     .def_property_readonly("angular_coverage", [](const PyCylinder& c) { return c.model.angular_coverage; },
                            "share of the circumference with inliers")
     .def_property_readonly("coefficients", [](const PyCylinder& c) {
@@ -575,6 +592,9 @@ PYBIND11_MODULE(facyl, m)
         c.model.toCoefficients(mc);
         return py::array_t<float>(7, mc.values.data());
       }, "(7,) float32: PCL's SACMODEL_CYLINDER layout (point on axis, axis direction, radius)")
+    .def("as_dict", [](const PyCylinder& c) {
+        return py::module_::import("json").attr("loads")(facyl_cli::cylinderJson(c.model, false, 9));
+      }, "The fields facyl_fit prints for this cylinder (no inlier indices), as a dict.")
     .def("__repr__", [](const PyCylinder& c) {
         const auto& m = c.model;
         char buf[256];
@@ -586,28 +606,70 @@ PYBIND11_MODULE(facyl, m)
         return std::string(buf);
       });
 
-  m.def("fit_cylinders", &fitCylinders, py::arg("points"), py::arg("normals") = py::none(),
-        py::kw_only(), py::arg("radius_limits") = std::make_pair(0.01, 0.25),
-        py::arg("prior") = "uniform", py::arg("up") = py::none(), py::arg("max_cylinders") = 1,
-        py::arg("voting") = "soft-curvature", py::arg("k") = 16,
-        py::arg("distance_threshold") = py::none(), py::arg("seed") = 0,
-        R"(Fits up to max_cylinders cylinders to points (N, 3), one after another.
+  m.def(
+    "fit_cylinders",
+    [](const py::object& points, const py::object& normals, const py::object& radius_limits,
+       const py::object& prior, const py::object& up, const std::string& voting, int neighbours,
+       int orientations, int accumulators, const py::object& distance_threshold,
+       int max_cylinders, bool outward_normals, long long seed, const std::string& units,
+       const py::object& k) {
+      py::dict o;
+      o["radius_limits"] = radius_limits;
+      o["prior"] = prior;
+      o["up"] = up;
+      o["voting"] = voting;
+      if (!k.is_none() && neighbours != 16)
+        throw py::value_error("give neighbours once (k is its old spelling)");
+      if (k.is_none())
+        o["neighbours"] = neighbours;
+      else
+        o["k"] = k; // the old spelling: messages name it as given
+      o["orientations"] = orientations;
+      o["accumulators"] = accumulators;
+      o["distance_threshold"] = distance_threshold;
+      o["max_cylinders"] = max_cylinders;
+      o["outward_normals"] = outward_normals;
+      o["seed"] = seed;
+      o["units"] = units;
+      return fitCylinders(points, normals, o);
+    },
+    py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
+    py::arg("radius_limits") = py::none(), py::arg("prior") = py::none(),
+    py::arg("up") = py::none(), py::arg("voting") = "soft-curvature", py::arg("neighbours") = 16,
+    py::arg("orientations") = 450, py::arg("accumulators") = 1,
+    py::arg("distance_threshold") = py::none(), py::arg("max_cylinders") = 1,
+    py::arg("outward_normals") = false, py::arg("seed") = 0, py::arg("units") = "auto",
+    py::arg("k") = py::none(),
+    R"(Fits up to max_cylinders cylinders to points (N, 3), one after another: facyl_fit's fit,
+with facyl_fit's options under the same names ('_' for '-') and the same defaults.
 
-The two-step Hough estimator of facyl_fit: normals and principal curvatures of the k nearest
-neighbours (unless normals (N, 3) are given), orientation votes weighted by curvature
+The two-step Hough estimator: normals and principal curvatures of the neighbours nearest
+points (unless normals (N, 3) are given), orientation votes weighted by curvature
 (voting="soft-curvature", paper eq. 3; "soft-normal"; "rabbani": hard votes), a circle Hough
 for position and radius, least-squares refinement.
 
-radius_limits: (min, max) in metres, default (0.01, 0.25). prior: orientation prior "uniform"
-(default), "vertical", "vertical-strong" or "horizontal" about up (default (0, 0, 1)).
-distance_threshold: inlier distance in metres (default None: estimated from the residuals).
-seed: seed of the randomized accumulator (same seed, same result). Returns a list of Cylinder,
-best first; empty when no cylinder is found. Raises ValueError/TypeError for bad input.)");
+points, normals: numpy arrays (N, 3) or Open3D Vector3dVector (pcd.points, pcd.normals).
+radius_limits: (min, max), default None: (0.01, 0.25) m as in every facyl tool (cans to
+buckets); "auto": 0 to twice the extent of the data across each candidate axis (pipes,
+tanks). up: gravity's opposite in the cloud's frame (default None: unknown). prior:
+orientation prior "uniform", "vertical", "vertical-strong" or "horizontal" about up ((0, 0, 1)
+when not given); default None: "vertical" when up is given, else "uniform" (detect() knows
+the table: vertical in its frame). neighbours: k of the normal and curvature estimation
+(default 16; k= is its old spelling). orientations: accumulator cells N_d (450).
+accumulators: independent accumulators (1). distance_threshold: inlier distance (default
+None: estimated from the residuals). outward_normals: inliers' normals must point away from
+the axis (default False). seed: seed of the randomized accumulator (same seed, same result).
+units: facyl works in metres. "auto" (default): metres, and a cloud evidently in millimetres
+(spanning more than 20 units) or radius limits beyond 1 raise ValueError; "m": metres, no
+check; "mm": points, lengths given and results in millimetres (converted to metres for the
+fit and back).
+Returns a list of Cylinder, best first; empty when no cylinder is found. Raises
+ValueError/TypeError for bad input.)");
 
   m.def("estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),
-        py::arg("k") = 16,
-        R"(Normals and principal curvatures of points (N, 3) from their k nearest neighbours
-(default 16), in one pass (facyl's NormalCurvatureEstimation). Returns (normals (N, 3),
+        py::arg("neighbours") = 16, py::kw_only(), py::arg("k") = py::none(),
+        R"(Normals and principal curvatures of points (N, 3) from their nearest neighbours
+(default 16; k= is the old spelling), in one pass (facyl's NormalCurvatureEstimation). Returns (normals (N, 3),
 principal_directions (N, 3), k_max (N,), k_min (N,)) as float32: unit normals, the unit
 direction of largest normal change, and k_max >= k_min >= 0, the eigenvalues of the covariance
 of the neighbours' normals projected on the tangent plane (PCL's pc1, pc2: dimensionless,
@@ -618,14 +680,21 @@ larger for tighter bends). NaN rows for points without a usable neighbourhood.)"
         R"(The tabletop pipeline of facyl_detect on one frame: table, objects on it, cylinders.
 
 points: an organized frame (H, W, 3) in the camera frame (x right, y down, z forward; NaN
-where the sensor has no depth), or (N, 3) with camera=(fx, fy, cx, cy) for the objects' pixel
-boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite, optional.
-model: "default" (the shipped shape classifier), "none", or a path to an .onnx with its .cfg.
-Returns a dict with the fields of facyl_detect's JSON ("table", "supports", "objects" with
-"p_cylinder", "is_cylinder", "cylinder" ..., "timing_ms"); objects also carry "indices" (rows
-of the flattened frame). A frame without any support is not an error: "table" then has
-"found" False and no coefficients, "supports" is empty and the objects have support -1.
-Raises ValueError for bad input.)");
+where the sensor has no depth; metres), or (N, 3) with camera=(fx, fy, cx, cy) for the
+objects' pixel boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite,
+optional. model: "default" (the shipped shape classifier), "none", or a path to an .onnx with
+its .cfg. Any other keyword is one of facyl_detect's recognizer options with '_' for '-':
+radius_limits=(0.01, 0.25), prior="vertical" (in the table frame), voting=, neighbours=16,
+orientations=450, distance_threshold=, min_score=0.5, min_probability=0.3, reject_below=0.1,
+max_cylinders_per_cluster=3, clustering="edge-aware", support="standing", any_normal_sign=True,
+... (same defaults and checks; facyl_detect -h lists them).
+Returns facyl_detect's JSON object as a dict, the same fields with the same meanings:
+"organized", "table" {"coefficients": [a, b, c, d] of the table plane in the cloud's frame
+with a unit normal towards the sensor, or None; "found"}, "supports", "objects" (each with
+"cylinder": the fields of Cylinder.as_dict(), or None), "timing_ms"; objects also carry
+"indices" (int64 rows of the flattened frame). A frame without any support is not an error:
+"table" then has "found" False and coefficients None, "supports" is empty and the objects have
+support -1. Raises ValueError for bad input.)");
 
   m.def("simulate_cylinder", &simulateCylinder, py::kw_only(), py::arg("radius") = 0.3,
         py::arg("height") = 1.0, py::arg("axis") = std::vector<double>{0, 0, 1},
@@ -647,5 +716,5 @@ sector). Returns {"points": (N, 3), "normals": (N, 3), "is_lid": (N,), "truth": 
         py::arg("k") = 16,
         "Median ms of fit_cylinders' C++ work (default settings) repeated inside C++: the "
         "reference for the binding's overhead.");
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = FACYL_VERSION;
 }

@@ -540,6 +540,58 @@ TEST(RealData, TheTutorialMug)
               objects.size(), cylinders, radius);
   EXPECT_EQ(cylinders, 1u);
   EXPECT_NEAR(radius, 0.039f, 0.003f);
+  // One object for the mug (its inside joined to it; the handle may be a fragment of its own),
+  // its base on the table and its axis pointing away from it.
+  const auto& t = rec.getTableCoefficients().values;
+  const Eigen::Vector4f table(t[0], t[1], t[2], t[3]);
+  for (const auto& o : objects)
+    if (o.is_cylinder) {
+      EXPECT_GT(o.cylinder.axis.dot(table.head<3>()), 0.99f);
+      EXPECT_NEAR(table.head<3>().dot(o.cylinder.point_on_axis) + table[3], 0.f, 0.01f);
+      EXPECT_GT(table.head<3>().dot(o.cylinder.top) + table[3], 0.08f); // the mug is ~10 cm
+      EXPECT_GT(o.cluster.indices.indices.size(), 10000u);
+    }
+}
+
+TEST(TabletopCylinderRecognizer, BaseOnTheSupportAxisAwayFromIt)
+{
+  // Standing cans: base on the table, axis up. Lying cans: the axis towards the camera's side.
+  // Without a support: up is against the image rows.
+  std::size_t upright = 0, lying = 0;
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  for (const std::uint64_t seed : {3u, 4u, 5u, 6u}) {
+    const facyl::RenderedScene s = scene(seed);
+    Cloud::Ptr cloud(new Cloud(s.cloud));
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    ASSERT_TRUE(rec.recognize(objects));
+    const Eigen::Vector4f table = s.table_plane;
+    for (const auto& o : objects) {
+      if (!o.is_cylinder)
+        continue;
+      const float along = o.cylinder.axis.dot(table.head<3>());
+      if (along > 0.9f) {
+        ++upright;
+        EXPECT_NEAR(table.head<3>().dot(o.cylinder.point_on_axis) + table[3], 0.f, 0.015f);
+        EXPECT_EQ(o.cylinder.point_on_axis, o.cylinder.base);
+      }
+      else if (std::abs(along) < 0.1f) {
+        ++lying;
+        EXPECT_GE(o.cylinder.axis.dot(-0.5f * (o.cylinder.base + o.cylinder.top)), 0.f);
+      }
+      EXPECT_GT(along, -0.1f) << "seed " << seed; // never into the table
+    }
+  }
+  EXPECT_GE(upright, 6u);
+  EXPECT_GE(lying, 1u);
+  facyl::CylinderModel m;
+  m.axis = Eigen::Vector3f(0.f, 1.f, 0.f); // pointing down the image
+  m.base = m.point_on_axis = Eigen::Vector3f(0.f, -0.1f, 1.f);
+  m.top = Eigen::Vector3f(0.f, 0.f, 1.f);
+  facyl::orientCylinder(m, Eigen::Vector3f(0.f, -1.f, 0.f), Eigen::Vector3f::Zero());
+  EXPECT_EQ(m.axis, Eigen::Vector3f(0.f, -1.f, 0.f));
+  EXPECT_EQ(m.point_on_axis, Eigen::Vector3f(0.f, 0.f, 1.f));
+  EXPECT_EQ(m.top, Eigen::Vector3f(0.f, -0.1f, 1.f));
 }
 
 TEST(RealData, MosdLabelledScenes)

@@ -1,10 +1,15 @@
 #!/usr/bin/python3
 """facyl_viewer under xvfb-run (CTest viewer_screenshots): screenshots of a simulated scene
 with --detect, --compare-pcl and --accumulator are written at the asked size, and the accepted
-cylinders are drawn (in the cylinder green) where the ground truth puts the cylinders. Also:
-a missing file and no display give clear messages. Skipped (exit 77) without xvfb-run.
+cylinders are drawn (in the cylinder green) where the ground truth puts the cylinders. A frame
+without any support shows its objects (no table). On PCL's real scenes (REAL_DATA/pcl, when
+given and there; VIEWPOINT 0 0 0 0 1 0 0, PCL's grabber habit, which once turned the cloud
+away from everything drawn on it): the mug of the tutorial scene is covered by the cylinder
+green and the table outline is drawn; the laptop and the box of the grabber frame get red
+boxes and the floor its outline. Also: a missing file and no display give clear messages.
+Skipped (exit 77) without xvfb-run.
 
-    viewer_screenshots.py FACYL_VIEWER FACYL_SYNTH FACYL_DETECT
+    viewer_screenshots.py FACYL_VIEWER FACYL_SYNTH FACYL_DETECT [REAL_DATA]
 """
 import json
 import os
@@ -21,6 +26,7 @@ if not shutil.which("xvfb-run"):
 import cv2  # python3-opencv
 
 viewer, synth, detect = sys.argv[1], sys.argv[2], sys.argv[3]
+real = sys.argv[4] if len(sys.argv) > 4 else ""
 failures = []
 
 
@@ -41,6 +47,28 @@ def shot(args, out, size):
 def green(img):
     b, g, r = (img[..., i].astype(int) for i in range(3))
     return (g > 90) & (g > 1.5 * r) & (g > 1.5 * b)
+
+
+def red(img):
+    """The boxes of objects that are not cylinders."""
+    b, g, r = (img[..., i].astype(int) for i in range(3))
+    return (r > 180) & (g < 70) & (b < 70)
+
+
+def blue(img):
+    """The table outline (0.2, 0.5, 1.0)."""
+    b, g, r = (img[..., i].astype(int) for i in range(3))
+    return (b > 200) & (r < 110) & (g > 80) & (g < 180)
+
+
+def write_pcd_frame(path, points):
+    """An organized (480, 640, 3) frame as an ASCII PCD (NaN without depth)."""
+    h, w = points.shape[:2]
+    with open(path, "w") as f:
+        f.write(f"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {w}\n"
+                f"HEIGHT {h}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {w * h}\nDATA ascii\n")
+        for x, y, z in points.reshape(-1, 3):
+            f.write("nan nan nan\n" if not np.isfinite(z) else f"{x:.6g} {y:.6g} {z:.6g}\n")
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -95,6 +123,58 @@ with tempfile.TemporaryDirectory() as tmp:
     if img is not None:
         thirds = [img[:, k * 300:(k + 1) * 300] for k in range(3)]
         check("--accumulator: three voting modes drawn", all(t.std() > 5 for t in thirds))
+
+    # A frame without any support (the table and background blanked): its objects are shown,
+    # the cylinders green where they are, no table outline; exit 0.
+    try:
+        import open3d as o3d
+    except ImportError:
+        o3d = None
+    if o3d is not None and cylinders:
+        pts = np.asarray(o3d.io.read_point_cloud(scene, remove_nan_points=False).points)
+        pts = pts.reshape(480, 640, 3).copy()
+        pts[(ids == 0) | (ids == 1)] = np.nan
+        floating = os.path.join(tmp, "floating.pcd")
+        write_pcd_frame(floating, pts)
+        r, img = shot([floating], os.path.join(tmp, "floating.png"), (640, 480))
+        ok = r.returncode == 0 and img is not None and img.shape[:2] == (480, 640)
+        check("no support: exit 0, objects shown", ok, f"exit {r.returncode} {r.stderr[-300:]}")
+        if ok:
+            share = green(img)[np.isin(ids, cylinders)].mean()
+            check("no support: cylinder green on the true cylinders, no table outline",
+                  share > 0.3 and blue(img).sum() < 20,
+                  f"green share {share:.2f}, {blue(img).sum()} outline pixels")
+
+    # PCL's real scenes: grabber frames whose VIEWPOINT turns them by 180 degrees about x.
+    tutorial = os.path.join(real, "pcl", "table_scene_mug_stereo_textured.pcd") if real else ""
+    grabber = os.path.join(real, "pcl", "grabber_frame_laptop_box.pcd") if real else ""
+    if tutorial and os.path.exists(tutorial):
+        r, img = shot([tutorial], os.path.join(tmp, "tutorial.png"), (640, 480))
+        ok = r.returncode == 0 and img is not None and img.shape[:2] == (480, 640)
+        check("tutorial scene: drawn", ok, f"exit {r.returncode} {r.stderr[-300:]}")
+        if ok:
+            # The frame's own camera: screenshot pixels are the frame's pixels. The mug's body
+            # lies at u 345..435, v 255..375 of the frame (by hand), its handle right of it.
+            g = green(img)
+            body = np.zeros(g.shape, bool)
+            body[255:375, 345:435] = True
+            around = np.zeros(g.shape, bool)
+            around[233:394, 312:497] = True
+            check("tutorial scene: the mug is covered by the cylinder green",
+                  g[body].mean() > 0.4 and g[~around].mean() < 0.01,
+                  f"green {g[body].mean():.2f} on the mug, {g[~around].mean():.4f} elsewhere")
+            check("tutorial scene: the table outline is drawn", blue(img).sum() > 300,
+                  f"{blue(img).sum()} outline pixels")
+    else:
+        print("skip PCL's tutorial scene: REAL_DATA/pcl not given or absent")
+    if grabber and os.path.exists(grabber):
+        r, img = shot([grabber], os.path.join(tmp, "grabber.png"), (640, 480))
+        ok = r.returncode == 0 and img is not None and img.shape[:2] == (480, 640)
+        check("grabber frame: drawn", ok, f"exit {r.returncode} {r.stderr[-300:]}")
+        if ok:
+            check("grabber frame: red boxes (laptop, box) and the floor's outline",
+                  red(img).sum() > 300 and blue(img).sum() > 300,
+                  f"{red(img).sum()} box pixels, {blue(img).sum()} outline pixels")
 
     # Clear messages, no crash.
     r, _ = shot([scene + ".missing"], os.path.join(tmp, "none.png"), (320, 240))

@@ -2,12 +2,20 @@
 """Reads a point cloud with Open3D, fits cylinders with facyl and draws them.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/fit_open3d.py data/default_cylinder.pcd
-        [--max-cylinders N] [--screenshot out.png | --no-window]
+        [--max-cylinders N] [--radius-limits A,B] [--units auto|m|mm]
+        [--screenshot OUT.png [--size W,H] | --no-window]
 
-Open3D reads the file (PCD, PLY, ...); facyl fits; each finite cylinder is drawn as an Open3D
-mesh (green) over the points (inliers red). Open3D has no cylinder detection of its own.
+Open3D reads the file (PCD, PLY, ...); facyl fits (Open3D's points go to facyl as they are,
+NaN rows of organized frames included: inliers index the file's points); each cylinder is
+drawn as a green wireframe from its base to its top (no surface that would hide the red
+inliers on it or the points inside) over the finite points (grey; inliers red). The view is
+the sensor's: from the origin along +z, image y down, as RGB-D frames and PCL's tools have
+it. Open3D has no cylinder detection of its own.
+--screenshot renders off-screen (under xvfb-run without a screen); its path must end in
+.png and must not be the input (exit 2, nothing written).
 """
 import argparse
+import os
 import sys
 
 import numpy as np
@@ -15,66 +23,141 @@ import open3d as o3d
 
 import facyl
 
+GREEN = (0.1, 0.8, 0.2)
+RED = (0.9, 0.1, 0.1)
+GREY = (0.6, 0.6, 0.6)
 
-def cylinder_mesh(c, resolution=40):
-    """An Open3D mesh of facyl Cylinder c (from its base to its top)."""
-    mesh = o3d.geometry.TriangleMesh.create_cylinder(radius=float(c.radius),
-                                                     height=float(max(c.height, 1e-3)),
-                                                     resolution=resolution)
-    # Open3D's cylinder is centred at the origin along z: rotate z onto the axis, move to the
-    # middle of base and top.
-    z = np.array([0.0, 0.0, 1.0])
+
+def cylinder_lines(c, segments=36, generators=24, rings=6):
+    """An Open3D wireframe of facyl Cylinder c from its base to its top: rings and generators
+    (lines hide no point: the red inliers on the surface and the lid points stay visible)."""
     a = np.asarray(c.axis, float)
-    v = np.cross(z, a)
-    s, cos = np.linalg.norm(v), float(np.dot(z, a))
-    if s < 1e-9:
-        rot = np.eye(3) if cos > 0 else np.diag([1.0, -1.0, -1.0])
-    else:
-        vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-        rot = np.eye(3) + vx + vx @ vx * ((1 - cos) / s ** 2)
-    mesh.rotate(rot, center=(0, 0, 0))
-    mesh.translate((np.asarray(c.base, float) + np.asarray(c.top, float)) / 2)
-    mesh.compute_vertex_normals()
-    mesh.paint_uniform_color([0.1, 0.8, 0.2])
-    return mesh
+    a /= np.linalg.norm(a)
+    u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    base, top = np.asarray(c.base, float), np.asarray(c.top, float)
+    if np.linalg.norm(top - base) < 1e-9:
+        top = base + a * max(float(c.height), 1e-3)
+    t = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    circle = float(c.radius) * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
+    vertices, lines = [], []
+    for k in range(rings + 1):
+        centre = base + (top - base) * k / rings
+        first = len(vertices)
+        vertices.extend(centre + circle)
+        lines += [[first + i, first + (i + 1) % segments] for i in range(segments)]
+    step = segments // generators
+    last = rings * segments
+    lines += [[i * step, last + i * step] for i in range(generators)]
+    wire = o3d.geometry.LineSet(o3d.utility.Vector3dVector(np.array(vertices)),
+                                o3d.utility.Vector2iVector(np.array(lines)))
+    wire.paint_uniform_color(GREEN)
+    return wire
+
+
+def sensor_camera(vis, points, width, height):
+    """Puts Open3D's camera where an RGB-D sensor is: at the origin looking along +z, image y
+    down, with a field of view that holds 96 % of the points. False when the cloud is not in
+    a sensor's frame (most points not in front of the origin)."""
+    ahead = points[points[:, 2] > 1e-6]
+    if len(ahead) < 0.5 * len(points):
+        return False
+    tx, ty = np.abs(ahead[:, 0] / ahead[:, 2]), np.abs(ahead[:, 1] / ahead[:, 2])
+    half = max(np.percentile(tx, 98) / width, np.percentile(ty, 98) / height) * 1.05
+    f = 0.5 / max(half, 1e-6)
+    f = min(max(f, 0.5 * height / np.tan(np.radians(44))), 0.5 * height / np.tan(np.radians(3)))
+    param = vis.get_view_control().convert_to_pinhole_camera_parameters()
+    param.intrinsic = o3d.camera.PinholeCameraIntrinsic(width, height, f, f, width / 2 - 0.5,
+                                                        height / 2 - 0.5)
+    param.extrinsic = np.eye(4)
+    return vis.get_view_control().convert_from_pinhole_camera_parameters(param)
+
+
+def same_file(a, b):
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("file")
     ap.add_argument("--max-cylinders", type=int, default=1)
+    ap.add_argument("--radius-limits", help="A,B (default: facyl's, 0 to twice the extent)")
+    ap.add_argument("--units", default="auto", choices=["auto", "m", "mm"])
     ap.add_argument("--screenshot", help="render off-screen to this PNG instead of a window")
+    ap.add_argument("--size", default="800,600", help="screenshot size W,H (default 800,600)")
     ap.add_argument("--no-window", action="store_true", help="print the fit only")
+    ap.add_argument("--version", action="version", version=f"fit_open3d (facyl) {facyl.__version__}")
     args = ap.parse_args()
+    if args.screenshot is not None:
+        if not args.screenshot.lower().endswith(".png"):
+            ap.exit(2, f"fit_open3d: --screenshot {args.screenshot}: a screenshot is a PNG image; "
+                       "give a path ending in .png. Nothing was written.\n")
+        if same_file(args.screenshot, args.file):
+            ap.exit(2, f"fit_open3d: --screenshot {args.screenshot}: is also the input; facyl "
+                       "never writes over its inputs. Nothing was written.\n")
+    radius_limits = None
+    if args.radius_limits:
+        try:
+            radius_limits = tuple(float(x) for x in args.radius_limits.split(","))
+        except ValueError:
+            ap.exit(2, f"fit_open3d: --radius-limits: expected A,B, got {args.radius_limits!r}\n")
+    try:
+        width, height = (int(x) for x in args.size.split(","))
+    except ValueError:
+        ap.exit(2, f"fit_open3d: --size: expected W,H, got {args.size!r}\n")
+
     pcd = o3d.io.read_point_cloud(args.file)
     points = np.asarray(pcd.points)
     if len(points) == 0:
         sys.exit(f"fit_open3d: {args.file}: no points (not a point cloud Open3D can read?)")
-    normals = np.asarray(pcd.normals) if pcd.has_normals() else None
-    cylinders = facyl.fit_cylinders(points, normals, max_cylinders=args.max_cylinders)
+    try:
+        cylinders = facyl.fit_cylinders(pcd.points, pcd.normals if pcd.has_normals() else None,
+                                        max_cylinders=args.max_cylinders,
+                                        radius_limits=radius_limits, units=args.units)
+    except ValueError as e:
+        sys.exit(f"fit_open3d: {args.file}: {e}")
     for c in cylinders:
         print(c)
     if not cylinders:
         print("fit_open3d: no cylinder found")
     if args.no_window:
         return
-    colors = np.full((len(points), 3), 0.6)
+
+    # What is drawn: the finite points only (NaN rows would make Open3D's view box NaN and the
+    # picture empty), grey, the inliers red.
+    colors = np.tile(GREY, (len(points), 1))
     for c in cylinders:
-        colors[c.inliers] = [0.9, 0.1, 0.1]
-    pcd.colors = o3d.utility.Vector3dVector(colors)
-    geometries = [pcd] + [cylinder_mesh(c) for c in cylinders]
+        colors[c.inliers] = RED
+    finite = np.isfinite(points).all(axis=1)
+    shown = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points[finite]))
+    shown.colors = o3d.utility.Vector3dVector(colors[finite])
+    geometries = [shown] + [cylinder_lines(c) for c in cylinders]
     if args.screenshot:
         vis = o3d.visualization.Visualizer()
-        vis.create_window(visible=False, width=800, height=600)
+        if not vis.create_window(visible=False, width=width, height=height):
+            sys.exit("fit_open3d: cannot open an off-screen window (no display? run under "
+                     "xvfb-run -a)")
         for g in geometries:
             vis.add_geometry(g)
+        if not sensor_camera(vis, points[finite], width, height):
+            view = vis.get_view_control()
+            view.set_lookat(np.median(points[finite], axis=0))
+            view.set_front([0.0, 0.0, -1.0])
+            view.set_up([0.0, -1.0, 0.0])
+        vis.get_render_option().point_size = 2.0
+        vis.get_render_option().line_width = 2.0
         vis.poll_events()
         vis.update_renderer()
         vis.capture_screen_image(args.screenshot, do_render=True)
         vis.destroy_window()
         print(f"fit_open3d: wrote {args.screenshot}")
     else:
-        o3d.visualization.draw_geometries(geometries)
+        o3d.visualization.draw_geometries(geometries, lookat=np.median(points[finite], axis=0),
+                                          front=[0.0, 0.0, -1.0], up=[0.0, -1.0, 0.0], zoom=0.6)
 
 
 if __name__ == "__main__":

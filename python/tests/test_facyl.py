@@ -1,8 +1,10 @@
 """pytest suite of the Python module (CTest python_bindings). Environment: PYTHONPATH with the
-built module, FACYL_FIT (the facyl_fit binary), FACYL_DATA (the repository's data/),
-FACYL_EXAMPLE (examples/python/fit_open3d.py)."""
+built module, FACYL_FIT and FACYL_DETECT (the tools), FACYL_DATA (the repository's data/),
+FACYL_EXAMPLE (examples/python/fit_open3d.py), FACYL_REAL_DATA (../shared/data/real; the tests
+that use it skip without it)."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -15,6 +17,10 @@ import facyl
 
 DATA = os.environ.get("FACYL_DATA", "")
 FACYL_FIT = os.environ.get("FACYL_FIT", "")
+FACYL_DETECT = os.environ.get("FACYL_DETECT", "")
+REAL = os.environ.get("FACYL_REAL_DATA", "")
+TUTORIAL = os.path.join(REAL, "pcl", "table_scene_mug_stereo_textured.pcd")
+SODA_CAN = os.path.join(REAL, "uw_objects", "soda_can_2_1_45.pcd")
 
 
 def cylinder(seed=3, radius=0.05, noise=0.01, points=900, random_axis=True, **kw):
@@ -59,15 +65,81 @@ def test_same_result_as_facyl_fit_for_the_same_seed():
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "c.pcd")
         write_pcd(path, pts)
-        out = subprocess.run([FACYL_FIT, "--seed", "7", "--radius-min", "0.01", "--radius-max",
-                              "0.25", path], check=True, capture_output=True, text=True).stdout
+        out = subprocess.run([FACYL_FIT, "--seed", "7", "--radius-limits", "0.01,0.25", path],
+                             check=True, capture_output=True, text=True).stdout
     ref = json.loads(out)["cylinders"][0]
-    c = facyl.fit_cylinders(pts, seed=7)[0]
+    c = facyl.fit_cylinders(pts, seed=7, radius_limits=(0.01, 0.25))[0]
     # facyl_fit prints 6 significant digits; the fit itself is the same computation.
     assert c.radius == pytest.approx(ref["radius"], rel=1e-5)
     assert np.allclose(c.axis, ref["axis"], atol=1e-5)
     assert np.allclose(c.point_on_axis, ref["point_on_axis"], atol=1e-5)
-    assert len(c.inliers) == ref["inliers"]
+    assert c.n_inliers == len(c.inliers) == ref["n_inliers"]
+    # One vocabulary: Cylinder's fields are facyl_fit's, in its order.
+    assert list(c.as_dict().keys()) == list(ref.keys())
+
+
+@pytest.mark.skipif(not FACYL_FIT, reason="FACYL_FIT (facyl_fit binary) not given")
+def test_defaults_are_facyl_fits():
+    """No settings given: the same fit as facyl_fit without options (issue 20: the same UW soda
+    can gave 32.8 mm there and 36.3 mm here: facyl_fit's radius limits were 0 to twice the
+    data's extent, Python's 0.01-0.25 m; now both 0.01-0.25 m, "auto" the other)."""
+    clouds = [("simulated", None)]
+    if os.path.exists(SODA_CAN):
+        clouds.append(("UW soda can", SODA_CAN))
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, path in clouds:
+            if path is None:
+                path = os.path.join(tmp, "c.pcd")
+                write_pcd(path, cylinder(seed=12, noise=0.02)["points"].astype(np.float32))
+            ref = json.loads(subprocess.run([FACYL_FIT, path], check=True, capture_output=True,
+                                            text=True).stdout)["cylinders"][0]
+            o3d = pytest.importorskip("open3d") if path == SODA_CAN else None
+            pts = (np.asarray(o3d.io.read_point_cloud(path).points) if o3d else
+                   cylinder(seed=12, noise=0.02)["points"].astype(np.float32))
+            c = facyl.fit_cylinders(pts)[0]
+            assert c.radius == pytest.approx(ref["radius"], rel=1e-5), name
+
+
+def test_open3d_vectors_are_taken_as_they_are():
+    o3d = pytest.importorskip("open3d")
+    sim = cylinder(seed=4)
+    pcd = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(sim["points"].astype(np.float64)))
+    pcd.normals = o3d.utility.Vector3dVector(sim["normals"].astype(np.float64))
+    a = facyl.fit_cylinders(pcd.points, pcd.normals)[0]
+    b = facyl.fit_cylinders(np.asarray(pcd.points), np.asarray(pcd.normals))[0]
+    assert a.radius == b.radius and np.array_equal(a.inliers, b.inliers)
+    n = facyl.estimate_normals_curvatures(pcd.points)[0]
+    assert n.shape == (len(sim["points"]), 3)
+
+
+# ------------------------------------------------------------------------------- units
+
+def test_millimetres_are_refused_or_converted():
+    """facyl works in metres (issue 20: the same can gave 41.3 mm in millimetres, 36.3 mm in
+    metres). A cloud evidently in millimetres, or radius limits beyond 1 m, raise ValueError
+    saying so; units="mm" converts and converts back: the metre fit, in millimetres."""
+    sim = cylinder(seed=8, radius=0.04, noise=0.005)
+    pts = sim["points"].astype(np.float64)
+    with pytest.raises(ValueError, match="metres"):
+        facyl.fit_cylinders(pts * 1000)
+    with pytest.raises(ValueError, match=r'units="mm"'):
+        facyl.fit_cylinders(pts * 1000, radius_limits=(10, 250), units="auto")
+    with pytest.raises(ValueError, match="radius_limits"):
+        facyl.fit_cylinders(pts, radius_limits=(10, 250))
+    metres = facyl.fit_cylinders(pts, radius_limits=(0.01, 0.25))[0]
+    mm = facyl.fit_cylinders(pts * 1000, radius_limits=(10, 250), units="mm")[0]
+    assert mm.radius == pytest.approx(1000 * metres.radius, rel=1e-4)
+    assert mm.height == pytest.approx(1000 * metres.height, rel=1e-3)
+    assert np.allclose(mm.point_on_axis, 1000 * metres.point_on_axis, atol=0.1)
+    assert np.array_equal(mm.inliers, metres.inliers)
+    # units="m": no check (a large cylinder in metres).
+    big = facyl.simulate_cylinder(radius=3.0, height=20.0, points=2000, seed=1)["points"]
+    with pytest.raises(ValueError, match="metres"):
+        facyl.fit_cylinders(big * 10)
+    assert facyl.fit_cylinders(big, units="m", radius_limits="auto")[0].radius == \
+        pytest.approx(3.0, rel=0.02)
+    with pytest.raises(ValueError, match="units"):
+        facyl.fit_cylinders(pts, units="inches")
 
 
 def test_float64_float32_fortran_and_nan_rows_give_the_same_fit():
@@ -82,6 +154,17 @@ def test_float64_float32_fortran_and_nan_rows_give_the_same_fit():
     c = facyl.fit_cylinders(with_nan)[0]
     assert c.inliers.min() >= 5
     assert c.radius == pytest.approx(ref.radius, rel=1e-3)
+
+
+def test_radius_limits_auto_and_the_prior_rule():
+    big = facyl.simulate_cylinder(radius=0.6, height=2.0, points=2000, seed=3)["points"]
+    assert facyl.fit_cylinders(big) == [] or facyl.fit_cylinders(big)[0].radius <= 0.25
+    assert facyl.fit_cylinders(big, radius_limits="auto")[0].radius == pytest.approx(0.6, rel=0.02)
+    # up given, prior not: vertical about up (one rule with detect(), which knows the table).
+    sim = cylinder(seed=2, random_axis=False)
+    a = facyl.fit_cylinders(sim["points"], up=(0, 0, 1), seed=1)[0]
+    b = facyl.fit_cylinders(sim["points"], up=(0, 0, 1), prior="vertical", seed=1)[0]
+    assert a.radius == b.radius and np.array_equal(a.inliers, b.inliers)
 
 
 def test_several_cylinders():
@@ -120,6 +203,10 @@ def test_detect_on_a_rendered_frame():
     assert scene["points"].shape == (480, 640, 3) and scene["colors"].dtype == np.uint8
     out = facyl.detect(scene["points"], scene["colors"])
     assert out["table"]["found"]
+    # The table plane: a, b, c, d in the cloud's frame, unit normal towards the sensor (at the
+    # origin here: d > 0).
+    a, b, c, d = out["table"]["coefficients"]
+    assert np.linalg.norm([a, b, c]) == pytest.approx(1, abs=1e-5) and d > 0
     assert len(out["table"]["coefficients"]) == 4
     cylinders = [o for o in out["objects"] if o["is_cylinder"]]
     assert len(cylinders) >= 3
@@ -134,6 +221,41 @@ def test_detect_on_a_rendered_frame():
     unorganized = facyl.detect(flat[keep], camera=scene["camera"], model="none")
     assert not unorganized["organized"]
     assert sum(o["is_cylinder"] for o in unorganized["objects"]) >= 3
+
+
+@pytest.mark.skipif(not FACYL_DETECT or not DATA, reason="FACYL_DETECT / FACYL_DATA not given")
+def test_detect_has_facyl_detects_fields():
+    """One vocabulary: detect() returns facyl_detect's JSON (plus "indices" per object)."""
+    o3d = pytest.importorskip("open3d")
+    path = os.path.join(DATA, "default_scene.pcd")
+    ref = json.loads(subprocess.run([FACYL_DETECT, path], check=True, capture_output=True,
+                                    text=True).stdout)
+    pcd = o3d.io.read_point_cloud(path, remove_nan_points=False)
+    colors = (np.asarray(pcd.colors) * 255).round().astype(np.uint8).reshape(480, 640, 3)
+    out = facyl.detect(np.asarray(pcd.points).reshape(480, 640, 3), colors)
+    assert set(out) == set(ref) - {"file"}
+    assert len(out["objects"]) == len(ref["objects"])
+    for o, r in zip(out["objects"], ref["objects"]):
+        assert set(o) == set(r) | {"indices"}
+        assert (o["cylinder"] is None) == (r["cylinder"] is None)
+        if o["cylinder"]:
+            assert list(o["cylinder"]) == list(r["cylinder"])
+            assert o["cylinder"]["radius"] == pytest.approx(r["cylinder"]["radius"], rel=1e-5)
+
+
+def test_detect_takes_the_recognizers_options():
+    scene = facyl.render_tabletop_scene(seed=20, layout="cluttered")
+    out = facyl.detect(scene["points"], scene["colors"], model="none",
+                       radius_limits=(0.01, 0.2), min_score=0.5, neighbours=16, voting="soft-curvature")
+    assert sum(o["is_cylinder"] for o in out["objects"]) >= 3
+    strict = facyl.detect(scene["points"], scene["colors"], model="none", min_score=0.99)
+    assert sum(o["is_cylinder"] for o in strict["objects"]) < sum(o["is_cylinder"] for o in out["objects"])
+    with pytest.raises(ValueError, match=r"min_score: 2 is not in \[0, 1\]"):
+        facyl.detect(scene["points"], min_score=2)
+    with pytest.raises(ValueError, match="unknown option sideways_prior"):
+        facyl.detect(scene["points"], sideways_prior=True)
+    with pytest.raises(ValueError, match="prior"):
+        facyl.detect(scene["points"], prior="sideways")
 
 
 def test_bundled_scene_matches_facyl_detect():
@@ -171,6 +293,10 @@ def test_bad_points(bad, error, message):
     ({"voting": "majority"}, "voting"),
     ({"max_cylinders": 0}, "max_cylinders"),
     ({"k": 2}, "k: 2"),
+    ({"neighbours": 2}, "neighbours: 2"),
+    ({"k": 12, "neighbours": 14}, "neighbours once"),
+    ({"units": "cm"}, "units"),
+    ({"orientations": 0}, "orientations"),
     ({"distance_threshold": -1.0}, "distance_threshold"),
     ({"seed": -3}, "seed"),
     ({"up": (0, 0, 0)}, "up"),
@@ -228,6 +354,36 @@ def test_help_reads_well():
 
 
 # ---------------------------------------------------------------------------- example
+
+def test_open3d_example_screenshot_of_the_tutorial_scene():
+    """fit_open3d.py --screenshot on PCL's tutorial scene (issue 20: all white, NaN points made
+    Open3D's view box NaN; opaque end caps hid the points): the finite points are drawn from
+    the sensor, the inliers red and the cylinder a green wireframe over them."""
+    pytest.importorskip("open3d", reason="python3-open3d is not installed")
+    cv2 = pytest.importorskip("cv2")
+    example = os.environ.get("FACYL_EXAMPLE")
+    if not example or not os.path.exists(TUTORIAL):
+        pytest.skip("FACYL_EXAMPLE or the real tutorial scene (FACYL_REAL_DATA) not given")
+    if not shutil.which("xvfb-run"):
+        pytest.skip("xvfb-run is not installed")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "shot.png")
+        r = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1600x1200x24", sys.executable,
+                            example, TUTORIAL, "--screenshot", out, "--size", "640,480"],
+                           capture_output=True, text=True, env=dict(os.environ), timeout=300)
+        assert r.returncode == 0, r.stderr[-500:]
+        img = cv2.imread(out)
+    assert img is not None and img.shape[:2] == (480, 640)
+    b, g, r_ = (img[..., i].astype(int) for i in range(3))
+    white = (b > 245) & (g > 245) & (r_ > 245)
+    red = (r_ > 180) & (g < 80) & (b < 80)
+    green = (g > 150) & (r_ < 100) & (b < 120)
+    grey = (abs(r_ - g) < 12) & (abs(g - b) < 12) & (r_ > 120) & (r_ < 190)
+    assert white.mean() < 0.5, f"{white.mean():.2f} of the picture is white"
+    assert grey.mean() > 0.2, "the scene's points are not drawn"
+    assert red.mean() > 0.01, f"inliers: {red.mean():.4f} of the picture is red"
+    assert green.sum() > 200, f"{green.sum()} green pixels"
+
 
 def test_open3d_example():
     pytest.importorskip("open3d", reason="python3-open3d is not installed: example skipped")

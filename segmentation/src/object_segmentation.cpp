@@ -76,19 +76,40 @@ private:
 class Grid {
 public:
   Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
-       const ObjectSegmentationParameters& p)
-  : cloud_(cloud), w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
+       const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr)
+  : w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
     slot_(cloud.size(), -1)
   {
+    std::size_t valid = 0;
+    for (const auto& q : cloud)
+      valid += finite(q);
+    // The noise's half-width by range, every 5 mm up to 12 m.
+    constexpr float kBin = 0.005f;
+    constexpr std::size_t kBins = 2400;
+    std::vector<float> noise_half;
+    if (noise) {
+      noise_half.resize(kBins);
+      for (std::size_t b = 0; b < kBins; ++b)
+        noise_half[b] = noise->halfWidth((static_cast<float>(b) + 0.5f) * kBin);
+    }
+    pixel_.reserve(valid);
+    xyz_.reserve(valid);
+    u_.reserve(valid);
+    v_.reserve(valid);
+    range_.reserve(valid);
+    gap2_.reserve(valid);
     for (std::size_t i = 0; i < cloud.size(); ++i)
       if (finite(cloud[i])) {
         slot_[i] = static_cast<int>(pixel_.size());
         pixel_.push_back(i);
+        xyz_.push_back(cloud[i].getVector3fMap());
         u_.push_back(static_cast<int>(i % static_cast<std::size_t>(w_)));
         v_.push_back(static_cast<int>(i / static_cast<std::size_t>(w_)));
-        const float r = (cloud[i].getVector3fMap() - viewpoint).norm();
+        const float r = (xyz_.back() - viewpoint).norm();
         range_.push_back(r);
-        const float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
+        float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
+        if (noise) // neighbours on one surface differ by the sensor's noise: never a jump
+          gap = std::max(gap, noise_half[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
         gap2_.push_back(gap * gap);
       }
   }
@@ -121,10 +142,10 @@ public:
       return -1;
     return slot_[static_cast<std::size_t>(v) * w_ + u];
   }
-  Eigen::Vector3f
+  const Eigen::Vector3f&
   point(int c) const
   {
-    return cloud_[pixel(c)].getVector3fMap();
+    return xyz_[static_cast<std::size_t>(c)];
   }
   float
   range(int c) const
@@ -160,10 +181,10 @@ public:
   }
 
 private:
-  const pcl::PointCloud<pcl::PointXYZ>& cloud_;
   int w_, h_;
   std::vector<int> slot_;
   std::vector<std::size_t> pixel_;
+  std::vector<Eigen::Vector3f> xyz_; ///< per valid pixel: its point
   std::vector<int> u_, v_;
   std::vector<float> range_, gap2_;
 };
@@ -277,6 +298,8 @@ public:
     size_(static_cast<std::size_t>(count), 0), boundary_(static_cast<std::size_t>(count), 0)
   {
     std::iota(group_.begin(), group_.end(), 0);
+    // The pairs of neighbours across segment borders, then summed per pair of segments.
+    std::vector<std::pair<std::uint64_t, std::uint8_t>> pairs; // (labels, connected)
     for (int i = 0; i < static_cast<int>(grid_.size()); ++i) {
       const int a = label_[static_cast<std::size_t>(i)];
       ++size_[static_cast<std::size_t>(a)];
@@ -287,11 +310,17 @@ public:
           if (b == a)
             return;
           ++boundary_[static_cast<std::size_t>(a)];
-          auto& link = links_[key(a, b)];
-          ++link.all;
-          link.connected += grid_.linked(i, j);
+          pairs.emplace_back(key(a, b), static_cast<std::uint8_t>(grid_.linked(i, j)));
         },
         [&] { ++boundary_[static_cast<std::size_t>(a)]; });
+    }
+    std::sort(pairs.begin(), pairs.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (const auto& [k, connected] : pairs) {
+      if (links_.empty() || links_.back().first != k)
+        links_.emplace_back(k, Link{});
+      ++links_.back().second.all;
+      links_.back().second.connected += connected;
     }
   }
 
@@ -299,24 +328,33 @@ public:
   void
   mergeNeighbours(std::size_t min_fragment, float enclosed_share)
   {
-    for (bool changed = true; changed;) {
+    // Each pass joins every segment to its best neighbour at once; chains of fragments need a
+    // pass per link. A noisy frame can shatter into thousands of fragments: after kMaxPasses
+    // the few still apart are left to the cluster size limits.
+    constexpr int kMaxPasses = 12;
+    bool changed = true;
+    for (int pass = 0; changed && pass < kMaxPasses; ++pass) {
       changed = false;
-      const auto stats = groupStats();
-      for (const auto& [g, s] : stats) {
-        if (find(g) != g)
-          continue; // merged in this pass already
+      const GroupStats stats = groupStats();
+      for (int g = 0; g < static_cast<int>(stats.size.size()); ++g) {
+        const auto gs = static_cast<std::size_t>(g);
+        if (stats.size[gs] == 0 || find(g) != g)
+          continue; // not a group, or merged in this pass already
         int best = -1;
         std::size_t best_links = 0;
-        for (const auto& [h, link] : s.links)
-          if (find(h) != g && link.connected > best_links && stats.at(h).size >= s.size)
-            best = h, best_links = link.connected;
+        for (std::size_t l = stats.first[gs]; l < stats.first[gs + 1]; ++l) {
+          const GroupLink& link = stats.links[l];
+          if (find(link.to) != g && link.connected > best_links &&
+              stats.size[static_cast<std::size_t>(link.to)] >= stats.size[gs])
+            best = link.to, best_links = link.connected;
+        }
         if (best < 0)
           continue;
-        const bool fragment = s.size < min_fragment;
+        const bool fragment = stats.size[gs] < min_fragment;
         const bool enclosed =
-          static_cast<float>(best_links) >= enclosed_share * static_cast<float>(s.boundary);
+          static_cast<float>(best_links) >= enclosed_share * static_cast<float>(stats.boundary[gs]);
         if (fragment || enclosed) {
-          group_[static_cast<std::size_t>(g)] = find(best);
+          group_[gs] = find(best);
           changed = true;
         }
       }
@@ -376,9 +414,16 @@ private:
     std::size_t all{0};       ///< 4-neighbour pairs across the border
     std::size_t connected{0}; ///< of which without a depth discontinuity
   };
+  /** A link from one group to another, summed over their labels. */
+  struct GroupLink {
+    int from{0}, to{0};
+    std::size_t all{0}, connected{0};
+  };
+  /** Per group (indexed by its root label; size 0 for other labels): size, boundary, and its
+   * links to other groups, links[first[g] .. first[g + 1]). */
   struct GroupStats {
-    std::size_t size{0}, boundary{0};
-    std::map<int, Link> links; ///< to other groups
+    std::vector<std::size_t> size, boundary, first;
+    std::vector<GroupLink> links;
   };
 
   static std::uint64_t
@@ -403,25 +448,45 @@ private:
     return a;
   }
 
-  std::map<int, GroupStats>
+  GroupStats
   groupStats()
   {
-    std::map<int, GroupStats> stats;
-    for (std::size_t s = 0; s < size_.size(); ++s) {
-      auto& g = stats[find(static_cast<int>(s))];
-      g.size += size_[s];
-      g.boundary += boundary_[s];
+    const std::size_t n = size_.size();
+    GroupStats stats;
+    stats.size.assign(n, 0);
+    stats.boundary.assign(n, 0);
+    for (std::size_t s = 0; s < n; ++s) {
+      const auto g = static_cast<std::size_t>(find(static_cast<int>(s)));
+      stats.size[g] += size_[s];
+      stats.boundary[g] += boundary_[s];
     }
     for (const auto& [k, link] : links_) {
       const int g = find(static_cast<int>(k >> 32)), h = find(static_cast<int>(k & 0xffffffffu));
       if (g == h) { // inside one group now: not boundary
-        stats[g].boundary -= link.all;
+        stats.boundary[static_cast<std::size_t>(g)] -= link.all;
         continue;
       }
-      auto& l = stats[g].links[h];
-      l.all += link.all;
-      l.connected += link.connected;
+      stats.links.push_back({g, h, link.all, link.connected});
     }
+    // Summed per pair of groups, grouped by the first.
+    std::sort(stats.links.begin(), stats.links.end(), [](const GroupLink& a, const GroupLink& b) {
+      return a.from != b.from ? a.from < b.from : a.to < b.to;
+    });
+    std::vector<GroupLink> summed;
+    for (const GroupLink& l : stats.links) {
+      if (!summed.empty() && summed.back().from == l.from && summed.back().to == l.to) {
+        summed.back().all += l.all;
+        summed.back().connected += l.connected;
+      }
+      else
+        summed.push_back(l);
+    }
+    stats.links.swap(summed);
+    stats.first.assign(n + 1, 0);
+    for (const GroupLink& l : stats.links)
+      ++stats.first[static_cast<std::size_t>(l.from) + 1];
+    for (std::size_t g = 0; g < n; ++g)
+      stats.first[g + 1] += stats.first[g];
     return stats;
   }
 
@@ -541,7 +606,7 @@ private:
   std::vector<int> label_; ///< per valid pixel
   std::vector<int> group_;
   std::vector<std::size_t> size_, boundary_;
-  std::unordered_map<std::uint64_t, Link> links_;
+  std::vector<std::pair<std::uint64_t, Link>> links_; ///< by pair of labels (key), ascending
 };
 
 } // namespace
@@ -610,11 +675,12 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
 std::vector<pcl::Indices>
 segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                         const std::vector<std::uint8_t>& has_depth, float focal,
-                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p)
+                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
+                        const DepthBand* noise)
 {
   if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
     return {};
-  const Grid grid(cloud, focal, viewpoint, p);
+  const Grid grid(cloud, focal, viewpoint, p, noise);
   if (grid.size() == 0)
     return {};
   const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);

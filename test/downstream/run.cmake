@@ -16,6 +16,7 @@ step(${CMAKE_COMMAND} -S "${DOWNSTREAM_SOURCE_DIR}" -B "${STAGE_DIR}/build"
      "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${EXE_LINKER_FLAGS}")
 step(${CMAKE_COMMAND} --build "${STAGE_DIR}/build")
 step("${STAGE_DIR}/build/facyl_downstream")
+step("${STAGE_DIR}/build/facyl_downstream_xyzi")
 if(DATA_DIR)
   foreach(tool facyl_fit facyl_detect)
     set(input "${DATA_DIR}/default_cylinder.pcd")

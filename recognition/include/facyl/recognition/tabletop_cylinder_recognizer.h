@@ -229,7 +229,8 @@ private:
   void
   usePriorFrameOf(int support);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
-   * container, cut off at its rim) to that one, and recognizes the joined objects again. */
+   * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
+   * that one, which keeps its fit and is classified again as a whole. */
   void
   joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */
@@ -241,11 +242,10 @@ private:
   fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
   Fit
   fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
-  /** Classifies, fits and decides one cluster: one object, or several (the recovery, when \a
-   * recover). */
+  /** Classifies, fits and decides one cluster: one object, or several (recovery). */
   void
   recognizeCluster(TabletopCluster cluster, float p_network,
-                   std::vector<RecognizedObject>& objects, bool recover = true);
+                   std::vector<RecognizedObject>& objects);
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
   std::vector<Fit>
@@ -273,6 +273,14 @@ private:
   std::size_t upright_{0};   ///< index of the estimator with the axis along the support's normal
   bool with_support_{false}; ///< the cluster being fitted has a support
 };
+
+/** \brief The convention of the recognizer's cylinders: the axis runs from the base (
+ * point_on_axis, the end nearest the support) to the top, pointing to the side of \a up (the
+ * support's normal; without a support, an upright camera's up: against the image rows); when
+ * the axis lies across \a up (within about 6 degrees of perpendicular: a lying can), it points
+ * to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
+void
+orientCylinder(CylinderModel& model, const Eigen::Vector3f& up, const Eigen::Vector3f& viewpoint);
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */

@@ -5,6 +5,8 @@
  */
 #pragma once
 
+#include <facyl/segmentation/support_planes.h>
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -79,11 +81,15 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
  * \param has_depth per pixel of the full frame: 1 where the sensor measured depth (table and
  *        background included), to tell an occluder's shadow from visible table.
  * \param focal focal length in pixels (> 0).
+ * \param noise the sensor's noise and bias by range (a support's band), when known: a depth
+ *        discontinuity is then at least its half-width (3 sigma), so that a noisy sensor's
+ *        surfaces do not shatter into fragments.
  * \return the segments' point indices, ascending, in no particular order of segments. */
 std::vector<pcl::Indices>
 segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                         const std::vector<std::uint8_t>& has_depth, float focal,
                         const Eigen::Vector3f& viewpoint,
-                        const ObjectSegmentationParameters& params);
+                        const ObjectSegmentationParameters& params,
+                        const DepthBand* noise = nullptr);
 
 } // namespace facyl

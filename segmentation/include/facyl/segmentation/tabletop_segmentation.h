@@ -198,9 +198,11 @@ struct SupportPlane {
  * them (the family with clearly the most objects standing on its planes), so that any camera
  * roll works without an up direction; an upright camera (supports facing the top of the image)
  * only breaks ties. The table is the candidate of that family with the most object points
- * standing on it; when nothing stands on any, the largest one (tableFound() is then false). A
- * frame without any support (a wall, a close-up) still gets its objects: the compact segments
- * off the large planes, with support -1, tableFound() false and empty table coefficients.
+ * standing on it; when nothing stands on any, the largest one (tableFound() is then false), and
+ * the compact segments off the supports are objects too, with support -1 (a table without
+ * depth: glossy or dark). A frame without any support (a wall, a close-up) still gets its
+ * objects: the compact segments of the frame, with support -1, tableFound() false and empty
+ * table coefficients.
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
@@ -478,9 +480,11 @@ private:
   /** Makes \a trial the result: supports, table, its coefficients and hull. */
   void
   adopt(Trial trial, std::vector<TabletopCluster>& clusters);
-  /** No support in view: the compact segments of the frame are its objects (support -1). */
+  /** No support in view (or none that objects stand on): the compact segments of the frame
+   * (of its points not flagged in \a taken) are objects too, with support -1. */
   void
-  segmentWithoutSupport(std::vector<TabletopCluster>& clusters);
+  segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
+                        const std::vector<std::uint8_t>* taken = nullptr);
   TabletopCluster
   makeCluster(pcl::Indices indices, int support) const;
   void
@@ -499,6 +503,8 @@ private:
     float region{0.f};
   };
   std::vector<Hulls> hulls_;
+  DepthBand noise_;        ///< the band of the largest plane of the last run
+  bool has_noise_{false};
   std::size_t table_{0};
   bool table_found_{false};
   float focal_{0.f}; ///< pixels (organized input)

@@ -161,6 +161,14 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
       applyClassifier(objects, first, p_network[k]);
   }
   joinContainerInsides(objects);
+  for (auto& o : objects) // base nearest the support, axis away from it
+    if (o.evidence.fitted) {
+      const int s = o.cluster.support;
+      const Eigen::Vector3f up =
+        s >= 0 ? Eigen::Vector3f(segmentation_.getSupports()[static_cast<std::size_t>(s)].frame.linear().col(2))
+               : Eigen::Vector3f(0.f, -1.f, 0.f);
+      orientCylinder(o.cylinder, up, viewpoint);
+    }
   timing_.total = ms(t0, Clock::now());
   return true;
 }
@@ -241,6 +249,27 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
            static_cast<float>(within_wall) >= kWithinWall * static_cast<float>(n) && sided > 0 &&
            static_cast<float>(facing) >= kFacingAxis * static_cast<float>(sided);
   };
+  // A small fragment beside a cylinder, within its height and a radius of its wall (a mug's
+  // handle, cut off at the depth jump between handle and body), is a part of it.
+  constexpr float kAttachmentSize = 0.1f, kAttachmentReach = 2.f, kAttached = 0.8f;
+  const auto isAttachment = [&](const RecognizedObject& outer, const RecognizedObject& o) {
+    const auto& idx = o.cluster.indices.indices;
+    if (static_cast<float>(idx.size()) >
+        kAttachmentSize * static_cast<float>(outer.cluster.indices.indices.size()))
+      return false;
+    const CylinderModel& c = outer.cylinder;
+    const Eigen::Vector3f axis = c.axis.normalized();
+    const float height = (c.top - c.base).dot(axis);
+    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
+    std::size_t n = 0, near = 0;
+    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
+      const Eigen::Vector3f d = (*input_)[idx[k]].getVector3fMap() - c.base;
+      const float t = d.dot(axis);
+      near += (d - t * axis).norm() <= kAttachmentReach * c.radius &&
+              t >= -0.2f * c.radius && t <= height + 0.2f * c.radius;
+    }
+    return n > 0 && static_cast<float>(near) >= kAttached * static_cast<float>(n);
+  };
   std::vector<int> host(objects.size(), -1);
   bool any = false;
   for (std::size_t a = 0; a < objects.size(); ++a) {
@@ -251,7 +280,7 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       if (b == a || host[b] >= 0 || host[a] >= 0 ||
           objects[b].cluster.support != outer.cluster.support)
         continue;
-      if (isInside(outer.cylinder, objects[b])) {
+      if (isInside(outer.cylinder, objects[b]) || isAttachment(outer, objects[b])) {
         host[b] = static_cast<int>(a);
         any = true;
       }
@@ -259,8 +288,9 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
   }
   if (!any)
     return;
+  // The joined object keeps the cylinder fitted to the outer wall and its evidence (the fit
+  // already saw the wall); the classifier judges the whole.
   std::vector<RecognizedObject> kept, joined;
-  std::vector<TabletopCluster> merged;
   for (std::size_t a = 0; a < objects.size(); ++a) {
     if (host[a] >= 0)
       continue;
@@ -268,7 +298,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       kept.push_back(std::move(objects[a]));
       continue;
     }
-    TabletopCluster c = objects[a].cluster;
+    RecognizedObject o = std::move(objects[a]);
+    TabletopCluster& c = o.cluster;
     for (std::size_t b = 0; b < objects.size(); ++b)
       if (host[b] == static_cast<int>(a))
         c.indices.indices.insert(c.indices.indices.end(), objects[b].cluster.indices.indices.begin(),
@@ -280,17 +311,22 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     c.centroid = pts.rowwise().mean();
     c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
                                   : projectedBox(pts, camera_);
-    merged.push_back(std::move(c));
+    joined.push_back(std::move(o));
   }
-  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu containers joined with their insides\n",
-            merged.size());
-  const std::vector<float> p_network = classifyClusters(merged);
-  for (std::size_t k = 0; k < merged.size(); ++k) {
-    const std::size_t first = joined.size();
-    usePriorFrameOf(merged[k].support);
-    recognizeCluster(std::move(merged[k]), p_network[k], joined, false);
-    if (classifier_)
-      applyClassifier(joined, first, p_network[k]);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides or "
+            "attachments\n",
+            joined.size());
+  if (classifier_) {
+    std::vector<TabletopCluster> views;
+    for (const auto& o : joined)
+      views.push_back(o.cluster);
+    const std::vector<float> p = classifyClusters(views);
+    for (std::size_t k = 0; k < joined.size(); ++k) {
+      auto& e = joined[k].evidence;
+      e.p_network = p[k];
+      e.p_cylinder = classifier_->fuse(e.p_network, e, params_.decision);
+      joined[k].is_cylinder = acceptCylinder(e, params_.decision);
+    }
   }
   objects = std::move(kept);
   for (auto& o : joined)
@@ -360,8 +396,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
 template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, float p_network,
-                                                     std::vector<RecognizedObject>& objects,
-                                                     bool recover)
+                                                     std::vector<RecognizedObject>& objects)
 {
   using Clock = std::chrono::steady_clock;
   const auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -389,7 +424,7 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
   // does not see as a cylinder as a whole, may hold several objects (each part is then
   // classified on its own view).
   const bool doubted = classifier_ && p_network < params_.decision.min_probability;
-  if (recover && params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
+  if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(input, std::move(best));
     if (!parts.empty()) {
@@ -473,15 +508,17 @@ TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluste
   const Eigen::Vector3f a = model.axis.normalized();
   const float d = model.distance_threshold;
   const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
-  std::vector<std::uint8_t> in_cluster; // membership of the cluster's pixels near the inliers
   std::vector<Eigen::Vector3f> near;
-  const std::unordered_set<pcl::index_t> members(cluster.begin(), cluster.end());
+  // The cluster's indices are ascending: membership by binary search.
+  const auto member = [&cluster](pcl::index_t j) {
+    return std::binary_search(cluster.begin(), cluster.end(), j);
+  };
   for (const auto i : model.inliers) {
     const int u0 = static_cast<int>(i % w), v0 = static_cast<int>(i / w);
     for (int v = v0; v < std::min(h, v0 + stride); ++v)
       for (int u = u0; u < std::min(w, u0 + stride); ++u) {
         const auto j = static_cast<pcl::index_t>(v * w + u);
-        if (!members.count(j))
+        if (!member(j))
           continue;
         const Eigen::Vector3f p = (*input_)[j].getVector3fMap();
         const float rho = distanceToLine(p, model.base, a);

@@ -45,6 +45,7 @@ TabletopSegmentation<PointT>::reset()
   extents_.clear();
   table_ = 0;
   table_found_ = false;
+  has_noise_ = false;
   focal_ = 0.f;
   image_down_.setZero();
   table_coefficients_.values.clear();
@@ -150,6 +151,10 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   else
     findPlanesUnorganized(candidates);
   keepSupportCandidates(candidates);
+  // The sensor's noise by range, as measured on the largest plane: the depth gaps of the object
+  // segmentation are never below it.
+  noise_ = candidates.empty() ? DepthBand{} : candidates.front().band;
+  has_noise_ = !candidates.empty();
   const double t_planes = ms(t0);
   std::vector<SupportPlane> all;
   std::vector<Above> above;
@@ -191,8 +196,22 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   PCL_DEBUG("[facyl::TabletopSegmentation] %.2f ms: planes %.2f, points %.2f, family %zu of "
             "%zu (%zu with supports)\n",
             ms(t0), t_planes, t_points - t_planes, chosen, families.size(), tried);
-  if (best)
+  if (best) {
     adopt(std::move(*best), clusters);
+    if (!table_found_) {
+      // Nothing stands on the supports in view (a table without depth: glossy, dark): the
+      // compact segments off them and off the clusters found are objects too, without a
+      // support.
+      std::vector<std::uint8_t> taken(input_->size(), 0);
+      for (const auto& support : supports_)
+        for (const auto i : support.inliers.indices)
+          taken[static_cast<std::size_t>(i)] = 1;
+      for (const auto& c : clusters)
+        for (const auto i : c.indices.indices)
+          taken[static_cast<std::size_t>(i)] = 1;
+      segmentWithoutSupport(clusters, &taken);
+    }
+  }
   else {
     PCL_DEBUG("[facyl::TabletopSegmentation] no support in view: %zu candidate planes, none "
               "of at least %g m^2\n",
@@ -949,13 +968,14 @@ TabletopSegmentation<PointT>::adopt(Trial trial, std::vector<TabletopCluster>& c
 
 template <typename PointT>
 void
-TabletopSegmentation<PointT>::segmentWithoutSupport(std::vector<TabletopCluster>& clusters)
+TabletopSegmentation<PointT>::segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
+                                                    const std::vector<std::uint8_t>* taken)
 {
   // Every point may belong to an object; objects are the segments of the frame that fit in
   // the object box (max_height in each direction): walls, floors and furniture do not.
   pcl::Indices points;
   for (const auto i : *indices_)
-    if (pcl::isFinite((*input_)[i]))
+    if (pcl::isFinite((*input_)[i]) && !(taken && (*taken)[static_cast<std::size_t>(i)]))
       points.push_back(i);
   std::vector<pcl::Indices> groups;
   cluster(points, groups);
@@ -1024,7 +1044,7 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
     for (std::size_t i = 0; i < input_->size(); ++i)
       has_depth_[i] = pcl::isFinite((*input_)[i]);
     out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
-                                  params_.objects);
+                                  params_.objects, has_noise_ ? &noise_ : nullptr);
     return;
   }
   pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
@@ -1079,7 +1099,8 @@ TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int str
     op.min_gap *= static_cast<float>(stride);
     op.max_gap *= static_cast<float>(stride);
     groups = segmentObjectsOrganized(coarse, has_depth, focal_ / static_cast<float>(stride),
-                                     input_->sensor_origin_.head(3), op);
+                                     input_->sensor_origin_.head(3), op,
+                                     has_noise_ ? &noise_ : nullptr);
   }
   else {
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(coarse));
@@ -1234,7 +1255,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
     }
   }
   const std::vector<pcl::Indices> segments =
-    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects);
+    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects,
+                            has_noise_ ? &noise_ : nullptr);
   // Every object point takes the segment of its pixel.
   std::vector<int> segment_of(n, -1);
   for (std::size_t s = 0; s < segments.size(); ++s)
