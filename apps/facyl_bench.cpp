@@ -111,6 +111,9 @@ struct Method {
   facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
   int sac{pcl::SAC_RANSAC};
   bool axis{false};
+  /** facyl 0.1's refinement: the best candidate alone, on its inliers (point_candidates 0),
+   * to compare with the refinement on the points on the same clouds. */
+  bool inliers_only{false};
 };
 
 std::vector<Method>
@@ -122,6 +125,8 @@ methods(const std::string& setting)
       {"facyl-rabbani", false, VotingMode::Rabbani},
       {"facyl-soft-normal", false, VotingMode::SoftNormal},
       {"facyl-soft-curvature", false, VotingMode::SoftCurvature},
+      {"facyl-soft-curvature-0.1", false, VotingMode::SoftCurvature, OrientationPrior::Uniform,
+       pcl::SAC_RANSAC, false, true},
   };
   if (setting == "paper") { // the axis is vertical: the priors of Table II apply
     m.push_back({"facyl-soft-curvature-mild", false, VotingMode::SoftCurvature,
@@ -255,6 +260,8 @@ runTask(const Task& task, const Level& level, const std::vector<Method>& ms, std
       hough.setVotingMode(m.mode);
       hough.setOrientationPrior(m.prior);
       hough.setRadiusLimits(r_min, r_max);
+      if (m.inliers_only)
+        hough.setPointCandidates(0);
       hough.setSeed(seed * 7919ULL + static_cast<std::uint64_t>(task.scene)); // a fresh draw
       hough.setInputCloud(s.cloud);
       hough.setInputNormals(cues);
