@@ -39,21 +39,68 @@ using Cues = pcl::PointCloud<facyl::NormalCurvature>;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 struct Level {
-  std::string sweep; ///< noise | outliers | occlusion
+  std::string sweep; ///< noise | outliers | occlusion | clutter
   float value;       ///< the swept quantity (noise: sigma / r; outliers: eq. 5; occlusion: eq. 6)
   float noise, lids, occlusion;
 };
+
+/** The level of \a sweep at \a value: the swept quantity, the others at their fixed values
+ * (1% noise, no lids, no occlusion; clutter: lids at 300% and the occlusion \a value). */
+Level
+levelOf(const std::string& sweep, float value)
+{
+  if (sweep == "noise")
+    return {sweep, value, value, 0.f, 0.f};
+  if (sweep == "outliers")
+    return {sweep, value, 0.01f, value, 0.f};
+  if (sweep == "occlusion")
+    return {sweep, value, 0.01f, 0.f, value};
+  if (sweep == "clutter")
+    return {sweep, value, 0.01f, 3.f, value};
+  throw std::invalid_argument("unknown sweep '" + sweep + "'");
+}
+
+/** --levels "SWEEP:V,V,...;SWEEP:V,...": the levels to run instead of the paper's. */
+std::vector<Level>
+parseLevels(const std::string& spec)
+{
+  std::vector<Level> out;
+  std::stringstream groups(spec);
+  for (std::string group; std::getline(groups, group, ';');) {
+    const auto colon = group.find(':');
+    if (colon == std::string::npos)
+      throw std::invalid_argument("--levels wants SWEEP:V,V,...;SWEEP:V,... (got '" + group + "')");
+    const std::string sweep = group.substr(0, colon);
+    std::stringstream values(group.substr(colon + 1));
+    for (std::string v; std::getline(values, v, ',');) {
+      std::size_t used = 0;
+      float value = 0.f;
+      try {
+        value = std::stof(v, &used);
+      }
+      catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != v.size() || !(value >= 0.f) || (sweep != "outliers" && !(value < 1.f)))
+        throw std::invalid_argument("--levels: '" + v + "' is not a level of " + sweep);
+      out.push_back(levelOf(sweep, value));
+    }
+  }
+  if (out.empty())
+    throw std::invalid_argument("--levels names no level");
+  return out;
+}
 
 std::vector<Level>
 levels()
 {
   std::vector<Level> out;
   for (int i = 0; i <= 8; ++i) // noise 0-20% of the radius, 9 levels
-    out.push_back({"noise", 0.025f * i, 0.025f * i, 0.f, 0.f});
+    out.push_back(levelOf("noise", 0.025f * i));
   for (int i = 0; i <= 10; ++i) // lids 0-500%, 11 levels
-    out.push_back({"outliers", 0.5f * i, 0.01f, 0.5f * i, 0.f});
+    out.push_back(levelOf("outliers", 0.5f * i));
   for (int i = 0; i <= 9; ++i) // occlusion 0-90%, 10 levels
-    out.push_back({"occlusion", 0.1f * i, 0.01f, 0.f, 0.1f * i});
+    out.push_back(levelOf("occlusion", 0.1f * i));
   return out;
 }
 
@@ -64,6 +111,9 @@ struct Method {
   facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
   int sac{pcl::SAC_RANSAC};
   bool axis{false};
+  /** facyl 0.1's refinement: the best candidate alone, on its inliers (point_candidates 0),
+   * to compare with the refinement on the points on the same clouds. */
+  bool inliers_only{false};
 };
 
 std::vector<Method>
@@ -75,6 +125,8 @@ methods(const std::string& setting)
       {"facyl-rabbani", false, VotingMode::Rabbani},
       {"facyl-soft-normal", false, VotingMode::SoftNormal},
       {"facyl-soft-curvature", false, VotingMode::SoftCurvature},
+      {"facyl-soft-curvature-0.1", false, VotingMode::SoftCurvature, OrientationPrior::Uniform,
+       pcl::SAC_RANSAC, false, true},
   };
   if (setting == "paper") { // the axis is vertical: the priors of Table II apply
     m.push_back({"facyl-soft-curvature-mild", false, VotingMode::SoftCurvature,
@@ -113,8 +165,8 @@ Scene
 makeScene(const std::string& setting, const Level& level, int scene, std::uint64_t seed)
 {
   // One seed per (setting, scene): every level sees the same cylinders, as in the paper.
-  std::mt19937_64 rng(seed * 1000003ULL + static_cast<std::uint64_t>(scene) * 7919ULL +
-                      (setting == "paper" ? 0ULL : 1ULL));
+  const std::uint64_t salt = setting == "paper" ? 0ULL : setting == "practical" ? 1ULL : 2ULL;
+  std::mt19937_64 rng(seed * 1000003ULL + static_cast<std::uint64_t>(scene) * 7919ULL + salt);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
   facyl::CylinderSimulationParameters p;
   p.lateral_points = 900;
@@ -208,6 +260,8 @@ runTask(const Task& task, const Level& level, const std::vector<Method>& ms, std
       hough.setVotingMode(m.mode);
       hough.setOrientationPrior(m.prior);
       hough.setRadiusLimits(r_min, r_max);
+      if (m.inliers_only)
+        hough.setPointCandidates(0);
       hough.setSeed(seed * 7919ULL + static_cast<std::uint64_t>(task.scene)); // a fresh draw
       hough.setInputCloud(s.cloud);
       hough.setInputNormals(cues);
@@ -248,7 +302,13 @@ printHelp(const char* self)
       "  --scenes N     cylinders per setting (default 1000, as in the paper)\n"
       "  --quick        50 scenes (a smoke test; about a minute on 2 cores)\n"
       "  --settings S   paper,practical (default both): paper = r 0.3 m, vertical axis;\n"
-      "                 practical = random axis, r 0.02-0.3 m, a table-like plane beside it\n"
+      "                 practical = random axis, r 0.02-0.3 m, a table-like plane beside it;\n"
+      "                 random = random axis, r 0.02-0.3 m, nothing else (other cylinders)\n"
+      "  --levels L     levels to run instead of the paper's sweeps, e.g.\n"
+      "                 'noise:0.1,0.15,0.2,0.3;outliers:1,3,5;occlusion:0.75;clutter:0.5'\n"
+      "                 (sweeps noise, outliers, occlusion, and clutter: lids at 300%% with\n"
+      "                 that occlusion; 1%% noise where noise is not swept)\n"
+      "  --methods M    only these methods (comma-separated names as in fits.csv)\n"
       "  --seed S       seed (default 1); the same seed gives the same fits\n"
       "  --threads T    threads (default: all cores)\n"
       "  --out DIR      output folder (default bench_out): fits.csv, summary.md\n"
@@ -268,9 +328,13 @@ main(int argc, char** argv)
   std::uint64_t seed = 1;
   std::string out = "bench_out", dump;
   std::vector<std::string> settings{"paper", "practical"};
+  std::vector<Level> lv = levels();
+  std::string method_filter;
   try {
     const facyl_cli::Arguments args(
-        argc, argv, {"--scenes", "--settings", "--seed", "--threads", "--out", "--dump"},
+        argc, argv,
+        {"--scenes", "--settings", "--seed", "--threads", "--out", "--dump", "--levels",
+         "--methods"},
         {"--quick"});
     dump = args.text("--dump", "");
     if (!args.positional().empty())
@@ -284,10 +348,13 @@ main(int argc, char** argv)
     settings.clear();
     std::stringstream ss(list);
     for (std::string s; std::getline(ss, s, ',');) {
-      if (s != "paper" && s != "practical")
+      if (s != "paper" && s != "practical" && s != "random")
         throw std::invalid_argument("unknown setting '" + s + "'");
       settings.push_back(s);
     }
+    if (args.has("--levels"))
+      lv = parseLevels(args.text("--levels", ""));
+    method_filter = args.text("--methods", "");
   }
   catch (const std::exception& e) {
     std::fprintf(stderr, "facyl_bench: %s\n", e.what());
@@ -301,7 +368,6 @@ main(int argc, char** argv)
   }
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); // "no cylinder" is a result here
 
-  const auto lv = levels();
   if (!dump.empty()) {
     std::stringstream ss(dump);
     std::string setting, sweep, level, scene;
@@ -311,7 +377,8 @@ main(int argc, char** argv)
     std::getline(ss, scene, ',');
     for (const auto& l : lv)
       if (l.sweep == sweep && !level.empty() && std::abs(l.value - std::stof(level)) < 1e-4f &&
-          (setting == "paper" || setting == "practical") && !scene.empty()) {
+          (setting == "paper" || setting == "practical" || setting == "random") &&
+          !scene.empty()) {
         const Scene s = makeScene(setting, l, std::stoi(scene), seed);
         pcl::io::savePCDFileBinary(out + "/scene.pcd", *s.cloud);
         std::printf("{\"file\":%s,\"radius\":%s,\"axis\":%s,\"base\":%s}\n",
@@ -330,8 +397,23 @@ main(int argc, char** argv)
       for (int k = 0; k < scenes; ++k)
         tasks.push_back({s, l, k});
   std::map<std::string, std::vector<Method>> method_sets;
-  for (const auto& s : settings)
+  for (const auto& s : settings) {
     method_sets[s] = methods(s);
+    if (!method_filter.empty()) {
+      auto& ms = method_sets[s];
+      const std::string list = "," + method_filter + ",";
+      ms.erase(std::remove_if(ms.begin(), ms.end(),
+                              [&](const Method& m) {
+                                return list.find("," + m.name + ",") == std::string::npos;
+                              }),
+               ms.end());
+      if (ms.empty()) {
+        std::fprintf(stderr, "facyl_bench: --methods names no method of setting %s\n",
+                     s.c_str());
+        return 2;
+      }
+    }
+  }
   std::vector<std::vector<Fit>> results(tasks.size());
 
   const int workers = facyl::parallelWorkers(tasks.size(), threads, 1);
@@ -383,7 +465,9 @@ main(int argc, char** argv)
         "radius and position in mm; time: median fit time (normals excluded, shared).\n";
   for (const auto& s : settings) {
     const auto& ms = method_sets[s];
-    for (const std::string sweep : {"noise", "outliers", "occlusion"}) {
+    for (const std::string sweep : {"noise", "outliers", "occlusion", "clutter"}) {
+      if (std::none_of(lv.begin(), lv.end(), [&](const Level& l) { return l.sweep == sweep; }))
+        continue;
       md << "\n## " << s << ": " << sweep << "\n\n| method | level | axis (deg) | radius (mm) | "
          << "position (mm) | failures | time (ms) |\n|---|---|---|---|---|---|---|\n";
       std::map<std::pair<std::size_t, std::size_t>, float> median_time;
@@ -421,6 +505,8 @@ main(int argc, char** argv)
         return ms.size();
       };
       const std::size_t soft = find("facyl-soft-curvature"), ransac = find("pcl-ransac");
+      if (soft == ms.size() || ransac == ms.size())
+        continue;
       md << "\nMedian fit time, pcl-ransac / facyl-soft-curvature:";
       for (std::size_t l = 0; l < lv.size(); ++l)
         if (lv[l].sweep == sweep)

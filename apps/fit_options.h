@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -56,7 +57,7 @@ fitValueOptions()
   return {"--method",   "--voting",       "--prior",  "--up",        "--orientations",
           "--accumulators", "--radius-limits", "--radius-min", "--radius-max",
           "--distance-threshold", "--max-cylinders", "--neighbours", "--seed", "--threads",
-          "--units"};
+          "--units", "--point-candidates", "--coarse-scale"};
 }
 
 /** Switches that applyFitOptions reads. */
@@ -74,11 +75,21 @@ fitAliases()
   return {{"--k", "--neighbours"}};
 }
 
+/** \a v as the shortest decimal that reads back as it (0.5, not 0.500000). */
+inline std::string
+compactNumber(float v)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
+  return text;
+}
+
 /** The help lines of those options. */
 inline const char*
 fitOptionsHelp()
 {
-  return "  --radius-limits A,B  radius interval (default 0.01,0.25: cans to buckets, as in\n"
+  static const std::string help = std::string(
+         "  --radius-limits A,B  radius interval (default 0.01,0.25: cans to buckets, as in\n"
          "                       every facyl tool); auto: 0 to twice the extent of the data\n"
          "                       across each candidate axis (pipes, tanks)\n"
          "  --up x,y,z           gravity's opposite in the cloud's frame (default: unknown)\n"
@@ -96,6 +107,11 @@ fitOptionsHelp()
          "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
          "                       pcl-ransac: 1% of the bounding-box diagonal)\n"
          "  --max-cylinders N    cylinders to extract, one after another (default 1)\n"
+         "  --point-candidates N candidates refined and compared on the points (default ") +
+    std::to_string(facyl::HoughCylinderParameters{}.point_candidates) + "; 0:\n"
+         "                       the best alone, refined on its inliers, as facyl 0.1 did)\n"
+         "  --coarse-scale S     at high noise, cues again from neighbours within S radii\n"
+         "                       (default " + compactNumber(facyl::HoughCylinderParameters{}.coarse_scale) + "; 0: never)\n"
          "  --outward-normals    inliers' normals must point away from the axis (normals\n"
          "                       towards a sensor outside the cylinder: excludes a cup's inner\n"
          "                       wall; the tabletop tools' default)\n"
@@ -109,6 +125,7 @@ fitOptionsHelp()
          "                       converted to metres for the fit and back)\n"
          "  (old spellings kept for this release: --radius-min R, --radius-max R, --k K,\n"
          "  --method soft-curvature|soft-normal|rabbani)\n";
+  return help.c_str();
 }
 
 /** Reads the fit options of \a args into \a s.
@@ -194,6 +211,10 @@ applyFitOptions(const Arguments& args, FitSettings& s)
   if (args.has("--outward-normals") && args.has("--any-normal-sign"))
     throw std::invalid_argument("--outward-normals and --any-normal-sign exclude each other");
   s.params.outward_normals = args.has("--outward-normals");
+  s.params.point_candidates = static_cast<std::size_t>(args.integer(
+    "--point-candidates", static_cast<long long>(s.params.point_candidates), 0, 64));
+  s.params.coarse_scale = static_cast<float>(
+    args.number("--coarse-scale", static_cast<double>(s.params.coarse_scale), 0.0, 2.0));
   const std::string why = facyl::validate(s.params);
   if (!why.empty())
     throw std::invalid_argument(why);

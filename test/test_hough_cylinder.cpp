@@ -68,7 +68,8 @@ struct Sweep {
 };
 
 Sweep
-sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = true)
+sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = true,
+      std::size_t point_candidates = facyl::HoughCylinderParameters{}.point_candidates)
 {
   Sweep s;
   for (int run = 0; run < runs; ++run) {
@@ -76,6 +77,7 @@ sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = tru
     Hough hough;
     hough.setVotingMode(mode);
     hough.setRefine(refine);
+    hough.setPointCandidates(point_candidates);
     hough.setRadiusLimits(0.01f, 0.5f);
     const auto o = fitOnce(sim.cloud.makeShared(), sim.truth, hough);
     s.axis_deg.push_back(o.axis_deg);
@@ -83,10 +85,11 @@ sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = tru
     s.failures += o.axis_deg > 10.f;
   }
   // The figures, for the record (ctest -V or running the test binary shows them).
-  std::printf("[ figures  ] %s lids %.0f%% noise %.0f%% refine %d, %d fits: axis error median "
-              "%.3f deg, p90 %.3f deg, %d off by > 10 deg; radius error median %.3f%%\n",
+  std::printf("[ figures  ] %s lids %.0f%% noise %.0f%% refine %d point candidates %zu, %d "
+              "fits: axis error median %.3f deg, p90 %.3f deg, %d off by > 10 deg; radius error "
+              "median %.3f%%\n",
               facyl::toString(mode).c_str(), 100.f * lid_ratio, 100.f * noise, refine ? 1 : 0,
-              runs, quantile(s.axis_deg, 0.5), quantile(s.axis_deg, 0.9), s.failures,
+              point_candidates, runs, quantile(s.axis_deg, 0.5), quantile(s.axis_deg, 0.9), s.failures,
               100.f * quantile(s.radius_rel, 0.5));
   return s;
 }
@@ -130,6 +133,28 @@ TEST(HoughCylinderEstimation, SoftCurvatureBeatsRabbaniWithLids)
   EXPECT_GT(rabbani.failures, 20);
   EXPECT_LT(soft.failures, rabbani.failures);
   EXPECT_LT(quantile(soft.axis_deg, 0.5), quantile(rabbani.axis_deg, 0.5));
+}
+
+TEST(HoughCylinderEstimation, HoldsAtHighNoise)
+{
+  // Issue 17: random axes, radius 0.02-0.3 m, no lids, Gaussian noise at 10-30% of the radius.
+  // The failure rates (axis off by > 10 deg) of the issue's targets, on 60 seeded clouds per
+  // level, and never more failures than the best candidate refined on its inliers alone
+  // (facyl 0.1: 13-52% failures on these levels in facyl_bench) on the same clouds.
+  constexpr int kRuns = 60;
+  const std::vector<std::pair<float, float>> targets{
+      {0.10f, 0.02f}, {0.15f, 0.05f}, {0.20f, 0.10f}, {0.30f, 0.35f}};
+  for (const auto& [noise, rate] : targets) {
+    const Sweep now = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns);
+    const Sweep before = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns, true, 0);
+    EXPECT_LE(now.failures, static_cast<int>(rate * kRuns)) << "noise " << noise;
+    EXPECT_LE(now.failures, before.failures) << "noise " << noise;
+    if (noise == 0.10f) {
+      EXPECT_LT(quantile(now.axis_deg, 0.5), 0.7f);
+      // The radius from 900 points with sigma = 0.1 r: well within 2% (median).
+      EXPECT_LT(quantile(now.radius_rel, 0.5), 0.02f);
+    }
+  }
 }
 
 TEST(HoughCylinderEstimation, RefinementRemovesCellQuantisation)

@@ -5,6 +5,8 @@
  */
 #include "fitting_detail.h"
 
+#include <facyl/features/point_cues.h>
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -42,6 +44,10 @@ validate(const HoughCylinderParameters& p)
     why << "max cylinders must be at least 1";
   else if (p.circle_grid < 8 || p.circle_grid > 4096)
     why << "circle grid " << p.circle_grid << " is not in [8, 4096]";
+  else if (!(p.noisy_cues_ratio > 0.f) || !std::isfinite(p.noisy_cues_ratio))
+    why << "noisy cues ratio " << p.noisy_cues_ratio << " is not a finite value > 0";
+  else if (!(p.coarse_scale >= 0.f) || !(p.coarse_scale <= 2.f))
+    why << "coarse scale " << p.coarse_scale << " is not in [0, 2]";
   return why.str();
 }
 
@@ -91,6 +97,8 @@ struct Candidate {
   float radius{0.f};
   float threshold{0.f};
   float radius_limit{std::numeric_limits<float>::infinity()}; ///< given or from the data
+  float normal_angle{0.f}; ///< inliers' largest normal angle (0: params.normal_angle_threshold)
+  float scale{0.f};        ///< robust sigma of the points' distances, once settled (0: unknown)
 };
 
 /** Robust noise estimate: 1.4826 MAD of the surface distances of the points near it. */
@@ -273,9 +281,9 @@ describe(const CylinderCues& cues, const std::vector<int>& active, const Candida
   m.point_on_axis = c.point_on_axis;
   m.radius = c.radius;
   m.distance_threshold = c.threshold;
+  const float normal_angle = c.normal_angle > 0.f ? c.normal_angle : params.normal_angle_threshold;
   const std::vector<int> inliers =
-      selectInliers(cues, active, c, std::cos(params.normal_angle_threshold),
-                    params.outward_normals);
+      selectInliers(cues, active, c, std::cos(normal_angle), params.outward_normals);
   m.inliers.assign(inliers.begin(), inliers.end());
   describeInliers(cues.points(Eigen::all, inliers), m);
   return m;
@@ -356,8 +364,232 @@ candidateScore(const CylinderCues& cues, const CylinderModel& m, bool curvature)
   return slope * sum;
 }
 
+/** A candidate of the competition: its model (inliers by normals) and score. */
+struct Contender {
+  Candidate candidate;
+  CylinderModel model;
+  double score{-1.0};
+};
+
+/** The points' own noise (estimateLocalNoise over 12 neighbours, 128 samples of the active
+ * points), computed on first use only: a fit whose spread about the model is small never
+ * needs it. */
+class LocalNoise {
+public:
+  LocalNoise(const CylinderCues& cues, const std::vector<int>& active)
+  : cues_(cues), active_(active)
+  {}
+  float
+  value() const
+  {
+    if (!value_)
+      value_ = estimateLocalNoise(cues_.points(Eigen::all, active_), 12, 128);
+    return *value_;
+  }
+
+private:
+  const CylinderCues& cues_;
+  const std::vector<int>& active_;
+  mutable std::optional<float> value_;
+};
+
+/** Whether the noise of the points exceeds params.noisy_cues_ratio of the radius of \a c: both
+ * their spread about its surface (its robust sigma) and their spread about their own local
+ * planes (\a local). Then per-point normals and curvatures from small neighbourhoods are more
+ * noise than cue. A large spread about the model alone is a misfit, not noise (a box that a
+ * cylinder does not describe): the cues are then trusted. */
+bool
+cuesAreNoise(const Candidate& c, const LocalNoise& local, const HoughCylinderParameters& params)
+{
+  const float limit = params.noisy_cues_ratio * c.radius;
+  return c.scale > limit && local.value() > limit;
+}
+
+/** \a candidate with its noise before any refinement on the points: the robust sigma of the
+ * distances of the points whose normals fit its axis (lids left out), as the fixed point of
+ * s = 1.4826 MAD of the distances within 3 s, from the MAD within one radius. The shrinking
+ * window sheds what lies near the surface without being it (a table, the rims of large lids),
+ * so the lateral points' own noise decides whether the cues are worth their name. */
+Candidate
+probeNoise(const CylinderCues& cues, const std::vector<int>& active, Candidate candidate,
+           const HoughCylinderParameters& params)
+{
+  std::vector<float> distances;
+  const std::vector<int> support = supporters(cues, active, candidate.axis, params);
+  for (const int col : support)
+    distances.push_back(std::abs(
+        distanceToLine(cues.points.col(col), candidate.point_on_axis, candidate.axis) -
+        candidate.radius));
+  float window = candidate.radius;
+  float scale = 0.f;
+  std::vector<float> near;
+  for (int round = 0; round < 5; ++round) {
+    near.clear();
+    for (const float e : distances)
+      if (e < window)
+        near.push_back(e);
+    if (near.size() < 5)
+      break;
+    scale = 1.4826f * medianOf(near);
+    window = 3.f * scale;
+  }
+  candidate.scale = std::max(scale, 1e-5f * candidate.radius);
+  return candidate;
+}
+
+/** Steps of the robust refinement for every finalist, then for the winner. */
+constexpr int kFirstRound = 8;
+constexpr int kLastRound = 20;
+/** Tukey's cut-off (robust sigmas) of the refinement on the points when the cues are noise:
+ * tighter than the 4.685 of 95% Gaussian efficiency, so that a table that cuts the surface,
+ * or continues it beyond the cylinder's end, pulls a noisy fit much less (facyl_bench,
+ * practical setting, 20% noise: 8% failures instead of 27%). With clean cues the normal gate
+ * keeps such points out, and the efficient 4.685 stays. */
+constexpr float kNoisyCutoff = 2.5f;
+
+/** A candidate refined on the points, with the normal gate its normals' noise asks for. */
+struct Settled {
+  Candidate candidate;
+  RobustCylinder fit;
+  NormalGate gate;
+};
+
+/** The normal gate for the points of \a fit: 2.6 median deviations of the normals within
+ * \a window of its surface (the 96th percentile of a Rayleigh law), at least
+ * params.normal_angle_threshold and at most 85 deg. Noisy normals then do not drop true points
+ * and clean ones still keep a table or a lid's rim out. */
+NormalGate
+gateFor(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+        const RobustCylinder& fit, float window, const HoughCylinderParameters& params)
+{
+  NormalGate gate{params.normal_angle_threshold, params.outward_normals};
+  gate.max_angle = std::clamp(2.6f * normalDeviation(points, normals, fit, window),
+                              params.normal_angle_threshold, 85.f * kOneDegree);
+  return gate;
+}
+
+/** The start of \a candidate's refinement on the points: its scale from the points whose
+ * normals fit its axis (lids and tables left out), and its gate. \a points and \a normals: the
+ * active ones. */
+Settled
+startOnPoints(const CylinderCues& cues, const std::vector<int>& active,
+              const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+              const Candidate& candidate, float cutoff, const HoughCylinderParameters& params)
+{
+  Settled s;
+  s.candidate = probeNoise(cues, active, candidate, params);
+  s.fit.point_on_axis = candidate.point_on_axis;
+  s.fit.axis = candidate.axis;
+  s.fit.radius = candidate.radius;
+  s.fit.scale = s.candidate.scale;
+  s.fit.cutoff = cutoff;
+  s.gate = gateFor(points, normals, s.fit, s.fit.scale, params);
+  return s;
+}
+
+/** At most \a iterations more steps of the robust refinement of \a s (refineCylinderRobust),
+ * then its gate and candidate (threshold: 3 sigma, at most half the radius) follow. \return
+ * false if the refinement fails or leaves the radius limits. */
+bool
+advanceOnPoints(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals, Settled& s,
+                int iterations, const HoughCylinderParameters& params)
+{
+  if (!refineCylinderRobust(points, normals, s.gate, s.fit, iterations) ||
+      s.fit.radius < params.radius_min || s.fit.radius > s.candidate.radius_limit)
+    return false;
+  s.gate = gateFor(points, normals, s.fit, s.fit.scale, params);
+  Candidate& c = s.candidate;
+  c.point_on_axis = s.fit.point_on_axis;
+  c.axis = foldToHemisphere(s.fit.axis.normalized());
+  c.radius = s.fit.radius;
+  c.scale = s.fit.scale;
+  c.normal_angle = s.gate.max_angle;
+  c.threshold = params.distance_threshold > 0.f
+                    ? params.distance_threshold
+                    : std::clamp(3.f * c.scale, 1e-3f * c.radius, 0.5f * c.radius);
+  return true;
+}
+
+/** Settles the competition on the points, once the cues are noise: each contender, refined
+ * on its inliers (refineCandidate), is refined on the points with Tukey's cut-off at
+ * kNoisyCutoff (startOnPoints, then kFirstRound steps of advanceOnPoints); all are compared on
+ * the points they explain at one scale, the smallest any of them reached (pointSupport), times
+ * the turn of their inliers' normals (normalRotationSlope: a plane strip still scores 0); the
+ * winner converges (kLastRound steps). \return the winner, or nothing if no refinement held. */
+std::optional<Candidate>
+settleOnPoints(const CylinderCues& cues, const std::vector<int>& active,
+               const std::vector<const Contender*>& contenders,
+               const HoughCylinderParameters& params)
+{
+  const Eigen::Matrix3Xf points = cues.points(Eigen::all, active);
+  const Eigen::Matrix3Xf normals = cues.normals(Eigen::all, active);
+  // Round one: a few steps each, enough to tell a converging start from a drifting one.
+  std::vector<Settled> settled;
+  for (const Contender* contender : contenders) {
+    // The least squares on the candidate's inliers first: it mends a start whose radius is
+    // off (a short arc), which the robust refinement, from the wide scale such a start shows,
+    // could not.
+    const Candidate start = refineCandidate(cues, active, contender->candidate, params);
+    Settled s = startOnPoints(cues, active, points, normals, start, kNoisyCutoff, params);
+    if (advanceOnPoints(points, normals, s, kFirstRound, params))
+      settled.push_back(std::move(s));
+  }
+  if (settled.empty())
+    return std::nullopt;
+  // Round two: the winner converges (kLastRound more steps at most).
+  const auto finish = [&](Settled& s) -> std::optional<Candidate> {
+    if (!advanceOnPoints(points, normals, s, kLastRound, params))
+      return std::nullopt;
+    return s.candidate;
+  };
+  if (settled.size() == 1)
+    return finish(settled.front());
+  const auto sharpest = std::min_element(
+      settled.begin(), settled.end(),
+      [](const Settled& a, const Settled& b) { return a.fit.scale < b.fit.scale; });
+  const float scale = sharpest->fit.scale;
+  const NormalGate gate = sharpest->gate;
+  Settled* best = nullptr;
+  double best_score = -1.0;
+  for (Settled& s : settled) {
+    const Candidate& c = s.candidate;
+    const std::vector<int> inliers =
+        selectInliers(cues, active, c, std::cos(c.normal_angle), params.outward_normals);
+    const double slope = normalRotationSlope(cues.points(Eigen::all, inliers),
+                                             cues.normals(Eigen::all, inliers),
+                                             c.point_on_axis, c.axis);
+    const double score = slope * pointSupport(points, normals, gate, s.fit, scale);
+    if (score > best_score) {
+      best_score = score;
+      best = &s;
+    }
+  }
+  return finish(*best);
+}
+
+/** Whether \a a beats \a b: a higher score, or the same with a smaller RMS error. */
+bool
+beats(const Contender& a, const Contender& b)
+{
+  return a.score > b.score || (a.score == b.score && a.model.rms_error < b.model.rms_error);
+}
+
+/** The \a count best of \a contenders, best first. */
+std::vector<const Contender*>
+ranked(const std::vector<Contender>& contenders, std::size_t count)
+{
+  std::vector<const Contender*> order;
+  for (const Contender& c : contenders)
+    order.push_back(&c);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const Contender* a, const Contender* b) { return beats(*a, *b); });
+  if (order.size() > count)
+    order.resize(count);
+  return order;
+}
+
 /** The competition of the seeds' candidates: each seed is refined (unless its refined axis
- * was tried already), positioned and scored; the best is kept. */
+ * was tried already), positioned and scored by its inliers. */
 class SeedCompetition {
 public:
   SeedCompetition(const CylinderCues& cues, const std::vector<int>& active,
@@ -377,16 +609,14 @@ public:
   bool
   convincing() const
   {
-    return best_ && best_->angular_coverage >= 0.5f && 4 * best_->inliers.size() >= active_.size();
+    const auto b = ranked(contenders_, 1);
+    return !b.empty() && b[0]->model.angular_coverage >= 0.5f &&
+           4 * b[0]->model.inliers.size() >= active_.size();
   }
-  /** The winner, refined by least squares on all five parameters (params.refine). */
-  std::optional<CylinderModel>
-  winner() const
+  std::vector<Contender>
+  contenders() &&
   {
-    if (best_ && params_.refine)
-      return describe(cues_, active_, refineCandidate(cues_, active_, best_candidate_, params_),
-                      params_);
-    return best_;
+    return std::move(contenders_);
   }
 
 private:
@@ -405,13 +635,11 @@ private:
     const auto candidate = fitPosition(cues_, active_, axis, params_);
     if (!candidate)
       return;
-    CylinderModel model = describe(cues_, active_, *candidate, params_);
-    const double s = candidateScore(cues_, model, curvature_);
-    if (!best_ || s > best_score_ || (s == best_score_ && model.rms_error < best_->rms_error)) {
-      best_ = std::move(model);
-      best_score_ = s;
-      best_candidate_ = *candidate;
-    }
+    Contender c;
+    c.candidate = *candidate;
+    c.model = describe(cues_, active_, *candidate, params_);
+    c.score = candidateScore(cues_, c.model, curvature_);
+    contenders_.push_back(std::move(c));
   }
 
   const CylinderCues& cues_;
@@ -419,20 +647,18 @@ private:
   const VotingCues& refining_;
   const HoughCylinderParameters& params_;
   const bool curvature_;
-  std::optional<CylinderModel> best_;
-  Candidate best_candidate_;
-  double best_score_{-1.0};
+  std::vector<Contender> contenders_;
   std::vector<Eigen::Vector3f> tried_; ///< refined axes
 };
 
-/** One cylinder among the \a active points: the seeds (the accumulators' peaks, the planar
- * normals' direction) compete; when none is convincing and curvature cues were used, the best
- * normals-only peak competes too (curvature directions fade into noise before normals do: a
- * short or noisy cylinder). */
-std::optional<CylinderModel>
-fitOne(const CylinderCues& cues, const std::vector<int>& active,
-       const std::vector<OrientationAccumulator>& accumulators,
-       const HoughCylinderParameters& params)
+/** The candidates that the cues propose among the \a active points: the seeds (the
+ * accumulators' peaks, the planar normals' direction) compete; when none is convincing and
+ * curvature cues were used, the best normals-only peak competes too (curvature directions fade
+ * into noise before normals do: a short or noisy cylinder). */
+std::vector<Contender>
+competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
+             const std::vector<OrientationAccumulator>& accumulators,
+             const HoughCylinderParameters& params)
 {
   const bool curvature = params.voting_mode == VotingMode::SoftCurvature;
   const std::vector<int> voters = subsample(active, params.max_voting_points);
@@ -455,7 +681,80 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
     addVotePeaks(accumulators.front(), voting, VotingMode::SoftNormal, params, 1, more);
     competition.run({more.begin() + static_cast<std::ptrdiff_t>(seeds.size()), more.end()});
   }
-  return competition.winner();
+  return std::move(competition).contenders();
+}
+
+/** Neighbours of a coarse cue at most: four times the usual k = 16, a normal's noise halved. */
+constexpr int kCoarseNeighbours = 64;
+
+/** \a cues with the cues of the \a active points estimated again from their neighbours among
+ * the active points within \a radius (estimatePointCues, signs kept). */
+CylinderCues
+coarserCues(const CylinderCues& cues, const std::vector<int>& active, float radius)
+{
+  const Eigen::Matrix3Xf points = cues.points(Eigen::all, active);
+  const Eigen::Matrix3Xf normals = cues.normals(Eigen::all, active);
+  const PointCues coarse = estimatePointCues(points, radius, kCoarseNeighbours, normals);
+  CylinderCues out = cues;
+  const bool curvature = cues.weights.size() == cues.points.cols();
+  for (std::size_t k = 0; k < active.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (!coarse.normals.col(i).allFinite())
+      continue;
+    const int s = active[k];
+    out.normals.col(s) = coarse.normals.col(i);
+    if (curvature) {
+      const bool measured = coarse.curvature_directions.col(i).allFinite();
+      out.curvature_directions.col(s) =
+          measured ? Eigen::Vector3f(coarse.curvature_directions.col(i)) : Eigen::Vector3f::Zero();
+      out.weights(s) = measured ? coarse.weights(i) : 0.f;
+    }
+  }
+  return out;
+}
+
+/** One cylinder among the \a active points: the candidates of the cues (competeSeeds), the best
+ * refined (with params.refine) and described. When the best candidate's normals are more noise
+ * than cue, cues at a coarser scale (half its radius) propose candidates too, and these cues
+ * judge them all. */
+std::optional<CylinderModel>
+fitOne(const CylinderCues& cues, const std::vector<int>& active,
+       const std::vector<OrientationAccumulator>& accumulators,
+       const HoughCylinderParameters& params)
+{
+  const std::vector<Contender> contenders = competeSeeds(cues, active, accumulators, params);
+  if (contenders.empty())
+    return std::nullopt;
+  const std::vector<const Contender*> finalists =
+      ranked(contenders, std::max<std::size_t>(1, params.point_candidates));
+  const Contender& best = *finalists.front();
+  if (!params.refine)
+    return best.model;
+  // The best, refined by least squares on its inliers: facyl 0.1's answer, and still the
+  // answer while the cues are good.
+  const Candidate refined = refineCandidate(cues, active, best.candidate, params);
+  const LocalNoise local(cues, active);
+  if (params.point_candidates == 0 ||
+      !cuesAreNoise(probeNoise(cues, active, refined, params), local, params))
+    return describe(cues, active, refined, params);
+
+  const auto settled = settleOnPoints(cues, active, finalists, params);
+  if (!settled) // no refinement on the points held
+    return describe(cues, active, refined, params);
+  if (!(params.coarse_scale > 0.f) || !cuesAreNoise(*settled, local, params))
+    return describe(cues, active, *settled, params);
+  // The cues are more noise than cue: cues at the coarse scale propose candidates too, and the
+  // coarse cues judge them against the winner so far.
+  const CylinderCues coarse = coarserCues(cues, active, params.coarse_scale * settled->radius);
+  const std::vector<Contender> coarse_contenders =
+      competeSeeds(coarse, active, accumulators, params);
+  Contender leader;
+  leader.candidate = *settled;
+  std::vector<const Contender*> judged_ones{&leader};
+  for (const Contender* c : ranked(coarse_contenders, params.point_candidates))
+    judged_ones.push_back(c);
+  const auto judged = settleOnPoints(coarse, active, judged_ones, params);
+  return describe(coarse, active, judged ? *judged : *settled, params);
 }
 
 } // namespace

@@ -26,8 +26,11 @@
 
 namespace facyl {
 
-/** \brief The Hough settings of the recognizer: defaults, with radii in [0.01, 0.25] m and
- * outward normals only. */
+/** \brief The Hough settings of the recognizer: defaults, with radii in [0.01, 0.25] m,
+ * outward normals only, and the best candidate refined on its inliers alone
+ * (point_candidates = 0): the decision (CylinderDecision) is calibrated on those fits, and a
+ * refinement on the points can bend a cylinder around a box's edge, which the decision then
+ * accepts (test_clutter, StackedCoaxialCylindersAndACanAgainstABox). */
 inline HoughCylinderParameters
 tabletopHoughDefaults()
 {
@@ -35,6 +38,7 @@ tabletopHoughDefaults()
   p.radius_min = 0.01f;
   p.radius_max = 0.25f;
   p.outward_normals = true; // objects on a table are seen from outside
+  p.point_candidates = 0;
   return p;
 }
 

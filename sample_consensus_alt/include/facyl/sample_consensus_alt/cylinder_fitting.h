@@ -112,6 +112,53 @@ bool
 refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
                Eigen::Vector3f& axis, float& radius, int iterations = 5);
 
+/** \brief Which normals agree with a cylinder's surface normal at their point. */
+struct NormalGate {
+  float max_angle{1.5707964f}; ///< rad, largest angle to the surface normal (pi/2: any)
+  bool outward{false}; ///< the normal must also point away from the axis
+};
+
+/** \brief An infinite cylinder with the robust scale of the points' distances to it. */
+struct RobustCylinder {
+  Eigen::Vector3f point_on_axis{Eigen::Vector3f::Zero()};
+  Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()};
+  float radius{0.f};
+  float scale{0.f};   ///< robust standard deviation of the surface distances (0: estimate)
+  float support{0.f}; ///< sum of the final Tukey weights: the points the surface explains
+  /** Tukey's cut-off in robust sigmas, > 0: 4.685 (95% Gaussian efficiency), or tighter
+   * when structure near the surface (a table cutting it) must pull less. */
+  float cutoff{4.685f};
+};
+
+/** \brief Robust refinement of all 5 degrees of freedom on the point-to-surface distances
+ * e = |P_a(x - p)| - r (normals, when given, only decide which points count): iteratively reweighted Gauss-Newton with Tukey's
+ * biweight at c.cutoff x s, the scale s re-estimated after every step as 1.4826 MAD of the
+ * distances within 4.685 s and never growing (so a start a few degrees off still sees its
+ * surface, and the window then closes on the points the converged model explains).
+ * Points far from the surface (lids, a table, other objects) get no weight.
+ * \param normals unit normals of \a points, or an empty matrix: with normals, a point whose
+ *        normal does not pass \a gate gets no weight (a table cutting the surface, a lid's rim).
+ * \param c in: the start, and its scale (0: 1.4826 MAD of the distances below the radius);
+ *        out: the refined cylinder, its scale and support.
+ * \return false if the system is degenerate or too few points support it (c unchanged). */
+bool
+refineCylinderRobust(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                     const NormalGate& gate, RobustCylinder& c, int iterations = 20);
+
+/** \brief The points that the surface of \a c explains at \a scale: the sum of their Tukey
+ * weights (cut-off c.cutoff x \a scale), with \a normals (or an empty matrix) through
+ * \a gate. Compared at one scale, it ranks cylinders by the points they explain. */
+float
+pointSupport(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+             const NormalGate& gate, const RobustCylinder& c, float scale);
+
+/** \brief The median angle (rad) between the normals of the points within \a window of the
+ * surface of \a c and the surface normal there: the normals' own noise once the model is
+ * right (Rayleigh-distributed, median = 1.18 sigma). 0 when fewer than 5 points are near. */
+float
+normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                const RobustCylinder& c, float window);
+
 /** \brief How fast the inliers' normals turn with their position around the axis: the
  * least-squares slope of (normal angle) against (position angle) over the inliers, about 1 on
  * a cylinder and about 0 on a plane strip that a wide cylinder happens to fit (a lid seen from
@@ -141,6 +188,20 @@ struct HoughCylinderParameters {
   float normal_angle_threshold{0.6f};   ///< rad, in (0, pi/2]: normal vs surface normal
   std::size_t orientation_candidates{1}; ///< peaks per accumulator that are fitted
   bool refine{true};                    ///< sub-cell axis + 5-dof least squares
+  /** With refine: how many candidates (the best by their normals' score) are refined on the
+   * points (refineCylinderRobust) and then compared on the points they explain at one scale
+   * (pointSupport). Points stay informative where normals turn to noise (sigma above ~10% of
+   * the radius with k = 16 neighbours). 0: only the best candidate is refined, by least
+   * squares on its inliers (facyl 0.1). */
+  std::size_t point_candidates{3};
+  /** With point_candidates: above this noise (robust sigma of the points' distances to the
+   * settled winner's surface, as a share of its radius; > 0) the given per-point cues count
+   * as noise: candidates are compared on their points alone, and cues estimated again at the
+   * coarse scale propose candidates too. Below it, each point counts by its eq. 3 vote. */
+  float noisy_cues_ratio{0.04f};
+  /** The coarse scale, in [0, 2]: neighbours within this share of the winner's radius (a
+   * patch its tangent plane still fits). 0: cues are never estimated again. */
+  float coarse_scale{0.5f};
   std::size_t max_cylinders{1};         ///< >= 1
   std::size_t min_inliers{0};           ///< 0: max(10, 5% of the points)
   std::size_t max_voting_points{500};   ///< voters are subsampled above this; 0: all

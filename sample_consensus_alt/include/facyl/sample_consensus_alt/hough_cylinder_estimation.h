@@ -27,9 +27,12 @@ namespace facyl {
  *
  * Step 1 votes for the axis direction on N_d cells drawn from an orientation prior (paper
  * eq. 1-3). The strongest peaks are refined below the cell size (refineAxis). Step 2 aligns
- * each axis with z, finds position and radius with a circle Hough transform, then refines all
- * five parameters by least squares; the candidate with most inliers wins. Its goodness of fit
- * is the inlier ratio of eq. 4.
+ * each axis with z and finds position and radius with a circle Hough transform. The best
+ * candidates are then refined on the points themselves (robust least squares on the
+ * point-to-surface distances) and compared on the points they explain; when the noise makes
+ * the given normals useless, normals and curvatures are estimated again at half the radius
+ * and propose candidates too (see HoughCylinderParameters::point_candidates). The goodness of
+ * fit is the inlier ratio of eq. 4.
  *
  * \code
  * facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
@@ -217,6 +220,45 @@ public:
   getRefine() const
   {
     return params_.refine;
+  }
+  /** \brief Candidates refined and compared on the points (default 3; 0: the best candidate
+   * alone, refined by least squares on its inliers, as facyl 0.1 did). */
+  void
+  setPointCandidates(std::size_t n)
+  {
+    params_.point_candidates = n;
+  }
+  /** \brief Candidates refined and compared on the points. */
+  std::size_t
+  getPointCandidates() const
+  {
+    return params_.point_candidates;
+  }
+  /** \brief Noise (robust sigma / radius, > 0) above which the given cues count as noise
+   * (default 0.04). */
+  void
+  setNoisyCuesRatio(float ratio)
+  {
+    params_.noisy_cues_ratio = ratio;
+  }
+  /** \brief Noise ratio above which the given cues count as noise. */
+  float
+  getNoisyCuesRatio() const
+  {
+    return params_.noisy_cues_ratio;
+  }
+  /** \brief Neighbourhood of the cues estimated again at high noise, as a share of the
+   * radius, in [0, 2] (default 0.5; 0: never). */
+  void
+  setCoarseScale(float share_of_radius)
+  {
+    params_.coarse_scale = share_of_radius;
+  }
+  /** \brief Neighbourhood of the coarse cues, as a share of the radius. */
+  float
+  getCoarseScale() const
+  {
+    return params_.coarse_scale;
   }
 
   /** \brief Orientation prior from a preset (default Uniform). */

@@ -1,0 +1,45 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#pragma once
+
+#include <Eigen/Core>
+
+namespace facyl {
+
+/** \brief Per-point cues of the columns of a 3 x N matrix (the cues of facyl::NormalCurvature
+ * in structure-of-arrays form). Columns without a usable neighbourhood hold NaN normals. */
+struct PointCues {
+  Eigen::Matrix3Xf normals;              ///< unit PCA normals
+  Eigen::Matrix3Xf curvature_directions; ///< unit c_max (paper III-C2)
+  Eigen::VectorXf weights;               ///< eq. 3 weight: curvatureAnisotropy(k_max, k_min)
+};
+
+/** \brief Normals and principal curvatures of every column of \a points from its neighbours
+ * within \a radius (the \a max_neighbours nearest of them at most, so that dense points cost
+ * no more than sparse ones), one neighbourhood query per point as in
+ * NormalCurvatureEstimation, on one thread (callers may run concurrently).
+ *
+ * This is the same estimate at a scale given in cloud units instead of a neighbour count: an
+ * estimator that has measured the noise and the size of its object can ask for cues at the
+ * scale where the noise averages out (a neighbourhood of half the radius of a cylinder still
+ * sees a surface that its tangent plane fits).
+ *
+ * \param reference unit normals (3 x N) whose signs the output follows (flipped where the dot
+ *        product is negative), or an empty matrix.
+ * \throws std::invalid_argument if \a radius is not positive and finite or
+ *         \a max_neighbours < 3. */
+PointCues
+estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbours,
+                  const Eigen::Matrix3Xf& reference);
+
+/** \brief The points' own noise, whatever shape they lie on: the median over \a samples
+ * evenly spread columns of sqrt(lambda_0 k / (k - 3)) of their \a k nearest neighbours (the
+ * spread along the local normal of a patch small enough to be flat; k - 3 degrees of freedom
+ * are left once the plane is fitted). Gaussian noise of sigma gives about sigma; a smooth surface without noise about 0 (a box's faces, a cylinder much wider than the
+ * patch), whatever a model fitted to the whole makes of it. 0 when no neighbourhood is usable.
+ * \throws std::invalid_argument if k < 3. */
+float
+estimateLocalNoise(const Eigen::Matrix3Xf& points, int k, int samples);
+
+} // namespace facyl

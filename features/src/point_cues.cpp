@@ -1,0 +1,122 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#include <facyl/features/local_geometry.h>
+#include <facyl/features/neighbourhoods.h>
+#include <facyl/features/point_cues.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace facyl {
+
+PointCues
+estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbours,
+                  const Eigen::Matrix3Xf& reference)
+{
+  if (!(radius > 0.f) || !std::isfinite(radius))
+    throw std::invalid_argument("estimatePointCues: the radius must be positive and finite");
+  if (max_neighbours < 3)
+    throw std::invalid_argument("estimatePointCues: a normal needs at least 3 neighbours");
+  const Eigen::Index n = points.cols();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  PointCues out;
+  out.normals.setConstant(3, n, nan);
+  out.curvature_directions.setConstant(3, n, nan);
+  out.weights.setZero(n);
+  if (n == 0)
+    return out;
+  // The k nearest, cut at the radius: the cost stays that of k neighbours where the points
+  // are dense.
+  const NeighbourSearch search(points);
+  const Neighbourhoods nb = search.nearest(points, max_neighbours, 1);
+  const float radius2 = radius * radius;
+  std::vector<std::size_t> counts(static_cast<std::size_t>(n), 0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int* list = nb.begin(static_cast<std::size_t>(i));
+    std::size_t k = 0;
+    while (k < nb.count(static_cast<std::size_t>(i)) &&
+           (points.col(list[k]) - points.col(i)).squaredNorm() <= radius2)
+      ++k;
+    counts[static_cast<std::size_t>(i)] = k;
+  }
+  const auto count = [&](Eigen::Index i) { return counts[static_cast<std::size_t>(i)]; };
+  const bool oriented = reference.cols() == n;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int* list = nb.begin(static_cast<std::size_t>(i));
+    Eigen::Vector3f normal;
+    float variation = 0.f;
+    if (count(i) < 3 ||
+        !estimateNormal(
+            count(i), [&](std::size_t j) { return Eigen::Vector3f(points.col(list[j])); },
+            normal, variation))
+      continue;
+    if (oriented && normal.dot(reference.col(i)) < 0.f)
+      normal = -normal;
+    out.normals.col(i) = normal;
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!out.normals.col(i).allFinite())
+      continue;
+    const int* list = nb.begin(static_cast<std::size_t>(i));
+    PrincipalCurvatures pc;
+    if (!principalCurvaturesFromNormals(
+            out.normals.col(i), count(i),
+            [&](std::size_t j) { return Eigen::Vector3f(out.normals.col(list[j])); }, pc))
+      continue;
+    out.curvature_directions.col(i) = pc.direction;
+    out.weights(i) = curvatureAnisotropy(pc.k_max, pc.k_min);
+  }
+  return out;
+}
+
+float
+estimateLocalNoise(const Eigen::Matrix3Xf& points, int k, int samples)
+{
+  if (k < 3)
+    throw std::invalid_argument("estimateLocalNoise: a neighbourhood needs at least 3 points");
+  const Eigen::Index n = points.cols();
+  if (n < k || samples < 1)
+    return 0.f;
+  const Eigen::Index m = std::min<Eigen::Index>(n, samples);
+  Eigen::Matrix3Xf queries(3, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    queries.col(i) = points.col(i * n / m);
+  const NeighbourSearch search(points);
+  const Neighbourhoods nb = search.nearest(queries, k, 1);
+  std::vector<float> spreads;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const std::size_t q = static_cast<std::size_t>(i);
+    if (nb.count(q) < 4)
+      continue;
+    const int* list = nb.begin(q);
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (std::size_t j = 0; j < nb.count(q); ++j)
+      mean += points.col(list[j]);
+    mean /= static_cast<float>(nb.count(q));
+    Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+    for (std::size_t j = 0; j < nb.count(q); ++j) {
+      const Eigen::Vector3f d = points.col(list[j]) - mean;
+      cov.noalias() += d * d.transpose();
+    }
+    cov /= static_cast<float>(nb.count(q));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
+    solver.computeDirect(cov, Eigen::EigenvaluesOnly);
+    // The smallest eigenvalue of k points keeps k - 3 of their degrees of freedom (a plane
+    // was fitted): E = sigma^2 (k - 3) / k.
+    const float unbias = static_cast<float>(nb.count(q)) / static_cast<float>(nb.count(q) - 3);
+    spreads.push_back(std::sqrt(std::max(0.f, solver.eigenvalues()(0)) * unbias));
+  }
+  if (spreads.empty())
+    return 0.f;
+  const auto mid = spreads.begin() + static_cast<std::ptrdiff_t>(spreads.size() / 2);
+  std::nth_element(spreads.begin(), mid, spreads.end());
+  return *mid;
+}
+
+} // namespace facyl
