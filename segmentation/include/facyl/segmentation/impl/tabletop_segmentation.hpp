@@ -471,8 +471,34 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
   // cells whose neighbourhood is whole enough for a normal on the fine grid, and no seed
   // there; a grid twice as coarse bridges the holes. Its seeds away from the planes found
   // grow as well.
-  if (grid.step == planeStep() && two_grids)
-    growCandidates(twice, planeSeeds(twice), candidates);
+  if (grid.step == planeStep() && two_grids) {
+    // Only seeds over the holes of the fine grid: most of the fine cells under them that have
+    // depth have no normal (where the fine grid saw normals, its own seeds spoke already).
+    std::vector<pcl::PointIndices> over_holes;
+    const auto fw = static_cast<std::size_t>(grid.small->width);
+    const auto fh = static_cast<std::size_t>(grid.small->height);
+    const auto tw = static_cast<std::size_t>(twice.small->width);
+    for (auto& r : planeSeeds(twice)) {
+      std::size_t with_depth = 0, without_normal = 0;
+      for (const auto k : r.indices) {
+        const std::size_t cu = static_cast<std::size_t>(k) % tw, cv = static_cast<std::size_t>(k) / tw;
+        for (std::size_t dv = 0; dv < 2; ++dv)
+          for (std::size_t du = 0; du < 2; ++du) {
+            const std::size_t u = 2 * cu + du, v = 2 * cv + dv;
+            if (u >= fw || v >= fh)
+              continue;
+            const auto f = static_cast<Eigen::Index>(v * fw + u);
+            if (grid.cells.col(f).allFinite()) {
+              ++with_depth;
+              without_normal += !grid.cell_normals.col(f).allFinite();
+            }
+          }
+      }
+      if (2 * without_normal >= with_depth && with_depth > 0)
+        over_holes.push_back(std::move(r));
+    }
+    growCandidates(twice, over_holes, candidates);
+  }
 }
 
 template <typename PointT>
