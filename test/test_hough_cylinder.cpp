@@ -348,10 +348,22 @@ TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
   hough.setInputNormals(normals);
   pcl::PointIndices inliers;
   pcl::ModelCoefficients coefficients;
-  // SoftCurvature (the default) needs curvatures, which pcl::Normal does not carry.
+  // SoftCurvature (the default) needs curvatures, which pcl::Normal does not carry: the
+  // estimator estimates them from the points.
+  ASSERT_TRUE(hough.segment(inliers, coefficients)) << hough.getFailureMessage();
+  EXPECT_TRUE(hough.curvaturesWereEstimated());
+  EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
+  // ... unless told not to: then it says why it cannot vote.
+  hough.setEstimateCurvatures(false);
   EXPECT_FALSE(hough.segment(inliers, coefficients));
+  EXPECT_EQ(hough.getFailureReason(), facyl::HoughFailure::NoCurvatures);
+  EXPECT_FALSE(hough.getFailureMessage().empty());
   EXPECT_TRUE(coefficients.values.empty());
   hough.setInputCurvatures(curvatures);
+  ASSERT_TRUE(hough.segment(inliers, coefficients));
+  EXPECT_FALSE(hough.curvaturesWereEstimated());
+  EXPECT_EQ(hough.getFailureReason(), facyl::HoughFailure::None);
+  hough.setEstimateCurvatures(true);
   ASSERT_TRUE(hough.segment(inliers, coefficients));
   EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
   hough.setInputCurvatures(nullptr);
@@ -393,26 +405,32 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     inliers.indices = {1, 2, 3};
     coefficients.values = {1.f};
     const bool ok = h.segment(inliers, coefficients);
-    return !ok && inliers.indices.empty() && coefficients.values.empty();
+    return !ok && inliers.indices.empty() && coefficients.values.empty() &&
+           h.getFailureReason() != facyl::HoughFailure::None && !h.getFailureMessage().empty();
   };
+  using R = facyl::HoughFailure;
   {
     Hough h; // no input at all
     EXPECT_TRUE(fails(h));
+    EXPECT_EQ(h.getFailureReason(), R::NoInputCloud);
   }
   {
     Hough h;
     h.setInputCloud(Cloud::Ptr(new Cloud));
     h.setInputNormals(cues);
     EXPECT_TRUE(fails(h)); // empty cloud
+    EXPECT_EQ(h.getFailureReason(), R::EmptyCloud);
   }
   {
     Hough h;
     h.setInputCloud(cloud);
     EXPECT_TRUE(fails(h)); // no normals
+    EXPECT_EQ(h.getFailureReason(), R::NoNormals);
     pcl::PointCloud<facyl::NormalCurvature>::Ptr fewer(new pcl::PointCloud<facyl::NormalCurvature>(*cues));
     fewer->resize(10);
     h.setInputNormals(fewer);
     EXPECT_TRUE(fails(h)); // sizes differ
+    EXPECT_EQ(h.getFailureReason(), R::SizeMismatch);
   }
   {
     Cloud::Ptr nan(new Cloud(*cloud));
@@ -422,6 +440,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputCloud(nan);
     h.setInputNormals(cues);
     EXPECT_TRUE(fails(h)); // no finite point
+    EXPECT_EQ(h.getFailureReason(), R::NoFinitePoints);
   }
   {
     Hough h;
@@ -429,6 +448,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputNormals(cues);
     h.setRadiusLimits(0.5f, 0.1f);
     EXPECT_TRUE(fails(h)); // inverted radius limits
+    EXPECT_EQ(h.getFailureReason(), R::InvalidParameters);
     h.setRadiusLimits(0.f, std::numeric_limits<float>::infinity());
     h.setNumberOfOrientations(0);
     EXPECT_TRUE(fails(h)); // empty accumulator
@@ -444,6 +464,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setOrientationPrior(facyl::OrientationPrior::Uniform);
     h.setIndices(pcl::IndicesPtr(new pcl::Indices{0, 1, static_cast<int>(cloud->size()) + 5}));
     EXPECT_TRUE(fails(h)); // index outside the cloud
+    EXPECT_EQ(h.getFailureReason(), R::InvalidIndices);
   }
   {
     // No cylinder in a plane: false, not a made-up cylinder.
@@ -454,6 +475,56 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputNormals(facyl_test::estimateCues(plane.makeShared()));
     h.setRadiusLimits(0.01f, 0.3f);
     EXPECT_TRUE(fails(h));
+    EXPECT_EQ(h.getFailureReason(), R::NoCylinder) << h.getFailureMessage();
+  }
+}
+
+TEST(HoughCylinderEstimation, SearchFailuresSayWhy)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.05f;
+  p.height = 0.3f;
+  p.noise = 0.001f;
+  const auto sim = facyl::simulateCylinder(p);
+  const auto cloud = sim.cloud.makeShared();
+  const auto cues = facyl_test::estimateCues(cloud);
+  std::vector<CylinderModel> models;
+  using R = facyl::HoughFailure;
+  {
+    // Radius limits that exclude the only cylinder there is.
+    Hough h;
+    h.setInputCloud(cloud);
+    h.setInputNormals(cues);
+    h.setRadiusLimits(0.1f, 0.2f);
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_TRUE(models.empty());
+    EXPECT_EQ(h.getFailureReason(), R::RadiusLimits) << h.getFailureMessage();
+    EXPECT_NE(h.getFailureMessage().find("radius limits [0.1, 0.2]"), std::string::npos)
+        << h.getFailureMessage();
+    // The same estimator with limits around the cylinder: found, and the reason is cleared.
+    h.setRadiusLimits(0.f, 0.1f);
+    ASSERT_TRUE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::None);
+    EXPECT_TRUE(h.getFailureMessage().empty());
+  }
+  {
+    // Fewer points than a cylinder needs inliers.
+    Hough h;
+    h.setInputCloud(cloud);
+    h.setInputNormals(cues);
+    h.setIndices(pcl::IndicesPtr(new pcl::Indices{0, 1, 2, 3, 4, 5}));
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::TooFewPoints) << h.getFailureMessage();
+    EXPECT_NE(h.getFailureMessage().find("too few points"), std::string::npos);
+    h.setIndices(pcl::IndicesPtr(new pcl::Indices));
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_NE(h.getFailureReason(), R::None);
+    Hough all;
+    all.setInputCloud(cloud);
+    all.setInputNormals(cues);
+    all.setMinInliers(cloud->size() + 1);
+    EXPECT_FALSE(all.segment(models));
+    EXPECT_EQ(all.getFailureReason(), R::TooFewPoints) << all.getFailureMessage();
   }
 }
 
