@@ -501,6 +501,11 @@ TEST(HoughCylinderEstimation, SearchFailuresSayWhy)
     EXPECT_EQ(h.getFailureReason(), R::RadiusLimits) << h.getFailureMessage();
     EXPECT_NE(h.getFailureMessage().find("radius limits [0.1, 0.2]"), std::string::npos)
         << h.getFailureMessage();
+    // Without the diagnosis (one fit per cluster in a pipeline): no second search.
+    h.setDiagnoseFailures(false);
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::NoCylinder) << h.getFailureMessage();
+    h.setDiagnoseFailures(true);
     // The same estimator with limits around the cylinder: found, and the reason is cleared.
     h.setRadiusLimits(0.f, 0.1f);
     ASSERT_TRUE(h.segment(models));

@@ -75,7 +75,7 @@ enum class HoughFailure {
  * Inputs that cannot give an answer (no cloud, no normals, sizes that differ, no finite point,
  * invalid parameters, SoftCurvature without curvatures when their estimation is off) are
  * reported with PCL_ERROR; a search that finds no cylinder (too few points, a cylinder outside
- * the radius limits, none at all) with PCL_WARN. Either way segment() returns false with empty
+ * the radius limits, none at all) with PCL_WARN (PCL_DEBUG after setDiagnoseFailures(false)). Either way segment() returns false with empty
  * outputs, and getFailureReason() / getFailureMessage() say why. segment() is not reentrant on one object; distinct
  * objects may run concurrently.
  *
@@ -143,6 +143,23 @@ public:
   curvaturesWereEstimated() const
   {
     return curvatures_estimated_;
+  }
+
+  /** \brief Whether a search that finds nothing is diagnosed (default true): with radius
+   * limits, the search is run once more without them, so that a cylinder they exclude is
+   * reported as HoughFailure::RadiusLimits with its radius, and the outcome is printed with
+   * PCL_WARN. false (pipelines for which "no cylinder" is a normal answer, e.g. one fit per
+   * cluster): no second search (HoughFailure::NoCylinder or TooFewPoints) and PCL_DEBUG. */
+  void
+  setDiagnoseFailures(bool diagnose)
+  {
+    diagnose_failures_ = diagnose;
+  }
+  /** \brief Whether a search that finds nothing is diagnosed. */
+  bool
+  getDiagnoseFailures() const
+  {
+    return diagnose_failures_;
   }
 
   /** \brief Why the last segment() returned false (HoughFailure::None after a success). */
@@ -435,14 +452,16 @@ private:
   const std::vector<OrientationAccumulator>&
   accumulators();
 
-  /** Records the failure, prints it (PCL_ERROR, or PCL_WARN when \a warn), returns false. */
+  enum class Level { Error, Warn, Debug };
+  /** Records the failure, prints it at \a level, returns false. */
   bool
-  fail(HoughFailure reason, const std::string& message, bool warn = false);
+  fail(HoughFailure reason, const std::string& message, Level level = Level::Error);
   /** After fitCylinders found nothing among \a n usable points: the reason. */
   bool
   explainNoCylinder(const CylinderCues& cues, std::size_t total_points);
 
   bool estimate_curvatures_{true};
+  bool diagnose_failures_{true};
   bool curvatures_estimated_{false};
   HoughFailure failure_{HoughFailure::None};
   std::string failure_message_;

@@ -63,14 +63,17 @@ HoughCylinderEstimation<PointT, PointNT>::segment(pcl::PointIndices& inliers,
 template <typename PointT, typename PointNT>
 bool
 HoughCylinderEstimation<PointT, PointNT>::fail(HoughFailure reason, const std::string& message,
-                                               bool warn)
+                                               Level level)
 {
   failure_ = reason;
   failure_message_ = message;
-  if (warn)
-    PCL_WARN("[facyl::%s::segment] %s.\n", getClassName().c_str(), message.c_str());
+  const std::string name = getClassName();
+  if (level == Level::Error)
+    PCL_ERROR("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
+  else if (level == Level::Warn)
+    PCL_WARN("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
   else
-    PCL_ERROR("[facyl::%s::segment] %s.\n", getClassName().c_str(), message.c_str());
+    PCL_DEBUG("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
   return false;
 }
 
@@ -92,6 +95,7 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
                                                             std::size_t total_points)
 {
   using detail::houghFormat;
+  const Level level = diagnose_failures_ ? Level::Warn : Level::Debug;
   const std::size_t n = static_cast<std::size_t>(cues.points.cols());
   const std::size_t min_inliers =
       params_.min_inliers > 0 ? params_.min_inliers
@@ -101,9 +105,9 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
                 houghFormat("too few points: %zu usable of %zu, and a cylinder needs %zu inliers "
                             "(setMinInliers)",
                             n, total_points, min_inliers),
-                true);
+                level);
   const bool limited = params_.radius_min > 0.f || std::isfinite(params_.radius_max);
-  if (limited) {
+  if (limited && diagnose_failures_) {
     // The same search without radius limits: a cylinder outside them is worth saying.
     HoughCylinderParameters open = params_;
     open.radius_min = 0.f;
@@ -123,13 +127,13 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
                               "the best cylinder has radius %g (%zu inliers)",
                               params_.radius_min, params_.radius_max, found.front().radius,
                               found.front().inliers.size()),
-                  true);
+                  level);
   }
   return fail(HoughFailure::NoCylinder,
               houghFormat("no cylinder found among %zu points (%zu usable; a cylinder needs %zu "
                           "inliers)",
                           total_points, n, min_inliers),
-              true);
+              level);
 }
 
 template <typename PointT, typename PointNT>
