@@ -374,6 +374,35 @@ TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
   }
 }
 
+TEST(HoughCylinderEstimation, EstimatedCurvaturesSurviveDegenerateClouds)
+{
+  // pcl::Normal carries no curvatures: they are estimated from points that cannot give them.
+  const auto run = [](const std::vector<Eigen::Vector3f>& at) {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
+    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+    for (const auto& v : at) {
+      xyz->push_back(pcl::PointXYZ(v.x(), v.y(), v.z()));
+      normals->push_back(pcl::Normal(0.f, 0.f, 1.f));
+    }
+    facyl::HoughCylinderEstimation<pcl::PointXYZ, pcl::Normal> hough;
+    hough.setInputCloud(xyz);
+    hough.setInputNormals(normals);
+    std::vector<CylinderModel> models;
+    const bool ok = hough.segment(models);
+    return std::make_pair(ok, hough.getFailureReason());
+  };
+  using R = facyl::HoughFailure;
+  EXPECT_EQ(run({Eigen::Vector3f(1.f, 2.f, 3.f)}).second, R::TooFewPoints);
+  EXPECT_EQ(run(std::vector<Eigen::Vector3f>(40, Eigen::Vector3f(1.f, 2.f, 3.f))).second,
+            R::NoCylinder);
+  std::vector<Eigen::Vector3f> line;
+  for (int i = 0; i < 40; ++i)
+    line.emplace_back(0.01f * static_cast<float>(i), 0.f, 0.f);
+  const auto on_line = run(line);
+  EXPECT_FALSE(on_line.first);
+  EXPECT_NE(on_line.second, R::None);
+}
+
 TEST(HoughCylinderEstimation, PriorsInTheReferenceFrame)
 {
   facyl::CylinderSimulationParameters p;

@@ -68,16 +68,17 @@ enum class HoughFailure {
  * the 16 nearest points, then the spread of those normals), whatever scale the given normals
  * have: with curvatures from normals smoothed over k = 50 neighbours (the tutorial's
  * pcl::NormalEstimation, then pcl::PrincipalCurvaturesEstimation at k = 50) the axis found on
- * the tutorial's mug is 81 degrees off. The given normals stay the
- * normals of the vote and of the inlier test. setEstimateCurvatures(false) turns this off:
- * segment() then fails * with HoughFailure::NoCurvatures. The other voting modes need normals only.
+ * the tutorial's mug is 81 degrees off. The given normals stay the normals of the vote and of
+ * the inlier test. setEstimateCurvatures(false) turns this off: segment() then fails with
+ * HoughFailure::NoCurvatures. The other voting modes need normals only.
  *
  * Inputs that cannot give an answer (no cloud, no normals, sizes that differ, no finite point,
  * invalid parameters, SoftCurvature without curvatures when their estimation is off) are
  * reported with PCL_ERROR; a search that finds no cylinder (too few points, a cylinder outside
- * the radius limits, none at all) with PCL_WARN (PCL_DEBUG after setDiagnoseFailures(false)). Either way segment() returns false with empty
- * outputs, and getFailureReason() / getFailureMessage() say why. segment() is not reentrant on one object; distinct
- * objects may run concurrently.
+ * the radius limits, none at all) with PCL_WARN (PCL_DEBUG after setDiagnoseFailures(false)).
+ * Either way segment() returns false with empty outputs, and getFailureReason() /
+ * getFailureMessage() say why. segment() is not reentrant on one object; distinct objects may
+ * run concurrently.
  *
  * \tparam PointT a point type with x, y, z
  * \tparam PointNT a type with normal_x/y/z; if it also has principal_curvature_x/y/z, pc1 and
