@@ -8,8 +8,10 @@
  * plane removed by SACSegmentationFromNormals, radius limits (0, 0.1).
  *
  *   cylinder_segmentation [table_scene_mug_stereo_textured.pcd] [--ransac]
+ *                         [--voting soft-curvature|soft-normal|rabbani]
  *
- * --ransac runs the tutorial's own RANSAC as well (seeded), to compare. Prints the
+ * --ransac runs the tutorial's own RANSAC as well (SACSegmentation's fixed seed), to compare;
+ * --voting chooses facyl's voting mode (default soft-curvature). Prints the
  * coefficients and, on failure, the reason the estimator gives.
  */
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
@@ -36,9 +38,28 @@ main(int argc, char** argv)
 {
   std::string file = "table_scene_mug_stereo_textured.pcd";
   bool ransac = false;
+  facyl::VotingMode voting = facyl::VotingMode::SoftCurvature;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--ransac") == 0)
       ransac = true;
+    else if (std::strcmp(argv[i], "--voting") == 0 && i + 1 < argc) {
+      const std::string mode = argv[++i];
+      if (mode == "soft-curvature")
+        voting = facyl::VotingMode::SoftCurvature;
+      else if (mode == "soft-normal")
+        voting = facyl::VotingMode::SoftNormal;
+      else if (mode == "rabbani")
+        voting = facyl::VotingMode::Rabbani;
+      else {
+        std::fprintf(stderr, "unknown voting mode %s (soft-curvature, soft-normal, rabbani)\n",
+                     mode.c_str());
+        return 2;
+      }
+    }
+    else if (argv[i][0] == '-') {
+      std::fprintf(stderr, "unknown option %s\n", argv[i]);
+      return 2;
+    }
     else
       file = argv[i];
   }
@@ -108,6 +129,7 @@ main(int argc, char** argv)
   hough.setInputCloud(cloud_filtered2);
   hough.setInputNormals(cloud_normals2);
   hough.setRadiusLimits(0, 0.1);
+  hough.setVotingMode(voting);
   if (hough.segment(*inliers_cylinder, *coefficients_cylinder)) {
     std::printf("facyl cylinder (%zu inliers): ", inliers_cylinder->indices.size());
     for (const float v : coefficients_cylinder->values)
