@@ -258,6 +258,7 @@ runTask(const Task& task, const Level& level, const std::vector<Method>& ms, std
     else {
       facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
       hough.setVotingMode(m.mode);
+      hough.setDiagnoseFailures(false); // timed: no second search when none is found
       hough.setOrientationPrior(m.prior);
       hough.setRadiusLimits(r_min, r_max);
       if (m.inliers_only)

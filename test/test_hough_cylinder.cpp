@@ -348,10 +348,22 @@ TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
   hough.setInputNormals(normals);
   pcl::PointIndices inliers;
   pcl::ModelCoefficients coefficients;
-  // SoftCurvature (the default) needs curvatures, which pcl::Normal does not carry.
+  // SoftCurvature (the default) needs curvatures, which pcl::Normal does not carry: the
+  // estimator estimates them from the points.
+  ASSERT_TRUE(hough.segment(inliers, coefficients)) << hough.getFailureMessage();
+  EXPECT_TRUE(hough.curvaturesWereEstimated());
+  EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
+  // ... unless told not to: then it says why it cannot vote.
+  hough.setEstimateCurvatures(false);
   EXPECT_FALSE(hough.segment(inliers, coefficients));
+  EXPECT_EQ(hough.getFailureReason(), facyl::HoughFailure::NoCurvatures);
+  EXPECT_FALSE(hough.getFailureMessage().empty());
   EXPECT_TRUE(coefficients.values.empty());
   hough.setInputCurvatures(curvatures);
+  ASSERT_TRUE(hough.segment(inliers, coefficients));
+  EXPECT_FALSE(hough.curvaturesWereEstimated());
+  EXPECT_EQ(hough.getFailureReason(), facyl::HoughFailure::None);
+  hough.setEstimateCurvatures(true);
   ASSERT_TRUE(hough.segment(inliers, coefficients));
   EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
   hough.setInputCurvatures(nullptr);
@@ -360,6 +372,35 @@ TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
     ASSERT_TRUE(hough.segment(inliers, coefficients)) << facyl::toString(mode);
     EXPECT_NEAR(coefficients.values[6], p.radius, 0.01f * p.radius);
   }
+}
+
+TEST(HoughCylinderEstimation, EstimatedCurvaturesSurviveDegenerateClouds)
+{
+  // pcl::Normal carries no curvatures: they are estimated from points that cannot give them.
+  const auto run = [](const std::vector<Eigen::Vector3f>& at) {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
+    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+    for (const auto& v : at) {
+      xyz->push_back(pcl::PointXYZ(v.x(), v.y(), v.z()));
+      normals->push_back(pcl::Normal(0.f, 0.f, 1.f));
+    }
+    facyl::HoughCylinderEstimation<pcl::PointXYZ, pcl::Normal> hough;
+    hough.setInputCloud(xyz);
+    hough.setInputNormals(normals);
+    std::vector<CylinderModel> models;
+    const bool ok = hough.segment(models);
+    return std::make_pair(ok, hough.getFailureReason());
+  };
+  using R = facyl::HoughFailure;
+  EXPECT_EQ(run({Eigen::Vector3f(1.f, 2.f, 3.f)}).second, R::TooFewPoints);
+  EXPECT_EQ(run(std::vector<Eigen::Vector3f>(40, Eigen::Vector3f(1.f, 2.f, 3.f))).second,
+            R::NoCylinder);
+  std::vector<Eigen::Vector3f> line;
+  for (int i = 0; i < 40; ++i)
+    line.emplace_back(0.01f * static_cast<float>(i), 0.f, 0.f);
+  const auto on_line = run(line);
+  EXPECT_FALSE(on_line.first);
+  EXPECT_NE(on_line.second, R::None);
 }
 
 TEST(HoughCylinderEstimation, PriorsInTheReferenceFrame)
@@ -393,26 +434,32 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     inliers.indices = {1, 2, 3};
     coefficients.values = {1.f};
     const bool ok = h.segment(inliers, coefficients);
-    return !ok && inliers.indices.empty() && coefficients.values.empty();
+    return !ok && inliers.indices.empty() && coefficients.values.empty() &&
+           h.getFailureReason() != facyl::HoughFailure::None && !h.getFailureMessage().empty();
   };
+  using R = facyl::HoughFailure;
   {
     Hough h; // no input at all
     EXPECT_TRUE(fails(h));
+    EXPECT_EQ(h.getFailureReason(), R::NoInputCloud);
   }
   {
     Hough h;
     h.setInputCloud(Cloud::Ptr(new Cloud));
     h.setInputNormals(cues);
     EXPECT_TRUE(fails(h)); // empty cloud
+    EXPECT_EQ(h.getFailureReason(), R::EmptyCloud);
   }
   {
     Hough h;
     h.setInputCloud(cloud);
     EXPECT_TRUE(fails(h)); // no normals
+    EXPECT_EQ(h.getFailureReason(), R::NoNormals);
     pcl::PointCloud<facyl::NormalCurvature>::Ptr fewer(new pcl::PointCloud<facyl::NormalCurvature>(*cues));
     fewer->resize(10);
     h.setInputNormals(fewer);
     EXPECT_TRUE(fails(h)); // sizes differ
+    EXPECT_EQ(h.getFailureReason(), R::SizeMismatch);
   }
   {
     Cloud::Ptr nan(new Cloud(*cloud));
@@ -422,6 +469,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputCloud(nan);
     h.setInputNormals(cues);
     EXPECT_TRUE(fails(h)); // no finite point
+    EXPECT_EQ(h.getFailureReason(), R::NoFinitePoints);
   }
   {
     Hough h;
@@ -429,6 +477,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputNormals(cues);
     h.setRadiusLimits(0.5f, 0.1f);
     EXPECT_TRUE(fails(h)); // inverted radius limits
+    EXPECT_EQ(h.getFailureReason(), R::InvalidParameters);
     h.setRadiusLimits(0.f, std::numeric_limits<float>::infinity());
     h.setNumberOfOrientations(0);
     EXPECT_TRUE(fails(h)); // empty accumulator
@@ -444,6 +493,7 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setOrientationPrior(facyl::OrientationPrior::Uniform);
     h.setIndices(pcl::IndicesPtr(new pcl::Indices{0, 1, static_cast<int>(cloud->size()) + 5}));
     EXPECT_TRUE(fails(h)); // index outside the cloud
+    EXPECT_EQ(h.getFailureReason(), R::InvalidIndices);
   }
   {
     // No cylinder in a plane: false, not a made-up cylinder.
@@ -454,6 +504,61 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputNormals(facyl_test::estimateCues(plane.makeShared()));
     h.setRadiusLimits(0.01f, 0.3f);
     EXPECT_TRUE(fails(h));
+    EXPECT_EQ(h.getFailureReason(), R::NoCylinder) << h.getFailureMessage();
+  }
+}
+
+TEST(HoughCylinderEstimation, SearchFailuresSayWhy)
+{
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.05f;
+  p.height = 0.3f;
+  p.noise = 0.001f;
+  const auto sim = facyl::simulateCylinder(p);
+  const auto cloud = sim.cloud.makeShared();
+  const auto cues = facyl_test::estimateCues(cloud);
+  std::vector<CylinderModel> models;
+  using R = facyl::HoughFailure;
+  {
+    // Radius limits that exclude the only cylinder there is.
+    Hough h;
+    h.setInputCloud(cloud);
+    h.setInputNormals(cues);
+    h.setRadiusLimits(0.1f, 0.2f);
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_TRUE(models.empty());
+    EXPECT_EQ(h.getFailureReason(), R::RadiusLimits) << h.getFailureMessage();
+    EXPECT_NE(h.getFailureMessage().find("radius limits [0.1, 0.2]"), std::string::npos)
+        << h.getFailureMessage();
+    // Without the diagnosis (one fit per cluster in a pipeline): no second search.
+    h.setDiagnoseFailures(false);
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::NoCylinder) << h.getFailureMessage();
+    h.setDiagnoseFailures(true);
+    // The same estimator with limits around the cylinder: found, and the reason is cleared.
+    h.setRadiusLimits(0.f, 0.1f);
+    ASSERT_TRUE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::None);
+    EXPECT_TRUE(h.getFailureMessage().empty());
+  }
+  {
+    // Fewer points than a cylinder needs inliers.
+    Hough h;
+    h.setInputCloud(cloud);
+    h.setInputNormals(cues);
+    h.setIndices(pcl::IndicesPtr(new pcl::Indices{0, 1, 2, 3, 4, 5}));
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_EQ(h.getFailureReason(), R::TooFewPoints) << h.getFailureMessage();
+    EXPECT_NE(h.getFailureMessage().find("too few points"), std::string::npos);
+    h.setIndices(pcl::IndicesPtr(new pcl::Indices));
+    EXPECT_FALSE(h.segment(models));
+    EXPECT_NE(h.getFailureReason(), R::None);
+    Hough all;
+    all.setInputCloud(cloud);
+    all.setInputNormals(cues);
+    all.setMinInliers(cloud->size() + 1);
+    EXPECT_FALSE(all.segment(models));
+    EXPECT_EQ(all.getFailureReason(), R::TooFewPoints) << all.getFailureMessage();
   }
 }
 

@@ -21,6 +21,23 @@
 
 namespace facyl {
 
+/** \brief Why HoughCylinderEstimation::segment() returned false (getFailureReason()). */
+enum class HoughFailure {
+  None,              ///< the last segment() found a cylinder (or none has run)
+  NoInputCloud,      ///< setInputCloud was not called
+  EmptyCloud,        ///< the input cloud has no points
+  NoNormals,         ///< setInputNormals was not called
+  SizeMismatch,      ///< normals or curvatures not one per point
+  InvalidParameters, ///< a setting is out of range (radius limits inverted, ...)
+  InvalidIndices,    ///< an index outside the cloud, or PCL refused the input
+  NoFinitePoints,    ///< no point has a finite position and normal
+  NoCurvatures,      ///< SoftCurvature without curvatures, and their estimation is off
+  TooFewPoints,      ///< fewer usable points than a cylinder needs inliers
+  RadiusLimits,      ///< a cylinder is there, but the radius limits exclude it
+  NoCylinder,        ///< the points hold no cylinder with enough inliers
+  InternalError      ///< an exception inside the fit (reported in the message)
+};
+
 /** \brief Two-step Hough cylinder estimator (Rabbani & van den Heuvel; Figueiredo et al. 2019)
  * with a randomized Gaussian-mixture orientation accumulator, curvature-weighted soft voting,
  * sub-cell refinement, and extraction of several cylinders.
@@ -44,14 +61,29 @@ namespace facyl {
  * if (hough.segment(inliers, coefficients)) ...
  * \endcode
  *
+ * <b>Normals without curvatures (a drop-in for PCL's cylinder tutorial).</b> The default
+ * SoftCurvature voting needs principal curvatures. When PointNT carries none (pcl::Normal,
+ * pcl::PointNormal) and none were given with setInputCurvatures, the estimator estimates them
+ * from the points itself, at the scale of facyl's own NormalCurvatureEstimation (normals of
+ * the 16 nearest points, then the spread of those normals), whatever scale the given normals
+ * have: with curvatures from normals smoothed over k = 50 neighbours (the tutorial's
+ * pcl::NormalEstimation, then pcl::PrincipalCurvaturesEstimation at k = 50) the axis found on
+ * the tutorial's mug is 81 degrees off. The given normals stay the normals of the vote and of
+ * the inlier test. setEstimateCurvatures(false) turns this off: segment() then fails with
+ * HoughFailure::NoCurvatures. The other voting modes need normals only.
+ *
  * Inputs that cannot give an answer (no cloud, no normals, sizes that differ, no finite point,
- * invalid parameters, SoftCurvature without curvatures) are reported with PCL_ERROR and make
- * segment() return false with empty outputs. segment() is not reentrant on one object; distinct
- * objects may run concurrently.
+ * invalid parameters, SoftCurvature without curvatures when their estimation is off) are
+ * reported with PCL_ERROR; a search that finds no cylinder (too few points, a cylinder outside
+ * the radius limits, none at all) with PCL_WARN (PCL_DEBUG after setDiagnoseFailures(false)).
+ * Either way segment() returns false with empty outputs, and getFailureReason() /
+ * getFailureMessage() say why. segment() is not reentrant on one object; distinct objects may
+ * run concurrently.
  *
  * \tparam PointT a point type with x, y, z
  * \tparam PointNT a type with normal_x/y/z; if it also has principal_curvature_x/y/z, pc1 and
- *         pc2 (facyl::NormalCurvature), those are the curvatures used by SoftCurvature voting.
+ *         pc2 (facyl::NormalCurvature), those are the curvatures used by SoftCurvature voting;
+ *         otherwise they are estimated from the points (see above).
  */
 template <typename PointT, typename PointNT>
 class HoughCylinderEstimation : public pcl::PCLBase<PointT> {
@@ -91,6 +123,57 @@ public:
   getInputCurvatures() const
   {
     return curvatures_;
+  }
+
+  /** \brief With SoftCurvature voting, when PointNT carries no curvatures and none were
+   * given: estimate the curvatures from the 16 nearest points (default true). false:
+   * segment() fails with HoughFailure::NoCurvatures instead. */
+  void
+  setEstimateCurvatures(bool estimate)
+  {
+    estimate_curvatures_ = estimate;
+  }
+  /** \brief Whether missing curvatures are estimated. */
+  bool
+  getEstimateCurvatures() const
+  {
+    return estimate_curvatures_;
+  }
+  /** \brief Whether the last segment() estimated the curvatures itself. */
+  bool
+  curvaturesWereEstimated() const
+  {
+    return curvatures_estimated_;
+  }
+
+  /** \brief Whether a search that finds nothing is diagnosed (default true): with radius
+   * limits, the search is run once more without them, so that a cylinder they exclude is
+   * reported as HoughFailure::RadiusLimits with its radius, and the outcome is printed with
+   * PCL_WARN. false (pipelines for which "no cylinder" is a normal answer, e.g. one fit per
+   * cluster): no second search (HoughFailure::NoCylinder or TooFewPoints) and PCL_DEBUG. */
+  void
+  setDiagnoseFailures(bool diagnose)
+  {
+    diagnose_failures_ = diagnose;
+  }
+  /** \brief Whether a search that finds nothing is diagnosed. */
+  bool
+  getDiagnoseFailures() const
+  {
+    return diagnose_failures_;
+  }
+
+  /** \brief Why the last segment() returned false (HoughFailure::None after a success). */
+  HoughFailure
+  getFailureReason() const
+  {
+    return failure_;
+  }
+  /** \brief The reason in words, as printed (empty after a success). */
+  const std::string&
+  getFailureMessage() const
+  {
+    return failure_message_;
   }
 
   /** \brief All numeric settings at once (see HoughCylinderParameters). */
@@ -369,6 +452,20 @@ public:
 private:
   const std::vector<OrientationAccumulator>&
   accumulators();
+
+  enum class Level { Error, Warn, Debug };
+  /** Records the failure, prints it at \a level, returns false. */
+  bool
+  fail(HoughFailure reason, const std::string& message, Level level = Level::Error);
+  /** After fitCylinders found nothing among \a n usable points: the reason. */
+  bool
+  explainNoCylinder(const CylinderCues& cues, std::size_t total_points);
+
+  bool estimate_curvatures_{true};
+  bool diagnose_failures_{true};
+  bool curvatures_estimated_{false};
+  HoughFailure failure_{HoughFailure::None};
+  std::string failure_message_;
 
   NormalsConstPtr normals_;
   CurvaturesConstPtr curvatures_;

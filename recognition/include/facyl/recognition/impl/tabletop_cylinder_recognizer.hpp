@@ -58,6 +58,7 @@ TabletopCylinderRecognizer<PointT>::configure()
     if (e == 3)
       hp.outward_normals = false;
     estimators_[e].setParameters(hp);
+    estimators_[e].setDiagnoseFailures(false); // a cluster without a cylinder is an answer
     estimators_[e].setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
     estimators_[e].setNumberOfOrientations(params_.orientations);
     estimators_[e].setSeed(params_.seed);
@@ -70,6 +71,7 @@ TabletopCylinderRecognizer<PointT>::configure()
     hp.refine = false; // the axis stays the support's normal
     estimators_.emplace_back();
     estimators_.back().setParameters(hp);
+    estimators_.back().setDiagnoseFailures(false);
     upright_ = estimators_.size() - 1;
   }
   else

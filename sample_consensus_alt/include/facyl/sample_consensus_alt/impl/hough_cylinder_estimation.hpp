@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/features/local_geometry.h>
+#include <facyl/features/point_cues.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 
 #include <pcl/common/point_tests.h>
@@ -11,7 +12,11 @@
 #include <pcl/point_traits.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <exception>
+#include <limits>
+#include <string>
 
 namespace facyl {
 
@@ -57,61 +62,125 @@ HoughCylinderEstimation<PointT, PointNT>::segment(pcl::PointIndices& inliers,
 
 template <typename PointT, typename PointNT>
 bool
+HoughCylinderEstimation<PointT, PointNT>::fail(HoughFailure reason, const std::string& message,
+                                               Level level)
+{
+  failure_ = reason;
+  failure_message_ = message;
+  const std::string name = getClassName();
+  if (level == Level::Error)
+    PCL_ERROR("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
+  else if (level == Level::Warn)
+    PCL_WARN("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
+  else
+    PCL_DEBUG("[facyl::%s::segment] %s.\n", name.c_str(), message.c_str());
+  return false;
+}
+
+namespace detail {
+/** printf into a std::string (messages of HoughCylinderEstimation). */
+template <typename... Args>
+std::string
+houghFormat(const char* format, Args... args)
+{
+  char buffer[512];
+  std::snprintf(buffer, sizeof buffer, format, args...);
+  return buffer;
+}
+} // namespace detail
+
+template <typename PointT, typename PointNT>
+bool
+HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& cues,
+                                                            std::size_t total_points)
+{
+  using detail::houghFormat;
+  const Level level = diagnose_failures_ ? Level::Warn : Level::Debug;
+  const std::size_t n = static_cast<std::size_t>(cues.points.cols());
+  const std::size_t min_inliers =
+      params_.min_inliers > 0 ? params_.min_inliers
+                              : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+  if (n < min_inliers)
+    return fail(HoughFailure::TooFewPoints,
+                houghFormat("too few points: %zu usable of %zu, and a cylinder needs %zu inliers "
+                            "(setMinInliers)",
+                            n, total_points, min_inliers),
+                level);
+  const bool limited = params_.radius_min > 0.f || std::isfinite(params_.radius_max);
+  if (limited && diagnose_failures_) {
+    // The same search without radius limits: a cylinder outside them is worth saying.
+    HoughCylinderParameters open = params_;
+    open.radius_min = 0.f;
+    open.radius_max = std::numeric_limits<float>::infinity();
+    open.max_cylinders = 1;
+    std::vector<CylinderModel> found;
+    try {
+      found = fitCylinders(cues, accumulators(), open, total_points);
+    }
+    catch (const std::exception&) {
+      found.clear();
+    }
+    if (!found.empty() && (found.front().radius < params_.radius_min ||
+                           found.front().radius > params_.radius_max))
+      return fail(HoughFailure::RadiusLimits,
+                  houghFormat("the radius limits [%g, %g] exclude every candidate: without them "
+                              "the best cylinder has radius %g (%zu inliers)",
+                              params_.radius_min, params_.radius_max, found.front().radius,
+                              found.front().inliers.size()),
+                  level);
+  }
+  return fail(HoughFailure::NoCylinder,
+              houghFormat("no cylinder found among %zu points (%zu usable; a cylinder needs %zu "
+                          "inliers)",
+                          total_points, n, min_inliers),
+              level);
+}
+
+template <typename PointT, typename PointNT>
+bool
 HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cylinders)
 {
+  using detail::houghFormat;
   cylinders.clear();
-  const char* name = "HoughCylinderEstimation";
-  if (!this->input_) {
-    PCL_ERROR("[facyl::%s::segment] no input cloud: call setInputCloud first.\n", name);
-    return false;
-  }
-  if (this->input_->empty()) {
-    PCL_ERROR("[facyl::%s::segment] the input cloud is empty.\n", name);
-    return false;
-  }
-  if (!normals_) {
-    PCL_ERROR("[facyl::%s::segment] no normals: call setInputNormals (e.g. with the output of "
-              "facyl::NormalCurvatureEstimation).\n",
-              name);
-    return false;
-  }
-  if (normals_->size() != this->input_->size()) {
-    PCL_ERROR("[facyl::%s::segment] %zu normals for %zu points: give one normal per point.\n",
-              name, normals_->size(), this->input_->size());
-    return false;
-  }
-  if (curvatures_ && curvatures_->size() != this->input_->size()) {
-    PCL_ERROR("[facyl::%s::segment] %zu curvatures for %zu points: give one per point.\n", name,
-              curvatures_->size(), this->input_->size());
-    return false;
-  }
+  failure_ = HoughFailure::None;
+  failure_message_.clear();
+  curvatures_estimated_ = false;
+  if (!this->input_)
+    return fail(HoughFailure::NoInputCloud, "no input cloud: call setInputCloud first");
+  if (this->input_->empty())
+    return fail(HoughFailure::EmptyCloud, "the input cloud is empty");
+  if (!normals_)
+    return fail(HoughFailure::NoNormals,
+                "no normals: call setInputNormals (e.g. with the output of "
+                "facyl::NormalCurvatureEstimation or pcl::NormalEstimation)");
+  if (normals_->size() != this->input_->size())
+    return fail(HoughFailure::SizeMismatch,
+                houghFormat("%zu normals for %zu points: give one normal per point",
+                            normals_->size(), this->input_->size()));
+  if (curvatures_ && curvatures_->size() != this->input_->size())
+    return fail(HoughFailure::SizeMismatch,
+                houghFormat("%zu curvatures for %zu points: give one per point",
+                            curvatures_->size(), this->input_->size()));
   const std::string why = validate(params_);
-  if (!why.empty()) {
-    PCL_ERROR("[facyl::%s::segment] %s.\n", name, why.c_str());
-    return false;
-  }
+  if (!why.empty())
+    return fail(HoughFailure::InvalidParameters, why);
   if (user_accumulators_.empty()) {
     std::string bad;
-    if (num_orientations_ == 0 || num_accumulators_ == 0) {
-      PCL_ERROR("[facyl::%s::segment] the orientation accumulator is empty (N_d = %zu, %zu "
-                "accumulators).\n",
-                name, num_orientations_, num_accumulators_);
-      return false;
-    }
-    if (!mixture_.isValid(&bad)) {
-      PCL_ERROR("[facyl::%s::segment] invalid orientation prior: %s.\n", name, bad.c_str());
-      return false;
-    }
-    if (!frame_.allFinite() || std::abs(frame_.determinant()) < 1e-6f) {
-      PCL_ERROR("[facyl::%s::segment] the reference frame is singular or not finite.\n", name);
-      return false;
-    }
+    if (num_orientations_ == 0 || num_accumulators_ == 0)
+      return fail(HoughFailure::InvalidParameters,
+                  houghFormat("the orientation accumulator is empty (N_d = %zu, %zu "
+                              "accumulators)",
+                              num_orientations_, num_accumulators_));
+    if (!mixture_.isValid(&bad))
+      return fail(HoughFailure::InvalidParameters, "invalid orientation prior: " + bad);
+    if (!frame_.allFinite() || std::abs(frame_.determinant()) < 1e-6f)
+      return fail(HoughFailure::InvalidParameters,
+                  "the reference frame is singular or not finite");
   }
   else if (std::any_of(user_accumulators_.begin(), user_accumulators_.end(),
                        [](const OrientationAccumulator& a) { return a.size() == 0; })) {
-    PCL_ERROR("[facyl::%s::segment] an accumulator given with setAccumulators is empty.\n",
-              name);
-    return false;
+    return fail(HoughFailure::InvalidParameters,
+                "an accumulator given with setAccumulators is empty");
   }
 
   constexpr bool normals_carry_curvature =
@@ -119,18 +188,15 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
       pcl::traits::has_field<PointNT, pcl::fields::pc2>::value &&
       pcl::traits::has_field<PointNT, pcl::fields::principal_curvature_x>::value;
   const bool need_curvature = params_.voting_mode == VotingMode::SoftCurvature;
-  if (need_curvature && !curvatures_ && !normals_carry_curvature) {
-    PCL_ERROR("[facyl::%s::segment] SoftCurvature voting needs principal curvatures: use "
-              "facyl::NormalCurvature normals, call setInputCurvatures, or choose another "
-              "voting mode.\n",
-              name);
-    return false;
-  }
+  const bool estimate = need_curvature && !curvatures_ && !normals_carry_curvature;
+  if (estimate && !estimate_curvatures_)
+    return fail(HoughFailure::NoCurvatures,
+                "SoftCurvature voting needs principal curvatures and their estimation is off "
+                "(setEstimateCurvatures(false)): use facyl::NormalCurvature normals, call "
+                "setInputCurvatures, turn the estimation on, or choose another voting mode");
 
-  if (!this->initCompute()) {
-    PCL_ERROR("[facyl::%s::segment] invalid input or indices.\n", name);
-    return false;
-  }
+  if (!this->initCompute())
+    return fail(HoughFailure::InvalidIndices, "invalid input or indices");
   const auto& indices = *this->indices_;
   const auto& cloud = *this->input_;
   const auto& normals = *normals_;
@@ -142,17 +208,18 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
   const auto n_max = static_cast<Eigen::Index>(indices.size());
   cues.points.resize(3, n_max);
   cues.normals.resize(3, n_max);
-  if (need_curvature) {
+  const bool given_curvature = need_curvature && !estimate;
+  if (given_curvature) {
     cues.curvature_directions.resize(3, n_max);
     cues.weights.resize(n_max);
   }
   Eigen::Index n = 0;
   for (const auto idx : indices) {
     if (idx < 0 || static_cast<std::size_t>(idx) >= cloud.size()) {
-      PCL_ERROR("[facyl::%s::segment] index %d is outside the cloud (%zu points).\n", name,
-                static_cast<int>(idx), cloud.size());
       this->deinitCompute();
-      return false;
+      return fail(HoughFailure::InvalidIndices,
+                  houghFormat("index %d is outside the cloud (%zu points)",
+                              static_cast<int>(idx), cloud.size()));
     }
     const auto& p = cloud[idx];
     const auto& q = normals[idx];
@@ -162,7 +229,7 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
       continue;
     cues.points.col(n) = p.getVector3fMap();
     cues.normals.col(n) = normal / len;
-    if (need_curvature) {
+    if (given_curvature) {
       Eigen::Vector3f c{Eigen::Vector3f::Zero()};
       float k_max = 0.f, k_min = 0.f;
       if (curvatures_) {
@@ -187,38 +254,50 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     ++n;
   }
   this->deinitCompute();
-  if (n == 0) {
-    PCL_ERROR("[facyl::%s::segment] none of the %zu points has a finite position and "
-              "normal.\n",
-              name, indices.size());
-    return false;
-  }
+  if (n == 0)
+    return fail(HoughFailure::NoFinitePoints,
+                houghFormat("none of the %zu points has a finite position and normal",
+                            indices.size()));
   cues.points.conservativeResize(3, n);
   cues.normals.conservativeResize(3, n);
-  if (need_curvature) {
+  if (given_curvature) {
     cues.curvature_directions.conservativeResize(3, n);
     cues.weights.conservativeResize(n);
   }
 
   try {
+    if (estimate) {
+      // Curvatures at facyl's own scale (NormalCurvatureEstimation's k = 16: normals of the
+      // 16 nearest points, then the spread of those normals), whatever scale the given
+      // normals have: normals smoothed over k = 50 neighbours bend c_max on a small cylinder.
+      // The given normals stay the normals of the vote and of the inlier test. Columns
+      // without a usable neighbourhood vote without curvature (weight 0).
+      constexpr int kCueNeighbours = 16;
+      const PointCues own = estimatePointCues(cues.points, std::numeric_limits<float>::max(),
+                                              kCueNeighbours, cues.normals);
+      cues.curvature_directions.setZero(3, n);
+      cues.weights.setZero(n);
+      for (Eigen::Index s = 0; s < n; ++s) {
+        if (own.curvature_directions.col(s).allFinite()) {
+          cues.curvature_directions.col(s) = own.curvature_directions.col(s);
+          cues.weights(s) = own.weights(s);
+        }
+      }
+      curvatures_estimated_ = true;
+    }
     cylinders = fitCylinders(cues, accumulators(), params_, indices.size());
   }
   catch (const std::exception& e) {
-    PCL_ERROR("[facyl::%s::segment] %s\n", name, e.what());
     cylinders.clear();
-    return false;
+    return fail(HoughFailure::InternalError, e.what());
   }
   for (auto& c : cylinders) {
     for (auto& i : c.inliers)
       i = column_to_index[static_cast<std::size_t>(i)];
     std::sort(c.inliers.begin(), c.inliers.end());
   }
-  if (cylinders.empty()) {
-    // A normal outcome (the points hold no cylinder), not something to act on.
-    PCL_DEBUG("[facyl::%s::segment] no cylinder found among %zu points.\n", name,
-              indices.size());
-    return false;
-  }
+  if (cylinders.empty())
+    return explainNoCylinder(cues, indices.size());
   return true;
 }
 
