@@ -10,6 +10,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <string>
 #include <vector>
 
 namespace facyl_cli {
@@ -43,10 +44,11 @@ estimateFitCues(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud, int k, un
 }
 
 /** HoughCylinderEstimation of \a cloud with \a cues and \a s; an empty list when no cylinder
- * is found. */
+ * is found, and then, with \a why, the estimator's reason (getFailureMessage). */
 inline std::vector<facyl::CylinderModel>
 houghFit(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
-         const pcl::PointCloud<facyl::NormalCurvature>::ConstPtr& cues, const HoughSettings& s)
+         const pcl::PointCloud<facyl::NormalCurvature>::ConstPtr& cues, const HoughSettings& s,
+         std::string* why = nullptr)
 {
   facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
   hough.setParameters(s.params);
@@ -58,7 +60,8 @@ houghFit(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
   hough.setInputCloud(cloud);
   hough.setInputNormals(cues);
   std::vector<facyl::CylinderModel> models;
-  hough.segment(models); // false with no cylinder: an empty list, not an error
+  if (!hough.segment(models) && why) // no cylinder: an empty list and its reason, not an error
+    *why = hough.getFailureMessage();
   return models;
 }
 

@@ -127,9 +127,12 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   if (s.method == "pcl-ransac") {
     models = fitPclRansac(cloud, *cues, s);
   }
-  else
-    models = facyl_cli::houghFit(cloud, cues, s);
+  std::string why;
+  if (s.method != "pcl-ransac")
+    models = facyl_cli::houghFit(cloud, cues, s, &why);
   const double fit_ms = fit_watch.getTime();
+  if (models.empty() && !why.empty())
+    std::fprintf(stderr, "facyl_fit: %s: no cylinder: %s\n", file.c_str(), why.c_str());
 
   using facyl_cli::number;
   const char* units_name = s.units == facyl_cli::Units::Millimetres ? "mm" : "m";
@@ -144,7 +147,10 @@ processFile(const std::string& file, const Settings& s, bool& ok)
     facyl_cli::scaleModel(m, 1.f / to_metres);
     out += (i ? "," : "") + facyl_cli::cylinderJson(m, s.inlier_indices);
   }
-  out += "],\"timing_ms\":{\"load\":" + number(load_ms) + ",\"normals\":" + number(normals_ms) +
+  out += "]";
+  if (models.empty() && !why.empty())
+    out += ",\"why_none\":" + facyl_cli::quote(why);
+  out += ",\"timing_ms\":{\"load\":" + number(load_ms) + ",\"normals\":" + number(normals_ms) +
          ",\"fit\":" + number(fit_ms) + ",\"total\":" + number(total_watch.getTime()) + "}}";
   ok = true;
   return out;

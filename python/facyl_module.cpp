@@ -266,12 +266,12 @@ fitSettings(const py::dict& options)
  * unless \a normals. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
-         const FitSettings& s)
+         const FitSettings& s, std::string* why = nullptr)
 {
   const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, 0, normals);
   if (cues->size() != cloud->size())
     return {};
-  return facyl_cli::houghFit(cloud, cues, s);
+  return facyl_cli::houghFit(cloud, cues, s, why);
 }
 
 pcl::PointCloud<pcl::Normal>::Ptr
@@ -309,10 +309,16 @@ fitCylinders(const py::object& points, const py::object& normals, const py::dict
   if (!units.empty())
     throw py::value_error("points: " + units);
   std::vector<facyl::CylinderModel> models;
+  std::string why;
   {
     py::gil_scoped_release release;
-    models = fitCloud(cloud, given, s);
+    models = fitCloud(cloud, given, s, &why);
   }
+  // No cylinder is an answer, not an error; its reason (the radius limits excluding the one
+  // there, too few points, ...) is a UserWarning.
+  if (models.empty() && !why.empty() &&
+      PyErr_WarnEx(PyExc_UserWarning, ("fit_cylinders: no cylinder: " + why).c_str(), 1) != 0)
+    throw py::error_already_set();
   std::vector<PyCylinder> out;
   for (auto& m : models) {
     facyl_cli::scaleModel(m, 1.f / to_metres);
@@ -867,7 +873,8 @@ units: facyl works in metres. "auto" (default): metres, and a cloud evidently in
 (spanning more than 20 units) or radius limits beyond 1 raise ValueError; "m": metres, no
 check; "mm": points, lengths given and results in millimetres (converted to metres for the
 fit and back).
-Returns a list of Cylinder, best first; empty when no cylinder is found. Raises
+Returns a list of Cylinder, best first; empty when no cylinder is found (with a UserWarning that
+says why: the radius limits exclude the cylinder there, too few points, ...). Raises
 ValueError/TypeError for bad input.)");
 
   m.def("estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),

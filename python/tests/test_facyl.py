@@ -58,6 +58,15 @@ def test_fit_recovers_simulated_cylinders():
         assert coeff.shape == (7,) and coeff[6] == pytest.approx(c.radius)
 
 
+def test_no_cylinder_says_why():
+    # The simulator's default radius (the paper's 0.3 m) lies outside the default radius
+    # limits (0.01-0.25 m): no cylinder, and a warning that names the limits and the radius.
+    points = facyl.simulate_cylinder(seed=3)["points"]
+    with pytest.warns(UserWarning, match=r"radius limits .* radius 0\.3"):
+        assert facyl.fit_cylinders(points) == []
+    assert len(facyl.fit_cylinders(points, radius_limits="auto")) == 1
+
+
 @pytest.mark.skipif(not FACYL_FIT, reason="FACYL_FIT (facyl_fit binary) not given")
 def test_same_result_as_facyl_fit_for_the_same_seed():
     sim = cylinder(seed=11, noise=0.02)
