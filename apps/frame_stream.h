@@ -50,27 +50,13 @@ struct StreamFrame {
   std::vector<std::string> skipped;
 };
 
-/** The header check of readPcd, without reading the data. \return an empty string, or why
- * facyl would refuse \a file. */
+/** The header check of readPcd (checkPcdHeader), without reading the data. \return an empty
+ * string, or why facyl would refuse \a file. */
 inline std::string
 checkPcdFile(const std::string& file)
 {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    return "not a regular file";
-  const std::uint64_t size = std::filesystem::file_size(file, ec);
-  if (ec)
-    return "cannot read the file's size";
-  std::ifstream in(file, std::ios::binary);
-  if (!in)
-    return "cannot open the file";
   PcdHeader h;
-  std::string why = parsePcdHeader(in, h);
-  if (why.empty())
-    why = checkPcdSize(in, h, size);
-  if (why.empty() && h.points == 0)
-    why = "the cloud is empty (POINTS 0)";
-  return why;
+  return checkPcdHeader(file, h);
 }
 
 /** The frames of a stream source: the PCD files of folder \a source sorted by name (or

@@ -205,11 +205,11 @@ struct Viewpoint {
   Eigen::Quaternionf orientation{Eigen::Quaternionf::Identity()};
 };
 
-/** Reads \a file into \a blob (and its VIEWPOINT into \a viewpoint): regular files only, the
- * header checked against the file's length before anything is allocated, x, y, z as 4-byte
- * floats. \return an empty string, or why the file cannot be used. */
+/** The checks of a PCD file that need only its header: a regular file, a header that agrees
+ * with the file's length, x, y, z as 4-byte floats, at least one point. Fills \a h.
+ * \return an empty string, or why facyl would refuse \a file. */
 inline std::string
-readPcd(const std::string& file, pcl::PCLPointCloud2& blob, Viewpoint* viewpoint = nullptr)
+checkPcdHeader(const std::string& file, PcdHeader& h)
 {
   std::error_code ec;
   const auto status = std::filesystem::status(file, ec);
@@ -225,13 +225,11 @@ readPcd(const std::string& file, pcl::PCLPointCloud2& blob, Viewpoint* viewpoint
   std::ifstream in(file, std::ios::binary);
   if (!in)
     return "cannot open the file";
-  PcdHeader h;
   std::string why = parsePcdHeader(in, h);
   if (why.empty())
     why = checkPcdSize(in, h, file_size);
   if (!why.empty())
     return why;
-  in.close();
   for (const char* axis : {"x", "y", "z"}) {
     std::size_t i = 0;
     while (i < h.fields.size() && h.fields[i] != axis)
@@ -247,6 +245,18 @@ readPcd(const std::string& file, pcl::PCLPointCloud2& blob, Viewpoint* viewpoint
   }
   if (h.points == 0)
     return "the cloud is empty (POINTS 0)";
+  return "";
+}
+
+/** Reads \a file into \a blob (and its VIEWPOINT into \a viewpoint): regular files only, the
+ * header checked against the file's length before anything is allocated (checkPcdHeader), x,
+ * y, z as 4-byte floats. \return an empty string, or why the file cannot be used. */
+inline std::string
+readPcd(const std::string& file, pcl::PCLPointCloud2& blob, Viewpoint* viewpoint = nullptr)
+{
+  PcdHeader h;
+  if (std::string why = checkPcdHeader(file, h); !why.empty())
+    return why;
   pcl::PCDReader reader;
   Eigen::Vector4f origin;
   Eigen::Quaternionf orientation;
