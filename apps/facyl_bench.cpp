@@ -5,8 +5,8 @@
  * the same cloud and normals; writes every fit (fits.csv) and a summary (summary.md).
  * scripts/bench_plot.py draws the figure from fits.csv.
  */
-#include "cli.h"
-#include "pcl_baseline.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/pcl_baseline.h>
 
 #include <facyl/features/parallel.h>
 #include <facyl/features/normal_curvature_estimation.h>
@@ -320,129 +320,103 @@ printHelp(const char* self)
 
 } // namespace
 
-int
-main(int argc, char** argv)
-{
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_bench", printHelp); rc >= 0)
-    return rc;
-  int scenes = 1000, threads = 0;
-  std::uint64_t seed = 1;
-  std::string out = "bench_out", dump;
+/** The command line. */
+struct Options {
+  int scenes{1000}, threads{0};
+  std::uint64_t seed{1};
+  std::string out{"bench_out"}, dump, method_filter;
   std::vector<std::string> settings{"paper", "practical"};
-  std::vector<Level> lv = levels();
-  std::string method_filter;
-  try {
-    const facyl_cli::Arguments args(
-        argc, argv,
-        {"--scenes", "--settings", "--seed", "--threads", "--out", "--dump", "--levels",
-         "--methods"},
-        {"--quick"});
-    dump = args.text("--dump", "");
-    if (!args.positional().empty())
-      throw std::invalid_argument("unexpected argument " + args.positional()[0]);
-    scenes = static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1, 1000000));
-    seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0, facyl_cli::kMaxSeed));
-    threads = static_cast<int>(args.integer("--threads", 0, 0, 256));
-    out = args.text("--out", out);
-    facyl_cli::checkOutputFolder("--out", out, [](const std::string&) { return false; }, {});
-    const std::string list = args.text("--settings", "paper,practical");
-    settings.clear();
-    std::stringstream ss(list);
-    for (std::string s; std::getline(ss, s, ',');) {
-      if (s != "paper" && s != "practical" && s != "random")
-        throw std::invalid_argument("unknown setting '" + s + "'");
-      settings.push_back(s);
-    }
-    if (args.has("--levels"))
-      lv = parseLevels(args.text("--levels", ""));
-    method_filter = args.text("--methods", "");
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_bench: %s\n", e.what());
-    return 2;
-  }
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) {
-    std::fprintf(stderr, "facyl_bench: cannot create %s: %s\n", out.c_str(), ec.message().c_str());
-    return 1;
-  }
-  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); // "no cylinder" is a result here
+  std::vector<Level> levels{::levels()};
+};
 
-  if (!dump.empty()) {
-    std::stringstream ss(dump);
-    std::string setting, sweep, level, scene;
-    std::getline(ss, setting, ',');
-    std::getline(ss, sweep, ',');
-    std::getline(ss, level, ',');
-    std::getline(ss, scene, ',');
-    for (const auto& l : lv)
-      if (l.sweep == sweep && !level.empty() && std::abs(l.value - std::stof(level)) < 1e-4f &&
-          (setting == "paper" || setting == "practical" || setting == "random") &&
-          !scene.empty()) {
-        const Scene s = makeScene(setting, l, std::stoi(scene), seed);
-        pcl::io::savePCDFileBinary(out + "/scene.pcd", *s.cloud);
-        std::printf("{\"file\":%s,\"radius\":%s,\"axis\":%s,\"base\":%s}\n",
-                    facyl_cli::quote(out + "/scene.pcd").c_str(),
-                    facyl_cli::number(s.truth.radius).c_str(),
-                    facyl_cli::vector(s.truth.axis).c_str(),
-                    facyl_cli::vector(s.truth.base).c_str());
-        return 0;
-      }
-    std::fprintf(stderr, "facyl_bench: --dump wants SETTING,SWEEP,LEVEL,SCENE as in fits.csv\n");
-    return 2;
+/** Reads the options. \throws std::invalid_argument for a bad one. */
+Options
+parseOptions(int argc, char** argv)
+{
+  Options o;
+  const facyl_cli::Arguments args(argc, argv,
+                                  {"--scenes", "--settings", "--seed", "--threads", "--out",
+                                   "--dump", "--levels", "--methods"},
+                                  {"--quick"});
+  o.dump = args.text("--dump", "");
+  if (!args.positional().empty())
+    throw std::invalid_argument("unexpected argument " + args.positional()[0]);
+  o.scenes =
+      static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1, 1000000));
+  o.seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0, facyl_cli::kMaxSeed));
+  o.threads = static_cast<int>(args.integer("--threads", 0, 0, 256));
+  o.out = args.text("--out", o.out);
+  facyl_cli::checkOutputFolder("--out", o.out, [](const std::string&) { return false; }, {});
+  o.settings.clear();
+  std::stringstream ss(args.text("--settings", "paper,practical"));
+  for (std::string s; std::getline(ss, s, ',');) {
+    if (s != "paper" && s != "practical" && s != "random")
+      throw std::invalid_argument("unknown setting '" + s + "'");
+    o.settings.push_back(s);
   }
-  std::vector<Task> tasks;
-  for (const auto& s : settings)
-    for (std::size_t l = 0; l < lv.size(); ++l)
-      for (int k = 0; k < scenes; ++k)
-        tasks.push_back({s, l, k});
-  std::map<std::string, std::vector<Method>> method_sets;
-  for (const auto& s : settings) {
-    method_sets[s] = methods(s);
-    if (!method_filter.empty()) {
-      auto& ms = method_sets[s];
-      const std::string list = "," + method_filter + ",";
-      ms.erase(std::remove_if(ms.begin(), ms.end(),
-                              [&](const Method& m) {
-                                return list.find("," + m.name + ",") == std::string::npos;
-                              }),
-               ms.end());
-      if (ms.empty()) {
-        std::fprintf(stderr, "facyl_bench: --methods names no method of setting %s\n",
-                     s.c_str());
-        return 2;
-      }
+  if (args.has("--levels"))
+    o.levels = parseLevels(args.text("--levels", ""));
+  o.method_filter = args.text("--methods", "");
+  return o;
+}
+
+/** --dump: writes the scene SETTING,SWEEP,LEVEL,SCENE to OUT/scene.pcd and prints its truth.
+ * \return the exit status. */
+int
+dumpScene(const Options& o)
+{
+  std::stringstream ss(o.dump);
+  std::string setting, sweep, level, scene;
+  std::getline(ss, setting, ',');
+  std::getline(ss, sweep, ',');
+  std::getline(ss, level, ',');
+  std::getline(ss, scene, ',');
+  for (const auto& l : o.levels)
+    if (l.sweep == sweep && !level.empty() && std::abs(l.value - std::stof(level)) < 1e-4f &&
+        (setting == "paper" || setting == "practical" || setting == "random") &&
+        !scene.empty()) {
+      const Scene s = makeScene(setting, l, std::stoi(scene), o.seed);
+      pcl::io::savePCDFileBinary(o.out + "/scene.pcd", *s.cloud);
+      std::printf("{\"file\":%s,\"radius\":%s,\"axis\":%s,\"base\":%s}\n",
+                  facyl_cli::quote(o.out + "/scene.pcd").c_str(),
+                  facyl_cli::number(s.truth.radius).c_str(),
+                  facyl_cli::vector(s.truth.axis).c_str(),
+                  facyl_cli::vector(s.truth.base).c_str());
+      return 0;
     }
+  std::fprintf(stderr, "facyl_bench: --dump wants SETTING,SWEEP,LEVEL,SCENE as in fits.csv\n");
+  return 2;
+}
+
+/** The methods of each setting, kept to --methods when given. \throws std::invalid_argument
+ * when --methods leaves a setting without any. */
+std::map<std::string, std::vector<Method>>
+methodSets(const Options& o)
+{
+  std::map<std::string, std::vector<Method>> sets;
+  for (const auto& s : o.settings) {
+    auto& ms = sets[s] = methods(s);
+    if (o.method_filter.empty())
+      continue;
+    const std::string list = "," + o.method_filter + ",";
+    ms.erase(std::remove_if(ms.begin(), ms.end(),
+                            [&](const Method& m) {
+                              return list.find("," + m.name + ",") == std::string::npos;
+                            }),
+             ms.end());
+    if (ms.empty())
+      throw std::invalid_argument("--methods names no method of setting " + s);
   }
-  std::vector<std::vector<Fit>> results(tasks.size());
+  return sets;
+}
 
-  const int workers = facyl::parallelWorkers(tasks.size(), threads, 1);
-  std::fprintf(stderr, "facyl_bench: %zu scene-levels (%d scenes x %zu levels x %zu settings) on "
-                       "%d threads\n",
-               tasks.size(), scenes, lv.size(), settings.size(), workers);
-  std::atomic<std::size_t> done{0};
-  const auto start = std::chrono::steady_clock::now();
-  std::mutex progress;
-  auto last = start;
-  facyl::parallelFor(tasks.size(), threads, 1, [&](std::size_t i, std::size_t) {
-    const auto& t = tasks[i];
-    results[i] = runTask(t, lv[t.level], method_sets[t.setting], seed);
-    const std::size_t d = ++done;
-    const std::lock_guard<std::mutex> lock(progress);
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last > std::chrono::seconds(5) || d == tasks.size()) {
-      last = now;
-      const double el = std::chrono::duration<double>(now - start).count();
-      std::fprintf(stderr, "facyl_bench: %zu/%zu, %.0f s, about %.0f s left\n", d, tasks.size(),
-                   el, el / static_cast<double>(d) * (tasks.size() - d));
-    }
-  });
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  // Every fit.
-  std::ofstream csv(out + "/fits.csv");
+/** Every fit, one line each, to OUT/fits.csv. */
+void
+writeFits(const Options& o, const std::vector<Task>& tasks,
+          std::map<std::string, std::vector<Method>>& method_sets,
+          const std::vector<std::vector<Fit>>& results)
+{
+  std::ofstream csv(o.out + "/fits.csv");
   csv << "setting,sweep,level,scene,method,found,axis_error_deg,radius_error_m,"
          "position_error_m,time_ms\n";
   for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -450,16 +424,25 @@ main(int argc, char** argv)
     const auto& ms = method_sets[t.setting];
     for (std::size_t m = 0; m < ms.size(); ++m) {
       const auto& f = results[i][m];
-      csv << t.setting << ',' << lv[t.level].sweep << ',' << lv[t.level].value << ',' << t.scene
-          << ',' << ms[m].name << ',' << f.found << ',' << f.axis_deg << ',' << f.radius_err
-          << ',' << f.position_err << ',' << f.time_ms << '\n';
+      csv << t.setting << ',' << o.levels[t.level].sweep << ',' << o.levels[t.level].value << ','
+          << t.scene << ',' << ms[m].name << ',' << f.found << ',' << f.axis_deg << ','
+          << f.radius_err << ',' << f.position_err << ',' << f.time_ms << '\n';
     }
   }
-  csv.close();
+}
 
-  // Summary: per setting, sweep, method and level. A fit that found nothing counts as an
-  // infinite error (and a failure), so medians stay honest.
-  std::ofstream md(out + "/summary.md");
+/** OUT/summary.md: per setting, sweep, method and level. A fit that found nothing counts as
+ * an infinite error (and a failure), so medians stay honest. */
+void
+writeSummary(const Options& o, const std::vector<Task>& tasks,
+             std::map<std::string, std::vector<Method>>& method_sets,
+             const std::vector<std::vector<Fit>>& results, int workers, double elapsed)
+{
+  const auto& lv = o.levels;
+  const auto& settings = o.settings;
+  const int scenes = o.scenes;
+  const std::uint64_t seed = o.seed;
+  std::ofstream md(o.out + "/summary.md");
   md << "# facyl_bench summary\n\n" << scenes << " scenes per setting and level, seed " << seed
      << ", " << workers << " threads, " << fmt(static_cast<float>(elapsed), 0)
      << " s. Failure: axis error > 10 deg or no cylinder. Errors: median / 90th percentile; "
@@ -517,7 +500,58 @@ main(int argc, char** argv)
     }
   }
   md.close();
+}
+
+int
+main(int argc, char** argv)
+{
+  Options o;
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_bench", printHelp,
+                                      [&] { o = parseOptions(argc, argv); });
+  if (rc >= 0)
+    return rc;
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) {
+    std::fprintf(stderr, "facyl_bench: cannot create %s: %s\n", o.out.c_str(),
+                 ec.message().c_str());
+    return 1;
+  }
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); // "no cylinder" is a result here
+  if (!o.dump.empty())
+    return dumpScene(o);
+  std::map<std::string, std::vector<Method>> method_sets;
+  try {
+    method_sets = methodSets(o);
+  }
+  catch (const std::exception& e) {
+    std::fprintf(stderr, "facyl_bench: %s\n", e.what());
+    return 2;
+  }
+  std::vector<Task> tasks;
+  for (const auto& s : o.settings)
+    for (std::size_t l = 0; l < o.levels.size(); ++l)
+      for (int k = 0; k < o.scenes; ++k)
+        tasks.push_back({s, l, k});
+  std::vector<std::vector<Fit>> results(tasks.size());
+  const int workers = facyl::parallelWorkers(tasks.size(), o.threads, 1);
+  std::fprintf(stderr, "facyl_bench: %zu scene-levels (%d scenes x %zu levels x %zu settings) on "
+                       "%d threads\n",
+               tasks.size(), o.scenes, o.levels.size(), o.settings.size(), workers);
+  const auto start = std::chrono::steady_clock::now();
+  {
+    facyl_cli::Progress progress("facyl_bench", tasks.size(), true);
+    facyl::parallelFor(tasks.size(), o.threads, 1, [&](std::size_t i, std::size_t) {
+      const auto& t = tasks[i];
+      results[i] = runTask(t, o.levels[t.level], method_sets[t.setting], o.seed);
+      progress.step();
+    });
+  }
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  writeFits(o, tasks, method_sets, results);
+  writeSummary(o, tasks, method_sets, results, workers, elapsed);
   std::fprintf(stderr, "facyl_bench: wrote %s/fits.csv and %s/summary.md in %.0f s\n",
-               out.c_str(), out.c_str(), elapsed);
+               o.out.c_str(), o.out.c_str(), elapsed);
   return 0;
 }

@@ -11,10 +11,10 @@
  *   OUT/depth.u8  2 x size x size bytes per object, planar
  *   OUT/objects.csv
  */
-#include "cli.h"
-#include "cylinder_fit.h"
-#include "recognizer_options.h"
-#include "scene_options.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/scene_options.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/classifier_input.h>
@@ -470,16 +470,12 @@ parseSettings(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_crops", printHelp); rc >= 0)
-    return rc;
   Settings s;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_crops", printHelp, [&] {
     s = parseSettings(argc, argv);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_crops: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
   std::size_t failed = 0;
   try {

@@ -2,11 +2,11 @@
  * facyl_detect: every cylinder on the table of RGB-D frames (paper III-A without the CNN).
  * One JSON object per scene on stdout.
  */
-#include "cli.h"
-#include "detect_json.h"
-#include "pcd_input.h"
-#include "recognizer_options.h"
-#include "track_json.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/detect_json.h>
+#include <facyl/tools/pcd_input.h>
+#include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/track_json.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/simulation/frame_roll.h>
@@ -471,17 +471,13 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_detect", printHelp); rc >= 0)
-    return rc;
   Settings s;
   std::vector<std::string> files;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_detect", printHelp, [&] {
     s = parseSettings(argc, argv, files);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_detect: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   // PCL's warnings about a file (e.g. a cloud without colour) would drown the output; the
   // errors that explain a failed scene stay.
   pcl::console::setVerbosityLevel(s.verbose ? pcl::console::L_DEBUG : pcl::console::L_ERROR);
@@ -493,6 +489,7 @@ main(int argc, char** argv)
     stream->tracker.setCamera(s.camera);
   }
   bool all_ok = true;
+  facyl_cli::Progress progress("facyl_detect", files.size());
   for (std::size_t k = 0; k < files.size(); ++k) {
     bool ok = false;
     try {
@@ -508,6 +505,7 @@ main(int argc, char** argv)
       std::cout << "}" << std::endl;
     }
     all_ok = ok && all_ok;
+    progress.step();
   }
   return all_ok ? 0 : 1;
 }

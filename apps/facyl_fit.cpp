@@ -1,12 +1,12 @@
 /*
  * facyl_fit: fit cylinders to PCD files; one JSON object per file on stdout.
  */
-#include "cli.h"
-#include "cylinder_fit.h"
-#include "cylinder_json.h"
-#include "fit_options.h"
-#include "pcd_input.h"
-#include "pcl_baseline.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/cylinder_json.h>
+#include <facyl/tools/fit_options.h>
+#include <facyl/tools/pcd_input.h>
+#include <facyl/tools/pcl_baseline.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
@@ -161,11 +161,9 @@ processFile(const std::string& file, const Settings& s, bool& ok)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_fit", printHelp); rc >= 0)
-    return rc;
   Settings s;
   std::vector<std::string> files;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_fit", printHelp, [&] {
     const facyl_cli::Arguments args(argc, argv, facyl_cli::fitValueOptions(),
                                     facyl_cli::joined(facyl_cli::fitSwitches(), {"--inliers"}),
                                     facyl_cli::fitAliases());
@@ -174,11 +172,9 @@ main(int argc, char** argv)
     s.inlier_indices = args.has("--inliers");
     if (files.empty())
       throw std::invalid_argument("no input file (see -h)");
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_fit: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   // PCL's own console messages (warnings about a file) go to stderr; the JSON stays clean.
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
   int failed = 0;

@@ -2,7 +2,7 @@
  * facyl_simulate: write a simulated cylinder (paper III-D1) as a PCD file, with its ground
  * truth as JSON on stdout.
  */
-#include "cli.h"
+#include <facyl/tools/cli.h>
 
 #include <facyl/simulation/cylinder_simulation.h>
 
@@ -11,35 +11,48 @@
 #include <iostream>
 
 namespace {
+/** "x,y,z" as the options take it. */
+std::string
+commaVector(const Eigen::Vector3f& v)
+{
+  return facyl_cli::compactNumber(v.x()) + "," + facyl_cli::compactNumber(v.y()) + "," +
+         facyl_cli::compactNumber(v.z());
+}
+
 void
 printHelp(const char* self)
 {
+  const facyl::CylinderSimulationParameters d; // the defaults' one home
   std::printf("Usage: %s [options] OUT.pcd\n"
-              "  --radius R        radius (default 0.05)\n"
-              "  --height H        height (default 0.2)\n"
-              "  --axis x,y,z      axis (default 0,0,1)\n"
-              "  --base x,y,z      centre of the bottom cap (default 0,0,0.8)\n"
+              "  --radius R        radius (default %s)\n"
+              "  --height H        height (default %s)\n"
+              "  --axis x,y,z      axis (default %s)\n"
+              "  --base x,y,z      centre of the bottom cap (default %s)\n"
               "  --random-axis     draw the axis uniformly\n"
-              "  --points N        lateral points |P| (default 900)\n"
-              "  --lids L          lid outliers of eq. 5, e.g. 1 = 100%% (default 0)\n"
-              "  --noise S         noise std. dev. relative to the radius (default 0)\n"
-              "  --occlusion O     occlusion of eq. 6 in [0, 1) (default 0)\n"
-              "  --seed S          seed (default 0)\n"
+              "  --points N        lateral points |P| (default %zu)\n"
+              "  --lids L          lid outliers of eq. 5, e.g. 1 = 100%% (default %s)\n"
+              "  --noise S         noise std. dev. relative to the radius (default %s)\n"
+              "  --occlusion O     occlusion of eq. 6 in [0, 1) (default %s)\n"
+              "  --seed S          seed (default %llu)\n"
               "  --with-normals    also write the exact normals\n"
               "OUT.pcd must end in .pcd (anything else is refused, nothing written).\n%s",
-              self, facyl_cli::commonHelp());
+              self, facyl_cli::compactNumber(d.radius).c_str(),
+              facyl_cli::compactNumber(d.height).c_str(), commaVector(d.axis).c_str(),
+              commaVector(d.base).c_str(), d.lateral_points,
+              facyl_cli::compactNumber(d.lid_ratio).c_str(),
+              facyl_cli::compactNumber(d.noise).c_str(),
+              facyl_cli::compactNumber(d.occlusion).c_str(),
+              static_cast<unsigned long long>(d.seed), facyl_cli::commonHelp());
 }
 } // namespace
 
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_simulate", printHelp); rc >= 0)
-    return rc;
   facyl::CylinderSimulationParameters p;
   std::string out;
   bool normals = false;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_simulate", printHelp, [&] {
     const facyl_cli::Arguments args(argc, argv,
                                     {"--radius", "--height", "--axis", "--base", "--points",
                                      "--lids", "--noise", "--occlusion", "--seed"},
@@ -48,25 +61,23 @@ main(int argc, char** argv)
       throw std::invalid_argument("give exactly one output file (see -h)");
     out = args.positional()[0];
     facyl_cli::checkOutputFile("", out, {".pcd"}, "PCD point cloud", {});
-    p.radius = static_cast<float>(args.number("--radius", 0.05, 1e-4, 100.0));
-    p.height = static_cast<float>(args.number("--height", 0.2, 1e-4, 1000.0));
-    p.axis = args.vector3("--axis", Eigen::Vector3f::UnitZ());
-    p.base = args.vector3("--base", Eigen::Vector3f(0.f, 0.f, 0.8f));
+    p.radius = static_cast<float>(args.number("--radius", p.radius, 1e-4, 100.0));
+    p.height = static_cast<float>(args.number("--height", p.height, 1e-4, 1000.0));
+    p.axis = args.vector3("--axis", p.axis);
+    p.base = args.vector3("--base", p.base);
     p.random_axis = args.has("--random-axis");
-    p.lateral_points = static_cast<std::size_t>(args.integer("--points", 900, 1, 10000000));
-    p.lid_ratio = static_cast<float>(args.number("--lids", 0.0, 0.0, 10.0));
-    p.noise = static_cast<float>(args.number("--noise", 0.0, 0.0, 10.0));
-    p.occlusion = static_cast<float>(args.number("--occlusion", 0.0, 0.0, 1.0));
-    p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
+    p.lateral_points = static_cast<std::size_t>(args.integer("--points", static_cast<long long>(p.lateral_points), 1, 10000000));
+    p.lid_ratio = static_cast<float>(args.number("--lids", p.lid_ratio, 0.0, 10.0));
+    p.noise = static_cast<float>(args.number("--noise", p.noise, 0.0, 10.0));
+    p.occlusion = static_cast<float>(args.number("--occlusion", p.occlusion, 0.0, 1.0));
+    p.seed = static_cast<std::uint64_t>(args.integer("--seed", static_cast<long long>(p.seed), 0, facyl_cli::kMaxSeed));
     normals = args.has("--with-normals");
     const std::string why = facyl::validate(p);
     if (!why.empty())
       throw std::invalid_argument(why);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_simulate: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   const auto sim = facyl::simulateCylinder(p);
   int rc;
   if (normals)

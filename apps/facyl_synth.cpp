@@ -7,8 +7,8 @@
  * PREFIX.json (ground truth), and prints one JSON line per scene. Scenery (far
  * furniture, robots) has ids 1000+ and class 7.
  */
-#include "cli.h"
-#include "scene_options.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/scene_options.h>
 
 #include <facyl/simulation/tabletop_scene.h>
 #include <facyl/simulation/tabletop_sequence.h>
@@ -153,14 +153,12 @@ writeSequence(const std::string& name, const facyl::TabletopSceneParameters& p,
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_synth", printHelp); rc >= 0)
-    return rc;
   facyl::TabletopSceneParameters p;
   std::string prefix;
   std::size_t count = 1;
   facyl::TabletopSequenceParameters sequence;
   bool stream = false;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_synth", printHelp, [&] {
     const facyl_cli::Arguments args(
       argc, argv,
       facyl_cli::joined(facyl_cli::sceneImageOptions(),
@@ -210,11 +208,9 @@ main(int argc, char** argv)
       if (!bad.empty())
         throw std::invalid_argument(bad);
     }
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_synth: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   const std::uint64_t first_seed = p.seed;
   for (std::size_t k = 0; k < count; ++k) {
     p.seed = first_seed + k;

@@ -5,9 +5,9 @@
  *                 detection on the labelled learn33..44 (DIR/labels.csv)
  * Prints figures (markdown) and, with --csv FILE, one row per object.
  */
-#include "cli.h"
-#include "recognizer_options.h"
-#include "scene_options.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/scene_options.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/segmentation_score.h>
@@ -41,12 +41,17 @@ struct Row {
   std::size_t pieces{0};    ///< output objects mapping to it
   facyl::SegmentOutcome segment; ///< how the segmentation recovered it
   facyl::CylinderEvidence evidence; ///< of its best (largest) output object
+  bool is_cylinder{false};  ///< the recognizer's decision on that object
   float radius{NAN}, true_radius{NAN}, axis_error_deg{NAN};
   std::size_t best{0};      ///< index of that output object
 };
 
-/** Evidence of an output object that matches no ground-truth object. */
-using Stray = facyl::CylinderEvidence;
+/** An output object that matches no ground-truth object: its evidence and the recognizer's
+ * decision. */
+struct Stray {
+  facyl::CylinderEvidence evidence;
+  bool is_cylinder{false};
+};
 
 double
 median(std::vector<double> v)
@@ -109,7 +114,7 @@ matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vec
     auto it = rows.find(label);
     if (it == rows.end()) {
       if (o.evidence.fitted)
-        stray.push_back(o.evidence);
+        stray.push_back({o.evidence, o.is_cylinder});
       continue;
     }
     Row& r = it->second;
@@ -120,6 +125,7 @@ matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vec
     best_size[label] = o.cluster.indices.indices.size();
     r.best = k;
     r.evidence = o.evidence;
+    r.is_cylinder = o.is_cylinder;
     r.radius = o.evidence.fitted ? o.cylinder.radius : NAN;
   }
   return on_scenery;
@@ -140,9 +146,20 @@ scoreRows(const std::vector<facyl::RecognizedObject>& objects, const std::vector
   }
 }
 
+/** The recognizer's decision on the row's object. */
 bool
-called(const Row& r, const facyl::CylinderDecision& d)
+called(const Row& r)
 {
+  return r.found && r.is_cylinder;
+}
+
+/** What the recognizer's rule (acceptCylinder) says of the row's object at decision \a d, other
+ * than the recognizer's own \a base: the rows of a threshold sweep. At \a base, its decision. */
+bool
+calledAt(const Row& r, const facyl::CylinderDecision& d, const facyl::CylinderDecision& base)
+{
+  if (d.score == base.score && d.min_score == base.min_score)
+    return called(r);
   return r.found && facyl::acceptCylinder(r.evidence, d);
 }
 
@@ -163,13 +180,15 @@ reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
       d.min_score = t;
       std::size_t tp = 0, fp = 0, fn = 0;
       for (const Row& r : rows) {
-        const bool yes = called(r, d);
+        const bool yes = calledAt(r, d, base);
         tp += r.positive && yes;
         fn += r.positive && !yes;
         fp += !r.positive && yes;
       }
       for (const Stray& e : stray)
-        fp += facyl::acceptCylinder(e, d);
+        fp += d.score == base.score && d.min_score == base.min_score
+                ? e.is_cylinder
+                : facyl::acceptCylinder(e.evidence, d);
       const bool is_default = score == base.score && std::abs(t - base.min_score) < 1e-6f;
       std::printf("| %s | %.1f%s | %zu | %zu | %zu | %.3f | %.3f |\n",
                   score == facyl::CylinderDecision::Score::SurfaceRatio ? "surface ratio"
@@ -330,7 +349,7 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
     if (!r.positive) {
       auto& c = fp_by[r.kind];
       ++c.second;
-      c.first += called(r, d);
+      c.first += called(r);
     }
   std::printf("\nDistractors called cylinders (default decision):");
   for (const auto& [k, c] : fp_by)
@@ -339,7 +358,7 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
   std::vector<double> radius_rel, axis;
   std::map<std::string, std::vector<double>> axis_by, radius_by;
   for (const Row& r : all)
-    if (r.positive && called(r, d)) {
+    if (r.positive && called(r)) {
       const double rel = std::abs(r.radius - r.true_radius) / r.true_radius * 100.0;
       radius_rel.push_back(rel);
       axis.push_back(r.axis_error_deg);
@@ -383,7 +402,9 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<facyl::RecognitionTiming> timing;
   std::vector<double> object_counts;
   std::size_t failures = 0, wrong_plane = 0, on_scenery = 0;
+  facyl_cli::Progress progress("facyl_tabletop_eval", opt.sim, true);
   for (std::size_t k = 0; k < opt.sim; ++k) {
+    progress.step(k > 0); // the scene before this one is done
     facyl::TabletopSceneParameters sp = opt.scene;
     sp.seed = opt.seed + k;
     facyl::RenderedScene scene = facyl::simulateTabletopScene(sp);
@@ -439,6 +460,7 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       all.push_back(r);
     }
   }
+  progress.step(); // the last scene
   csv.write(opt.layout == "spread" ? "sim-" + opt.sensor : "sim-" + opt.layout + "-" + opt.sensor,
             all);
   reportSimulated(all, stray, opt, failures, wrong_plane, on_scenery);
@@ -504,8 +526,10 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<facyl::RecognitionTiming> timing;
   std::vector<double> object_counts;
   int status = 0;
+  facyl_cli::Progress progress("facyl_tabletop_eval", 45, true);
   for (int g = 0; g < 4; ++g)
     for (int k = groups[g].first; k <= groups[g].second; ++k) {
+      progress.step(k > 0); // the scene before this one is done
       const std::string name = "learn" + std::to_string(k);
       const std::string file = (std::filesystem::path(opt.mosd) / (name + ".pcd")).string();
       if (!std::filesystem::exists(file))
@@ -540,6 +564,7 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
       for (auto& [id, r] : rows)
         by_group[static_cast<std::size_t>(g)].push_back(r);
     }
+  progress.step(); // the last scene
   segmentationHeader("## mOSD learn scenes: segmentation against the dataset's labels (objects "
                      "with >= " +
                      std::to_string(opt.params.segmentation.min_cluster_size) + " points)");
@@ -602,7 +627,7 @@ evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
     for (auto& [id, r] : rows) {
       all.push_back(r);
       const std::string& note = objects_truth.at(id)[2];
-      if (called(r, d))
+      if (called(r))
         for (const char* key :
              {"sticker", "plain white mug", "flower canister", "small white canister", "Pringles"})
           if (note.find(key) != std::string::npos)
@@ -620,7 +645,7 @@ evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
                 r.evidence.surface_ratio,
                 r.evidence.fitted ? (std::to_string(r.radius * 1000.f).substr(0, 5) + " mm").c_str()
                                   : "-",
-                called(r, d) ? ", called a cylinder" : "");
+                called(r) ? ", called a cylinder" : "");
   std::vector<Row> strict = all;
   for (Row& r : strict)
     r.positive = r.kind == "cylinder";
@@ -728,16 +753,12 @@ parseOptions(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_tabletop_eval", printHelp); rc >= 0)
-    return rc;
   Options opt;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_tabletop_eval", printHelp, [&] {
     opt = parseOptions(argc, argv);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_tabletop_eval: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   CsvWriter csv(opt.csv);
   Recognizer rec;
   rec.setParameters(opt.params);

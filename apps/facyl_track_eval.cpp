@@ -3,9 +3,9 @@
  * camera moving around a static cluttered table; facyl_synth --sequence's renderer): tracked
  * against per-frame detection.
  */
-#include "cli.h"
-#include "recognizer_options.h"
-#include "scene_options.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/scene_options.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/simulation/tabletop_sequence.h>
@@ -512,16 +512,12 @@ parseOptions(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_track_eval", printHelp); rc >= 0)
-    return rc;
   Options opt;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_track_eval", printHelp, [&] {
     opt = parseOptions(argc, argv);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_track_eval: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
   Recognizer rec;
   rec.setParameters(opt.params);

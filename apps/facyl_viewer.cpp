@@ -6,13 +6,13 @@
  * or one object's orientation accumulators for the three voting modes. --screenshot renders
  * and exits (under xvfb-run without a screen).
  */
-#include "cli.h"
-#include "cylinder_fit.h"
-#include "frame_stream.h"
-#include "json_value.h"
-#include "pcd_input.h"
-#include "pcl_baseline.h"
-#include "recognizer_options.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/frame_stream.h>
+#include <facyl/tools/json_value.h>
+#include <facyl/tools/pcd_input.h>
+#include <facyl/tools/pcl_baseline.h>
+#include <facyl/tools/recognizer_options.h>
 
 #include <facyl/features/local_geometry.h>
 #include <facyl/features/normal_curvature_estimation.h>
@@ -47,7 +47,6 @@ using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
 
 constexpr int kDefaultWidth = 1024, kDefaultHeight = 768;
 constexpr int kMeshSegments = 36;
-constexpr std::size_t kOrientations = 450; // the paper's N_d
 constexpr float kPclMinInlierRatio = 0.5f; // PCL's fit is drawn as a cylinder from this on
 
 void
@@ -96,7 +95,7 @@ printHelp(const char* self)
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
     "l labels.\n%s"
     "Exit status: 0; 1 when a file cannot be shown; 2 for bad usage (nothing written).\n",
-    self, self, kOrientations, kDefaultWidth, kDefaultHeight,
+    self, self, facyl::HoughCylinderParameters{}.orientations, kDefaultWidth, kDefaultHeight,
     facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
 }
 
@@ -523,8 +522,10 @@ drawAccumulators(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, 
     voting.weight(n) = facyl::curvatureAnisotropy(c.pc1, c.pc2);
     ++n;
   }
+  const facyl::HoughCylinderParameters defaults; // N_d and seed as the estimator's
   const auto acc = facyl::OrientationAccumulator::sample(
-    facyl::GaussianMixture::fromPrior(facyl::OrientationPrior::Uniform), kOrientations, 0);
+    facyl::GaussianMixture::fromPrior(facyl::OrientationPrior::Uniform), defaults.orientations,
+    defaults.seed);
   const float radius = 0.6f * (o.box_max - o.box_min).maxCoeff() + 0.02f;
   const char* names[] = {"rabbani", "soft-normal", "soft-curvature"};
   const facyl::VotingMode modes[] = {facyl::VotingMode::Rabbani, facyl::VotingMode::SoftNormal,
@@ -999,16 +1000,12 @@ parseSettings(int argc, char** argv)
 int
 main(int argc, char** argv)
 {
-  if (const int rc = facyl_cli::standardOptions(argc, argv, "facyl_viewer", printHelp); rc >= 0)
-    return rc;
   Settings s;
-  try {
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_viewer", printHelp, [&] {
     s = parseSettings(argc, argv);
-  }
-  catch (const std::exception& e) {
-    std::fprintf(stderr, "facyl_viewer: %s\n", e.what());
-    return 2;
-  }
+  });
+  if (rc >= 0)
+    return rc;
   const char* display = std::getenv("DISPLAY");
   if (!display || !*display) {
     std::fprintf(stderr, "facyl_viewer: no X display (DISPLAY is not set)%s\n",

@@ -1,9 +1,9 @@
 /*
  * libFuzzer target: PCD bytes -> what facyl_fit and facyl_detect do with a file: the checked
- * reader (apps/pcd_input.h), the conversion, then (for clouds small enough to keep the fuzzer
+ * reader (apps/common/include/facyl/tools/pcd_input.h), the conversion, then (for clouds small enough to keep the fuzzer
  * fast) normals and curvatures, the Hough fit and the tabletop recognizer.
  */
-#include "../apps/pcd_input.h"
+#include <facyl/tools/pcd_input.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>

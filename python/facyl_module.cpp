@@ -3,11 +3,11 @@
  * computes. Every input is checked here, before C++ sees it: ValueError / TypeError with the
  * argument's name, never a crash.
  */
-#include "../apps/cylinder_fit.h"
-#include "../apps/detect_json.h"
-#include "../apps/fit_options.h"
-#include "../apps/recognizer_options.h"
-#include "../apps/track_json.h"
+#include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/detect_json.h>
+#include <facyl/tools/fit_options.h>
+#include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/track_json.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_classifier.h>
@@ -262,7 +262,7 @@ fitSettings(const py::dict& options)
   return s;
 }
 
-/** The fit of facyl_fit (apps/cylinder_fit.h) on \a cloud (already in metres): cues estimated
+/** The fit of facyl_fit (apps/common/include/facyl/tools/cylinder_fit.h) on \a cloud (already in metres): cues estimated
  * unless \a normals. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
@@ -846,7 +846,8 @@ PYBIND11_MODULE(facyl, m)
     py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
     py::arg("radius_limits") = py::none(), py::arg("prior") = py::none(),
     py::arg("up") = py::none(), py::arg("voting") = "soft-curvature", py::arg("neighbours") = 16,
-    py::arg("orientations") = 450, py::arg("accumulators") = 1,
+    py::arg("orientations") = facyl::HoughCylinderParameters{}.orientations,
+    py::arg("accumulators") = facyl::HoughCylinderParameters{}.accumulators,
     py::arg("distance_threshold") = py::none(), py::arg("max_cylinders") = 1,
     py::arg("outward_normals") = false, py::arg("seed") = 0, py::arg("units") = "auto",
     py::arg("k") = py::none(),
@@ -907,11 +908,17 @@ with a unit normal towards the sensor, or None; "found"}, "supports", "objects" 
 "table" then has "found" False and coefficients None, "supports" is empty and the objects have
 support -1. Raises ValueError for bad input.)");
 
-  m.def("simulate_cylinder", &simulateCylinder, py::kw_only(), py::arg("radius") = 0.3,
-        py::arg("height") = 1.0, py::arg("axis") = std::vector<double>{0, 0, 1},
-        py::arg("base") = std::vector<double>{0, 0, 0}, py::arg("points") = 900,
-        py::arg("lid_ratio") = 0.0, py::arg("noise") = 0.0, py::arg("occlusion") = 0.0,
-        py::arg("random_axis") = false, py::arg("seed") = 0,
+  const facyl::CylinderSimulationParameters sim; // the defaults' one home
+  const auto shown = [](float v) { return std::round(1e6 * static_cast<double>(v)) / 1e6; };
+  m.def("simulate_cylinder", &simulateCylinder, py::kw_only(),
+        py::arg("radius") = shown(sim.radius), py::arg("height") = shown(sim.height),
+        py::arg("axis") = std::vector<double>{shown(sim.axis.x()), shown(sim.axis.y()),
+                                              shown(sim.axis.z())},
+        py::arg("base") = std::vector<double>{shown(sim.base.x()), shown(sim.base.y()),
+                                              shown(sim.base.z())},
+        py::arg("points") = sim.lateral_points, py::arg("lid_ratio") = shown(sim.lid_ratio),
+        py::arg("noise") = shown(sim.noise), py::arg("occlusion") = shown(sim.occlusion),
+        py::arg("random_axis") = sim.random_axis, py::arg("seed") = sim.seed,
         R"(A simulated cylinder (paper III-D1): points on the lateral surface (points = |P|), lid
 outliers (lid_ratio, eq. 5), noise (relative to the radius), occlusion (eq. 6, a removed
 sector). Returns {"points": (N, 3), "normals": (N, 3), "is_lid": (N,), "truth": {...}}.)");

@@ -3,7 +3,7 @@
  * clouds, frames stored in world coordinates, high resolutions, missing pixels), the parallel
  * loop, and thread safety and determinism of the pipeline.
  */
-#include "../apps/cli.h"
+#include <facyl/tools/cli.h>
 #include "test_helpers.h"
 
 #include <facyl/features/parallel.h>

@@ -2,7 +2,7 @@
  * facyl: tracking across frames (CylinderTracker, its numerics, simulated streams, the PCD
  * grabber stream).
  */
-#include "../apps/frame_stream.h"
+#include <facyl/tools/frame_stream.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/tabletop_geometry.h>

@@ -58,10 +58,18 @@ def test_fit_recovers_simulated_cylinders():
         assert coeff.shape == (7,) and coeff[6] == pytest.approx(c.radius)
 
 
+def test_library_defaults_work_together():
+    # The simulator's default cylinder (a can) is found by the fit's defaults.
+    truth = facyl.simulate_cylinder()["truth"]
+    found = facyl.fit_cylinders(facyl.simulate_cylinder()["points"])
+    assert len(found) == 1
+    assert abs(found[0].radius - truth["radius"]) < 1e-3
+
+
 def test_no_cylinder_says_why():
-    # The simulator's default radius (the paper's 0.3 m) lies outside the default radius
-    # limits (0.01-0.25 m): no cylinder, and a warning that names the limits and the radius.
-    points = facyl.simulate_cylinder(seed=3)["points"]
+    # The paper's 0.3 m cylinder lies outside the default radius limits (0.01-0.25 m): no
+    # cylinder, and a warning that names the limits and the radius.
+    points = facyl.simulate_cylinder(radius=0.3, height=1.0, seed=3)["points"]
     with pytest.warns(UserWarning, match=r"radius limits .* radius 0\.3"):
         assert facyl.fit_cylinders(points) == []
     assert len(facyl.fit_cylinders(points, radius_limits="auto")) == 1

@@ -21,9 +21,7 @@ validate(const TabletopRecognizerParameters& p)
   if (!why.empty())
     return "decision: " + why;
   std::ostringstream s;
-  if (p.orientations < 10 || p.orientations > 100000)
-    s << "orientations " << p.orientations << " must be in [10, 100000]";
-  else if (!(p.fit_point_angle >= 0.f && p.fit_point_angle <= 0.1f))
+  if (!(p.fit_point_angle >= 0.f && p.fit_point_angle <= 0.1f))
     s << "fit_point_angle " << p.fit_point_angle << " must be in [0, 0.1] rad";
   else if (p.max_fit_points < 50 || p.max_fit_points > 1000000)
     s << "max_fit_points " << p.max_fit_points << " must be in [50, 1000000]";

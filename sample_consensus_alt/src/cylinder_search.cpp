@@ -26,7 +26,12 @@ std::string
 validate(const HoughCylinderParameters& p)
 {
   std::ostringstream why;
-  if (p.kernel_exponent < 1 || p.kernel_exponent > 16)
+  if (p.orientations < kMinOrientations || p.orientations > kMaxOrientations)
+    why << "orientations (N_d) " << p.orientations << " is not in [" << kMinOrientations << ", "
+        << kMaxOrientations << "]";
+  else if (p.accumulators < 1 || p.accumulators > kMaxAccumulators)
+    why << "accumulators " << p.accumulators << " is not in [1, " << kMaxAccumulators << "]";
+  else if (p.kernel_exponent < 1 || p.kernel_exponent > 16)
     why << "kernel exponent " << p.kernel_exponent << " is not in [1, 16]";
   else if (!(p.radius_min >= 0.f) || !std::isfinite(p.radius_min))
     why << "minimum radius " << p.radius_min << " is not a finite value >= 0";

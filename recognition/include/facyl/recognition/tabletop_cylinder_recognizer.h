@@ -26,8 +26,9 @@
 
 namespace facyl {
 
-/** \brief The Hough settings of the recognizer: defaults, with radii in [0.01, 0.25] m,
- * outward normals only, and the best candidate refined on its inliers alone
+/** \brief The Hough settings of the recognizer: defaults, with the "mostly vertical" prior
+ * (in the table frame), radii in [0.01, 0.25] m, outward normals only, and the best candidate
+ * refined on its inliers alone
  * (point_candidates = 0): the decision (CylinderDecision) is calibrated on those fits, and a
  * refinement on the points can bend a cylinder around a box's edge, which the decision then
  * accepts (test_clutter, StackedCoaxialCylindersAndACanAgainstABox). */
@@ -35,6 +36,7 @@ inline HoughCylinderParameters
 tabletopHoughDefaults()
 {
   HoughCylinderParameters p;
+  p.prior = OrientationPrior::Vertical; // expressed in the table frame (up = table normal)
   p.radius_min = 0.01f;
   p.radius_max = 0.25f;
   p.outward_normals = true; // objects on a table are seen from outside
@@ -45,11 +47,10 @@ tabletopHoughDefaults()
 /** \brief Settings of TabletopCylinderRecognizer. */
 struct TabletopRecognizerParameters {
   TabletopSegmentationParameters segmentation;
+  /** The fit's settings, the orientation prior (in the table frame), N_d and the seed
+   * included. */
   HoughCylinderParameters hough{tabletopHoughDefaults()};
   CylinderDecision decision;      ///< what makes a fitted object a cylinder
-  /** Orientation prior, expressed in the table frame (up = table normal). */
-  OrientationPrior prior{OrientationPrior::Vertical};
-  std::size_t orientations{450};  ///< accumulator cells N_d, in [10, 100000]
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
    * a lying (Horizontal) prior in the table frame, then (objects on a support) with the axis
    * fixed along the support's normal, and keep the best. */
@@ -77,7 +78,6 @@ struct TabletopRecognizerParameters {
    * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
   float reject_below{0.1f};
   int neighbours{16};             ///< k of the normal/curvature estimation, in [5, 200]
-  std::uint64_t seed{0};
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>
@@ -178,8 +179,25 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
 void
 describeInliers(const Eigen::Matrix3Xf& inlier_points, CylinderModel& model);
 
-/** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). */
+/** \brief Allowed range of HoughCylinderParameters::orientations (N_d); validate() checks it. */
+constexpr std::size_t kMinOrientations = 10;
+constexpr std::size_t kMaxOrientations = 100000;
+/** \brief Most accumulators per fit (HoughCylinderParameters::accumulators). */
+constexpr std::size_t kMaxAccumulators = 64;
+
+/** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). Each
+ * setting has its home here: the tools, the recognizer and the Python module read their
+ * defaults from a default-constructed struct and validate() is the one range check. */
 struct HoughCylinderParameters {
+  /** Orientation prior of the accumulator draws (paper eq. 1-2), about the estimator's
+   * reference frame; HoughCylinderEstimation::setOrientationMixture replaces it with an
+   * explicit mixture. */
+  OrientationPrior prior{OrientationPrior::Uniform};
+  /** N_d, cells per orientation accumulator (450, as in the paper), in [kMinOrientations,
+   * kMaxOrientations]. */
+  std::size_t orientations{450};
+  std::size_t accumulators{1};          ///< independent accumulators per fit, in [1, kMaxAccumulators]
+  std::uint64_t seed{0};                ///< seed of the accumulator draws: equal seeds, equal results
   VotingMode voting_mode{VotingMode::SoftCurvature};
   int kernel_exponent{2};               ///< >= 1; 1 is the paper's eq. 3
   float radius_min{0.f};                ///< >= 0

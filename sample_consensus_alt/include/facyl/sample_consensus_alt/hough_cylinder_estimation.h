@@ -13,6 +13,7 @@
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/type_traits.h>
 
 #include <cstdint>
 #include <memory>
@@ -181,6 +182,8 @@ public:
   setParameters(const HoughCylinderParameters& params)
   {
     params_ = params;
+    explicit_mixture_ = false; // params.prior is the prior again
+    drawn_.clear();
   }
   /** \brief All numeric settings. */
   const HoughCylinderParameters&
@@ -344,24 +347,29 @@ public:
     return params_.coarse_scale;
   }
 
-  /** \brief Orientation prior from a preset (default Uniform). */
+  /** \brief Orientation prior from a preset (HoughCylinderParameters::prior, default
+   * Uniform). */
   void
   setOrientationPrior(OrientationPrior prior)
   {
-    setOrientationMixture(GaussianMixture::fromPrior(prior));
+    params_.prior = prior;
+    explicit_mixture_ = false;
+    drawn_.clear();
   }
-  /** \brief Orientation prior as an explicit Gaussian mixture, in the reference frame. */
+  /** \brief Orientation prior as an explicit Gaussian mixture, in the reference frame; it
+   * replaces the preset until setOrientationPrior or setParameters. */
   void
   setOrientationMixture(const GaussianMixture& mixture)
   {
     mixture_ = mixture;
+    explicit_mixture_ = true;
     drawn_.clear();
   }
-  /** \brief The orientation prior. */
-  const GaussianMixture&
+  /** \brief The orientation prior: the explicit mixture, or the preset's. */
+  GaussianMixture
   getOrientationMixture() const
   {
-    return mixture_;
+    return explicit_mixture_ ? mixture_ : GaussianMixture::fromPrior(params_.prior);
   }
   /** \brief Frame of the prior: its columns are the prior's x, y, z ("up") axes in cloud
    * coordinates (default identity). */
@@ -380,44 +388,47 @@ public:
   {
     return frame_;
   }
-  /** \brief Cells per accumulator, N_d (default 450, as in the paper). */
+  /** \brief Cells per accumulator, N_d (HoughCylinderParameters::orientations: default 450,
+   * as in the paper). */
   void
   setNumberOfOrientations(std::size_t n)
   {
-    num_orientations_ = n;
+    params_.orientations = n;
     drawn_.clear();
   }
   /** \brief N_d. */
   std::size_t
   getNumberOfOrientations() const
   {
-    return num_orientations_;
+    return params_.orientations;
   }
-  /** \brief Independent accumulators voted per fit (default 1); their peaks compete. */
+  /** \brief Independent accumulators voted per fit (HoughCylinderParameters::accumulators,
+   * default 1); their peaks compete. */
   void
   setNumberOfAccumulators(std::size_t n)
   {
-    num_accumulators_ = n;
+    params_.accumulators = n;
     drawn_.clear();
   }
   /** \brief Accumulators per fit. */
   std::size_t
   getNumberOfAccumulators() const
   {
-    return num_accumulators_;
+    return params_.accumulators;
   }
-  /** \brief Seed of the accumulator draws (default 0): equal seeds give equal results. */
+  /** \brief Seed of the accumulator draws (HoughCylinderParameters::seed, default 0): equal
+   * seeds give equal results. */
   void
   setSeed(std::uint64_t seed)
   {
-    seed_ = seed;
+    params_.seed = seed;
     drawn_.clear();
   }
   /** \brief The seed. */
   std::uint64_t
   getSeed() const
   {
-    return seed_;
+    return params_.seed;
   }
   /** \brief Explicit accumulators; they replace the drawn ones until cleared with {}. */
   void
@@ -453,6 +464,27 @@ private:
   const std::vector<OrientationAccumulator>&
   accumulators();
 
+  static constexpr bool kNormalsCarryCurvature =
+      pcl::traits::has_field<PointNT, pcl::fields::pc1>::value &&
+      pcl::traits::has_field<PointNT, pcl::fields::pc2>::value &&
+      pcl::traits::has_field<PointNT, pcl::fields::principal_curvature_x>::value;
+  /** SoftCurvature voting without curvatures given (setInputCurvatures or in the normals). */
+  bool
+  curvaturesToEstimate() const
+  {
+    return params_.voting_mode == VotingMode::SoftCurvature && !curvatures_ &&
+           !kNormalsCarryCurvature;
+  }
+  /** The checks before a fit (input, normals, parameters, prior); false, recorded, when one
+   * fails. */
+  bool
+  checkInput();
+  /** The indexed points with a finite position and normal as columns of \a cues (with the
+   * given curvatures' directions and eq. 3 weights when SoftCurvature has them), and the cloud
+   * index of each column; false, recorded, for a bad index or no such point. */
+  bool
+  gatherCues(CylinderCues& cues, std::vector<pcl::index_t>& column_to_index);
+
   enum class Level { Error, Warn, Debug };
   /** Records the failure, prints it at \a level, returns false. */
   bool
@@ -470,11 +502,9 @@ private:
   NormalsConstPtr normals_;
   CurvaturesConstPtr curvatures_;
   HoughCylinderParameters params_;
-  GaussianMixture mixture_{GaussianMixture::fromPrior(OrientationPrior::Uniform)};
+  GaussianMixture mixture_; ///< with explicit_mixture_: replaces params_.prior
+  bool explicit_mixture_{false};
   Eigen::Matrix3f frame_{Eigen::Matrix3f::Identity()};
-  std::size_t num_orientations_{450};
-  std::size_t num_accumulators_{1};
-  std::uint64_t seed_{0};
   std::vector<OrientationAccumulator> user_accumulators_;
   std::vector<OrientationAccumulator> drawn_;
 };

@@ -14,12 +14,15 @@
 
 namespace facyl {
 
-/** \brief Settings of one simulated cylinder (paper III-D1). */
+/** \brief Settings of one simulated cylinder (paper III-D1). The defaults are a can 0.8 m in
+ * front of a camera looking along z, within every fit's default radius limits; the paper's
+ * study (facyl_bench) uses r = 0.3 m. facyl_simulate and Python's simulate_cylinder take
+ * their defaults from here. */
 struct CylinderSimulationParameters {
-  float radius{0.3f};                              ///< > 0
-  float height{1.0f};                              ///< > 0
+  float radius{0.05f};                             ///< > 0
+  float height{0.2f};                              ///< > 0
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()};  ///< non-zero; ignored if random_axis
-  Eigen::Vector3f base{Eigen::Vector3f::Zero()};   ///< centre of the bottom cap
+  Eigen::Vector3f base{0.f, 0.f, 0.8f};            ///< centre of the bottom cap
   bool random_axis{false};                         ///< draw the axis uniformly on the sphere
   std::size_t lateral_points{900};                 ///< |P|, points of the full lateral surface
   /** Lid outliers of eq. 5: (total points / |P|) - 1 of the unoccluded cylinder; e.g. 3 puts

@@ -51,17 +51,15 @@ TabletopCylinderRecognizer<PointT>::configure()
   const bool any_sign = params_.retry_upright_lying && params_.hough.outward_normals &&
                         params_.retry_any_normal_sign;
   estimators_.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
-  const OrientationPrior priors[4] = {params_.prior, OrientationPrior::VerticalStrong,
-                                      OrientationPrior::Horizontal, params_.prior};
+  const OrientationPrior priors[4] = {params_.hough.prior, OrientationPrior::VerticalStrong,
+                                      OrientationPrior::Horizontal, params_.hough.prior};
   for (std::size_t e = 0; e < estimators_.size(); ++e) {
     HoughCylinderParameters hp = params_.hough;
     if (e == 3)
       hp.outward_normals = false;
+    hp.prior = priors[e];
     estimators_[e].setParameters(hp);
     estimators_[e].setDiagnoseFailures(false); // a cluster without a cylinder is an answer
-    estimators_[e].setOrientationMixture(GaussianMixture::fromPrior(priors[e]));
-    estimators_[e].setNumberOfOrientations(params_.orientations);
-    estimators_[e].setSeed(params_.seed);
   }
   // Last, on objects with a support: the axis fixed along the support's normal, only position
   // and radius fitted. A short, wide tin seen from above shows mostly its lid and a thin band
@@ -389,7 +387,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
     auto& o = objects[k];
     auto& e = o.evidence;
     e.p_cylinder = e.fitted ? classifier_->fuse(e.p_network, e, params_.decision) : e.p_network;
-    o.is_cylinder = o.is_cylinder && !(e.p_cylinder < params_.decision.min_probability);
+    o.is_cylinder = o.is_cylinder && acceptCylinder(e, params_.decision); // p now known
   }
   timing_.classification +=
     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();

@@ -37,10 +37,12 @@ HoughCylinderEstimation<PointT, PointNT>::accumulators()
 {
   if (!user_accumulators_.empty())
     return user_accumulators_;
-  if (drawn_.empty())
-    for (std::size_t k = 0; k < num_accumulators_; ++k)
-      drawn_.push_back(
-          OrientationAccumulator::sample(mixture_, num_orientations_, seed_ + k, frame_));
+  if (drawn_.empty()) {
+    const GaussianMixture mixture = getOrientationMixture();
+    for (std::size_t k = 0; k < params_.accumulators; ++k)
+      drawn_.push_back(OrientationAccumulator::sample(mixture, params_.orientations,
+                                                      params_.seed + k, frame_));
+  }
   return drawn_;
 }
 
@@ -138,13 +140,9 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
 
 template <typename PointT, typename PointNT>
 bool
-HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cylinders)
+HoughCylinderEstimation<PointT, PointNT>::checkInput()
 {
   using detail::houghFormat;
-  cylinders.clear();
-  failure_ = HoughFailure::None;
-  failure_message_.clear();
-  curvatures_estimated_ = false;
   if (!this->input_)
     return fail(HoughFailure::NoInputCloud, "no input cloud: call setInputCloud first");
   if (this->input_->empty())
@@ -166,12 +164,7 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     return fail(HoughFailure::InvalidParameters, why);
   if (user_accumulators_.empty()) {
     std::string bad;
-    if (num_orientations_ == 0 || num_accumulators_ == 0)
-      return fail(HoughFailure::InvalidParameters,
-                  houghFormat("the orientation accumulator is empty (N_d = %zu, %zu "
-                              "accumulators)",
-                              num_orientations_, num_accumulators_));
-    if (!mixture_.isValid(&bad))
+    if (!getOrientationMixture().isValid(&bad))
       return fail(HoughFailure::InvalidParameters, "invalid orientation prior: " + bad);
     if (!frame_.allFinite() || std::abs(frame_.determinant()) < 1e-6f)
       return fail(HoughFailure::InvalidParameters,
@@ -182,33 +175,32 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     return fail(HoughFailure::InvalidParameters,
                 "an accumulator given with setAccumulators is empty");
   }
-
-  constexpr bool normals_carry_curvature =
-      pcl::traits::has_field<PointNT, pcl::fields::pc1>::value &&
-      pcl::traits::has_field<PointNT, pcl::fields::pc2>::value &&
-      pcl::traits::has_field<PointNT, pcl::fields::principal_curvature_x>::value;
-  const bool need_curvature = params_.voting_mode == VotingMode::SoftCurvature;
-  const bool estimate = need_curvature && !curvatures_ && !normals_carry_curvature;
-  if (estimate && !estimate_curvatures_)
+  if (curvaturesToEstimate() && !estimate_curvatures_)
     return fail(HoughFailure::NoCurvatures,
                 "SoftCurvature voting needs principal curvatures and their estimation is off "
                 "(setEstimateCurvatures(false)): use facyl::NormalCurvature normals, call "
                 "setInputCurvatures, turn the estimation on, or choose another voting mode");
+  return true;
+}
 
+template <typename PointT, typename PointNT>
+bool
+HoughCylinderEstimation<PointT, PointNT>::gatherCues(CylinderCues& cues,
+                                                     std::vector<pcl::index_t>& column_to_index)
+{
+  using detail::houghFormat;
   if (!this->initCompute())
     return fail(HoughFailure::InvalidIndices, "invalid input or indices");
   const auto& indices = *this->indices_;
   const auto& cloud = *this->input_;
   const auto& normals = *normals_;
-
-  // Gather the finite points with finite normals (and curvatures) into columns.
-  CylinderCues cues;
-  std::vector<pcl::index_t> column_to_index;
+  column_to_index.clear();
   column_to_index.reserve(indices.size());
   const auto n_max = static_cast<Eigen::Index>(indices.size());
   cues.points.resize(3, n_max);
   cues.normals.resize(3, n_max);
-  const bool given_curvature = need_curvature && !estimate;
+  const bool given_curvature =
+      params_.voting_mode == VotingMode::SoftCurvature && !curvaturesToEstimate();
   if (given_curvature) {
     cues.curvature_directions.resize(3, n_max);
     cues.weights.resize(n_max);
@@ -239,7 +231,7 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
         k_max = pc.pc1;
         k_min = pc.pc2;
       }
-      else if constexpr (normals_carry_curvature) {
+      else if constexpr (kNormalsCarryCurvature) {
         c = Eigen::Vector3f(q.principal_curvature_x, q.principal_curvature_y,
                             q.principal_curvature_z);
         k_max = q.pc1;
@@ -264,28 +256,54 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     cues.curvature_directions.conservativeResize(3, n);
     cues.weights.conservativeResize(n);
   }
+  return true;
+}
 
+namespace detail {
+/** Curvatures of \a cues at facyl's own scale (NormalCurvatureEstimation's k = 16: normals of
+ * the 16 nearest points, then the spread of those normals), whatever scale the given normals
+ * have: normals smoothed over k = 50 neighbours bend c_max on a small cylinder. The given
+ * normals stay the normals of the vote and of the inlier test. Columns without a usable
+ * neighbourhood vote without curvature (weight 0). */
+inline void
+estimateOwnCurvatures(CylinderCues& cues)
+{
+  constexpr int kCueNeighbours = 16;
+  const Eigen::Index n = cues.points.cols();
+  const PointCues own = estimatePointCues(cues.points, std::numeric_limits<float>::max(),
+                                          kCueNeighbours, cues.normals);
+  cues.curvature_directions.setZero(3, n);
+  cues.weights.setZero(n);
+  for (Eigen::Index s = 0; s < n; ++s) {
+    if (own.curvature_directions.col(s).allFinite()) {
+      cues.curvature_directions.col(s) = own.curvature_directions.col(s);
+      cues.weights(s) = own.weights(s);
+    }
+  }
+}
+} // namespace detail
+
+template <typename PointT, typename PointNT>
+bool
+HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cylinders)
+{
+  cylinders.clear();
+  failure_ = HoughFailure::None;
+  failure_message_.clear();
+  curvatures_estimated_ = false;
+  if (!checkInput())
+    return false;
+  CylinderCues cues;
+  std::vector<pcl::index_t> column_to_index;
+  if (!gatherCues(cues, column_to_index))
+    return false;
+  const std::size_t total_points = this->indices_->size();
   try {
-    if (estimate) {
-      // Curvatures at facyl's own scale (NormalCurvatureEstimation's k = 16: normals of the
-      // 16 nearest points, then the spread of those normals), whatever scale the given
-      // normals have: normals smoothed over k = 50 neighbours bend c_max on a small cylinder.
-      // The given normals stay the normals of the vote and of the inlier test. Columns
-      // without a usable neighbourhood vote without curvature (weight 0).
-      constexpr int kCueNeighbours = 16;
-      const PointCues own = estimatePointCues(cues.points, std::numeric_limits<float>::max(),
-                                              kCueNeighbours, cues.normals);
-      cues.curvature_directions.setZero(3, n);
-      cues.weights.setZero(n);
-      for (Eigen::Index s = 0; s < n; ++s) {
-        if (own.curvature_directions.col(s).allFinite()) {
-          cues.curvature_directions.col(s) = own.curvature_directions.col(s);
-          cues.weights(s) = own.weights(s);
-        }
-      }
+    if (curvaturesToEstimate()) {
+      detail::estimateOwnCurvatures(cues);
       curvatures_estimated_ = true;
     }
-    cylinders = fitCylinders(cues, accumulators(), params_, indices.size());
+    cylinders = fitCylinders(cues, accumulators(), params_, total_points);
   }
   catch (const std::exception& e) {
     cylinders.clear();
@@ -297,7 +315,7 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     std::sort(c.inliers.begin(), c.inliers.end());
   }
   if (cylinders.empty())
-    return explainNoCylinder(cues, indices.size());
+    return explainNoCylinder(cues, total_points);
   return true;
 }
 

@@ -15,7 +15,7 @@
  */
 #pragma once
 
-#include "pcd_input.h"
+#include <facyl/tools/pcd_input.h>
 
 #include <pcl/io/pcd_grabber.h>
 #include <pcl/pcl_config.h>

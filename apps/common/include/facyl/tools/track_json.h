@@ -6,9 +6,9 @@
  */
 #pragma once
 
-#include "cli.h"
-#include "cylinder_json.h"
-#include "detect_json.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_json.h>
+#include <facyl/tools/detect_json.h>
 
 #include <facyl/tracking/cylinder_tracker.h>
 

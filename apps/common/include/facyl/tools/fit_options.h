@@ -5,8 +5,8 @@
  */
 #pragma once
 
-#include "cli.h"
-#include "cylinder_fit.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_fit.h>
 
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 
@@ -75,15 +75,6 @@ fitAliases()
   return {{"--k", "--neighbours"}};
 }
 
-/** \a v as the shortest decimal that reads back as it (0.5, not 0.500000). */
-inline std::string
-compactNumber(float v)
-{
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
-  return text;
-}
-
 /** The help lines of those options. */
 inline const char*
 fitOptionsHelp()
@@ -102,8 +93,10 @@ fitOptionsHelp()
          "                       SACMODEL_CYLINDER on the same normals, for comparison)\n"
          "  --neighbours K       k of the normal and curvature estimation (default 16; old\n"
          "                       spelling --k)\n"
-         "  --orientations N     cells per orientation accumulator, N_d (default 450)\n"
-         "  --accumulators K     independent accumulators per fit (default 1)\n"
+         "  --orientations N     cells per orientation accumulator, N_d (default " +
+    std::to_string(facyl::HoughCylinderParameters{}.orientations) + ")\n"
+         "  --accumulators K     independent accumulators per fit (default " +
+    std::to_string(facyl::HoughCylinderParameters{}.accumulators) + ")\n"
          "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
          "                       pcl-ransac: 1% of the bounding-box diagonal)\n"
          "  --max-cylinders N    cylinders to extract, one after another (default 1)\n"
@@ -152,15 +145,19 @@ applyFitOptions(const Arguments& args, FitSettings& s)
                                 "' is not soft-curvature, soft-normal or rabbani");
   // One rule with the tabletop tools: the prior is vertical about a known up, uniform without.
   const std::string prior = args.text("--prior", args.has("--up") ? "vertical" : "uniform");
-  if (!facyl::parseOrientationPrior(prior, s.prior))
+  if (!facyl::parseOrientationPrior(prior, s.params.prior))
     throw std::invalid_argument("option " + args.spelling("--prior") + ": '" + prior +
                                 "' is not uniform, vertical, vertical-strong or horizontal");
   s.up = args.vector3("--up", Eigen::Vector3f::UnitZ());
   if (!(s.up.norm() > 0.f))
     throw std::invalid_argument("option " + args.spelling("--up") + " must not be zero");
-  s.orientations =
-    static_cast<std::size_t>(args.integer("--orientations", 450, 1, 200000));
-  s.accumulators = static_cast<std::size_t>(args.integer("--accumulators", 1, 1, 64));
+  s.params.orientations = static_cast<std::size_t>(
+    args.integer("--orientations", static_cast<long long>(s.params.orientations),
+                 static_cast<long long>(facyl::kMinOrientations),
+                 static_cast<long long>(facyl::kMaxOrientations)));
+  s.params.accumulators = static_cast<std::size_t>(
+    args.integer("--accumulators", static_cast<long long>(s.params.accumulators), 1,
+                 static_cast<long long>(facyl::kMaxAccumulators)));
 
   const std::string units = args.text("--units", "auto");
   if (units == "auto")
@@ -206,7 +203,8 @@ applyFitOptions(const Arguments& args, FitSettings& s)
   s.params.max_cylinders =
     static_cast<std::size_t>(args.integer("--max-cylinders", 1, 1, 100));
   s.neighbours = static_cast<int>(args.integer("--neighbours", 16, 3, 1000));
-  s.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, kMaxSeed));
+  s.params.seed = static_cast<std::uint64_t>(
+    args.integer("--seed", static_cast<long long>(s.params.seed), 0, kMaxSeed));
   s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0, 256));
   if (args.has("--outward-normals") && args.has("--any-normal-sign"))
     throw std::invalid_argument("--outward-normals and --any-normal-sign exclude each other");

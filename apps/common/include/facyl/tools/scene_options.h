@@ -4,7 +4,7 @@
  */
 #pragma once
 
-#include "cli.h"
+#include <facyl/tools/cli.h>
 
 #include <facyl/simulation/tabletop_scene.h>
 

@@ -5,7 +5,7 @@
  */
 #pragma once
 
-#include "cli.h"
+#include <facyl/tools/cli.h>
 
 #include <facyl/sample_consensus_alt/cylinder_model.h>
 

@@ -15,14 +15,11 @@
 
 namespace facyl_cli {
 
-/** The estimator's settings as the tools expose them. */
+/** The estimator's settings as the tools expose them: its parameters (prior, N_d, seed
+ * included) and the "up" of the prior's frame. */
 struct HoughSettings {
   facyl::HoughCylinderParameters params;
-  facyl::OrientationPrior prior{facyl::OrientationPrior::Uniform};
   Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
-  std::size_t orientations{450};
-  std::size_t accumulators{1};
-  std::uint64_t seed{0};
 };
 
 /** Normals and curvatures of \a cloud from its \a k nearest neighbours (\a normals, when
@@ -52,11 +49,7 @@ houghFit(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
 {
   facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
   hough.setParameters(s.params);
-  hough.setOrientationPrior(s.prior);
   hough.setUpDirection(s.up);
-  hough.setNumberOfOrientations(s.orientations);
-  hough.setNumberOfAccumulators(s.accumulators);
-  hough.setSeed(s.seed);
   hough.setInputCloud(cloud);
   hough.setInputNormals(cues);
   std::vector<facyl::CylinderModel> models;

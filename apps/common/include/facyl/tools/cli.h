@@ -11,6 +11,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <unistd.h>
+#include <mutex>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -22,6 +25,15 @@
 #include <vector>
 
 namespace facyl_cli {
+
+/** \a v as the shortest decimal that reads back as it for help texts (0.5, not 0.500000). */
+inline std::string
+compactNumber(float v)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
+  return text;
+}
 
 /** The largest seed an option accepts (seeds are read as signed 64-bit integers). */
 constexpr long long kMaxSeed = std::numeric_limits<long long>::max();
@@ -233,6 +245,76 @@ standardOptions(int argc, char** argv, const char* tool, PrintHelp help)
     }
   return -1;
 }
+
+/** The opening every tool shares: -h/--help and --version (standardOptions), then \a parse,
+ * which reads the options; a std::exception it throws is a usage error: "TOOL: what" on stderr
+ * and exit status 2. \return -1 when the tool goes on, else the exit status to return now. */
+template <typename PrintHelp, typename Parse>
+int
+startTool(int argc, char** argv, const char* tool, PrintHelp help, Parse&& parse)
+{
+  if (const int rc = standardOptions(argc, argv, tool, help); rc >= 0)
+    return rc;
+  try {
+    parse();
+  }
+  catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", tool, e.what());
+    return 2;
+  }
+  return -1;
+}
+
+/** Progress of a long run on stderr ("TOOL: n/N, t s, about u s left", redrawn at most every
+ * second) when stderr is a terminal and the run has more than one item; silent otherwise (logs
+ * and pipes stay clean), and while the results go to that terminal too, unless \a quiet_stdout
+ * says that nothing is printed there during the run. step() may be called from several
+ * threads. */
+class Progress {
+public:
+  Progress(const char* tool, std::size_t total, bool quiet_stdout = false)
+    : tool_(tool), total_(total),
+      shown_(total > 1 && isatty(fileno(stderr)) != 0 &&
+             (quiet_stdout || isatty(fileno(stdout)) == 0)),
+      start_(std::chrono::steady_clock::now()), last_(start_)
+  {}
+  ~Progress()
+  {
+    if (shown_ && drawn_)
+      std::fprintf(stderr, "\n");
+  }
+  Progress(const Progress&) = delete;
+  Progress&
+  operator=(const Progress&) = delete;
+
+  /** \a n more items done. */
+  void
+  step(std::size_t n = 1)
+  {
+    if (!shown_)
+      return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_ += n;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::seconds(1) && done_ < total_)
+      return;
+    last_ = now;
+    drawn_ = true;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double left = done_ ? elapsed / static_cast<double>(done_) *
+                                    static_cast<double>(total_ - std::min(done_, total_))
+                              : 0.0;
+    std::fprintf(stderr, "\r%s: %zu/%zu, %.0f s, about %.0f s left   ", tool_, done_, total_,
+                 elapsed, left);
+  }
+
+private:
+  const char* tool_;
+  std::size_t total_, done_{0};
+  bool shown_, drawn_{false};
+  std::chrono::steady_clock::time_point start_, last_;
+  std::mutex mutex_;
+};
 
 // ---- outputs: never over an input, never a file of another kind ----
 

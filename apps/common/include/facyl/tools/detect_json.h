@@ -5,8 +5,8 @@
  */
 #pragma once
 
-#include "cli.h"
-#include "cylinder_json.h"
+#include <facyl/tools/cli.h>
+#include <facyl/tools/cylinder_json.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 

@@ -4,7 +4,7 @@
  */
 #pragma once
 
-#include "cli.h"
+#include <facyl/tools/cli.h>
 
 #include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
@@ -45,7 +45,7 @@ recognizerAliases()
 inline const char*
 recognizerOptionsHelp()
 {
-  return "Shape classifier (paper III-B; a CNN on each object's view, run by OpenCV DNN):\n"
+  static const std::string help = std::string("Shape classifier (paper III-B; a CNN on each object's view, run by OpenCV DNN):\n"
          "  --model M              default (the model shipped with facyl) | none | PATH.onnx\n"
          "                         (with PATH.cfg beside it, see CylinderClassifier)\n"
          "  --reject-below P       clusters whose network probability is below P are not\n"
@@ -74,7 +74,8 @@ recognizerOptionsHelp()
          "  --radius-limits A,B    radius interval in m (default 0.01,0.25: objects on a table)\n"
          "  --voting V             soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
          "  --distance-threshold D inlier distance in m (default: estimated from the residuals)\n"
-         "  --orientations N       accumulator cells (default 450)\n"
+         "  --orientations N       accumulator cells (default ") +
+    std::to_string(facyl::TabletopRecognizerParameters{}.hough.orientations) + ")\n"
          "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
          "  --neighbours K         k of the normal/curvature estimation (default 16; old\n"
          "                         spelling --k)\n"
@@ -97,6 +98,7 @@ recognizerOptionsHelp()
          "                         band (default 0,0.5)\n"
          "  --cluster-tolerance D  Euclidean clustering tolerance in m (default 0.02)\n"
          "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n";
+  return help.c_str();
 }
 
 /** Reads the recognizer options of \a args into \a p and \a up (zero when not given).
@@ -127,19 +129,23 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
                                 "' is not soft-curvature, soft-normal or rabbani");
   p.hough.distance_threshold = static_cast<float>(
     args.number("--distance-threshold", p.hough.distance_threshold, 0.0, 1.0));
-  if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.prior))
+  if (args.has("--prior") &&
+      !facyl::parseOrientationPrior(args.text("--prior", ""), p.hough.prior))
     throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
   const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
   if (!(radii.first >= 0 && radii.second <= 10))
     throw std::invalid_argument("--radius-limits: expected 0 <= A < B <= 10 (m)");
   p.hough.radius_min = static_cast<float>(radii.first);
   p.hough.radius_max = static_cast<float>(radii.second);
-  p.orientations = static_cast<std::size_t>(
-    args.integer("--orientations", static_cast<long long>(p.orientations), 10, 100000));
+  p.hough.orientations = static_cast<std::size_t>(
+    args.integer("--orientations", static_cast<long long>(p.hough.orientations),
+                 static_cast<long long>(facyl::kMinOrientations),
+                 static_cast<long long>(facyl::kMaxOrientations)));
   p.max_fit_points = static_cast<std::size_t>(
     args.integer("--max-fit-points", static_cast<long long>(p.max_fit_points), 50, 1000000));
   p.neighbours = static_cast<int>(args.integer("--neighbours", p.neighbours, 5, 200));
-  p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, kMaxSeed));
+  p.hough.seed = static_cast<std::uint64_t>(
+    args.integer("--seed", static_cast<long long>(p.hough.seed), 0, kMaxSeed));
   p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(
     "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1, 20));
   auto& g = p.segmentation;
