@@ -86,10 +86,10 @@ def detect(
 
 def simulate_cylinder(
     *,
-    radius: float = 0.3,
-    height: float = 1.0,
+    radius: float = 0.05,
+    height: float = 0.2,
     axis: Sequence[float] = (0.0, 0.0, 1.0),
-    base: Sequence[float] = (0.0, 0.0, 0.0),
+    base: Sequence[float] = (0.0, 0.0, 0.8),
     points: int = 900,
     lid_ratio: float = 0.0,
     noise: float = 0.0,

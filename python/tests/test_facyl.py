@@ -466,3 +466,37 @@ def test_tracker_bad_frames_keep_the_tracks():
         facyl.Tracker(radius_limit=(0.01, 0.2))
     with pytest.raises(ValueError, match="change"):
         facyl.render_sequence_frame(change="shake")
+
+
+def test_stub_defaults_are_the_module_defaults():
+    # facyl.pyi restates the defaults for type checkers: each must be the module's own.
+    import ast
+    import re
+
+    stub = os.path.join(os.path.dirname(facyl.__file__), "facyl.pyi")
+    if not os.path.exists(stub):
+        pytest.skip("no facyl.pyi beside the module")
+    tree = ast.parse(open(stub).read())
+    checked = 0
+    for node in tree.body:
+        if not isinstance(node, ast.FunctionDef) or not hasattr(facyl, node.name):
+            continue
+        doc = getattr(facyl, node.name).__doc__ or ""
+        signature = doc.splitlines()[0] if doc else ""
+        args = node.args.args[-len(node.args.defaults):] if node.args.defaults else []
+        pairs = list(zip(args, node.args.defaults))
+        pairs += [(a, d) for a, d in zip(node.args.kwonlyargs, node.args.kw_defaults) if d]
+        for arg, default in pairs:
+            stub_value = ast.literal_eval(default)
+            m = re.search(r"\b%s: [^=]+ = ([^,)]+(?:\])?)" % arg.arg, signature)
+            if not m or m.group(1) in ("None", "..."):
+                continue
+            text = m.group(1)
+            if text.startswith("["):
+                text = signature[m.start(1):signature.index("]", m.start(1)) + 1]
+            module_value = ast.literal_eval(text)
+            if isinstance(stub_value, tuple):
+                stub_value = list(stub_value)
+            assert module_value == stub_value, (node.name, arg.arg, module_value, stub_value)
+            checked += 1
+    assert checked >= 10
