@@ -16,6 +16,7 @@ for a in "$@"; do
   esac
 done
 bash scripts/setup.sh
+bash scripts/check_format.sh # unformatted C++ fails CI (scripts/check_format.sh --fix formats it)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=ON >/dev/null
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
