@@ -8,8 +8,8 @@
 #include <facyl/tools/cli.h>
 #include <facyl/tools/pcl_baseline.h>
 
-#include <facyl/features/parallel.h>
 #include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/features/parallel.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/simulation/cylinder_simulation.h>
 
@@ -30,7 +30,6 @@
 #include <mutex>
 #include <random>
 #include <sstream>
-
 
 namespace {
 
@@ -122,22 +121,22 @@ methods(const std::string& setting)
   using facyl::OrientationPrior;
   using facyl::VotingMode;
   std::vector<Method> m = {
-      {"facyl-rabbani", false, VotingMode::Rabbani},
-      {"facyl-soft-normal", false, VotingMode::SoftNormal},
-      {"facyl-soft-curvature", false, VotingMode::SoftCurvature},
-      {"facyl-soft-curvature-0.1", false, VotingMode::SoftCurvature, OrientationPrior::Uniform,
-       pcl::SAC_RANSAC, false, true},
+    {"facyl-rabbani", false, VotingMode::Rabbani},
+    {"facyl-soft-normal", false, VotingMode::SoftNormal},
+    {"facyl-soft-curvature", false, VotingMode::SoftCurvature},
+    {"facyl-soft-curvature-0.1", false, VotingMode::SoftCurvature, OrientationPrior::Uniform,
+     pcl::SAC_RANSAC, false, true},
   };
   if (setting == "paper") { // the axis is vertical: the priors of Table II apply
-    m.push_back({"facyl-soft-curvature-mild", false, VotingMode::SoftCurvature,
-                 OrientationPrior::Vertical});
+    m.push_back(
+      {"facyl-soft-curvature-mild", false, VotingMode::SoftCurvature, OrientationPrior::Vertical});
     m.push_back({"facyl-soft-curvature-strong", false, VotingMode::SoftCurvature,
                  OrientationPrior::VerticalStrong});
   }
-  m.push_back({"pcl-ransac", true, VotingMode::SoftCurvature, OrientationPrior::Uniform,
-               pcl::SAC_RANSAC});
-  m.push_back({"pcl-mlesac", true, VotingMode::SoftCurvature, OrientationPrior::Uniform,
-               pcl::SAC_MLESAC});
+  m.push_back(
+    {"pcl-ransac", true, VotingMode::SoftCurvature, OrientationPrior::Uniform, pcl::SAC_RANSAC});
+  m.push_back(
+    {"pcl-mlesac", true, VotingMode::SoftCurvature, OrientationPrior::Uniform, pcl::SAC_MLESAC});
   if (setting == "paper")
     m.push_back({"pcl-ransac-axis", true, VotingMode::SoftCurvature, OrientationPrior::Uniform,
                  pcl::SAC_RANSAC, true});
@@ -198,10 +197,10 @@ makeScene(const std::string& setting, const Level& level, int scene, std::uint64
     n.normalize();
     Eigen::Vector3f d = n.cross(Eigen::Vector3f(g(rng), g(rng), g(rng))).normalized();
     const float size = 2.f * std::max(p.height, 2.f * p.radius);
-    const Eigen::Vector3f centre = sim.truth.base + 0.5f * p.height * sim.truth.axis +
-                                   (p.radius + 0.5f * size + 0.02f) * d;
+    const Eigen::Vector3f centre =
+      sim.truth.base + 0.5f * p.height * sim.truth.axis + (p.radius + 0.5f * size + 0.02f) * d;
     const auto plane =
-        facyl::simulatePlane(centre, n, size, size, 900, level.noise * p.radius, rng());
+      facyl::simulatePlane(centre, n, size, size, 900, level.noise * p.radius, rng());
     for (const auto& q : plane)
       s.cloud->push_back(pcl::PointXYZ(q.x, q.y, q.z));
   }
@@ -298,24 +297,24 @@ void
 printHelp(const char* self)
 {
   std::printf(
-      "Usage: %s [options]\n"
-      "Robustness study of the paper's Fig. 10 against PCL SACMODEL_CYLINDER.\n"
-      "  --scenes N     cylinders per setting (default 1000, as in the paper)\n"
-      "  --quick        50 scenes (a smoke test; about a minute on 2 cores)\n"
-      "  --settings S   paper,practical (default both): paper = r 0.3 m, vertical axis;\n"
-      "                 practical = random axis, r 0.02-0.3 m, a table-like plane beside it;\n"
-      "                 random = random axis, r 0.02-0.3 m, nothing else (other cylinders)\n"
-      "  --levels L     levels to run instead of the paper's sweeps, e.g.\n"
-      "                 'noise:0.1,0.15,0.2,0.3;outliers:1,3,5;occlusion:0.75;clutter:0.5'\n"
-      "                 (sweeps noise, outliers, occlusion, and clutter: lids at 300%% with\n"
-      "                 that occlusion; 1%% noise where noise is not swept)\n"
-      "  --methods M    only these methods (comma-separated names as in fits.csv)\n"
-      "  --seed S       seed (default 1); the same seed gives the same fits\n"
-      "  --threads T    threads (default: all cores)\n"
-      "  --out DIR      output folder (default bench_out): fits.csv, summary.md\n"
-      "  --dump SETTING,SWEEP,LEVEL,SCENE  write that scene to DIR/scene.pcd (to rerun one fit\n"
-      "                 with facyl_fit) and stop; LEVEL as in fits.csv\n%s",
-      self, facyl_cli::commonHelp());
+    "Usage: %s [options]\n"
+    "Robustness study of the paper's Fig. 10 against PCL SACMODEL_CYLINDER.\n"
+    "  --scenes N     cylinders per setting (default 1000, as in the paper)\n"
+    "  --quick        50 scenes (a smoke test; about a minute on 2 cores)\n"
+    "  --settings S   paper,practical (default both): paper = r 0.3 m, vertical axis;\n"
+    "                 practical = random axis, r 0.02-0.3 m, a table-like plane beside it;\n"
+    "                 random = random axis, r 0.02-0.3 m, nothing else (other cylinders)\n"
+    "  --levels L     levels to run instead of the paper's sweeps, e.g.\n"
+    "                 'noise:0.1,0.15,0.2,0.3;outliers:1,3,5;occlusion:0.75;clutter:0.5'\n"
+    "                 (sweeps noise, outliers, occlusion, and clutter: lids at 300%% with\n"
+    "                 that occlusion; 1%% noise where noise is not swept)\n"
+    "  --methods M    only these methods (comma-separated names as in fits.csv)\n"
+    "  --seed S       seed (default 1); the same seed gives the same fits\n"
+    "  --threads T    threads (default: all cores)\n"
+    "  --out DIR      output folder (default bench_out): fits.csv, summary.md\n"
+    "  --dump SETTING,SWEEP,LEVEL,SCENE  write that scene to DIR/scene.pcd (to rerun one fit\n"
+    "                 with facyl_fit) and stop; LEVEL as in fits.csv\n%s",
+    self, facyl_cli::commonHelp());
 }
 
 } // namespace
@@ -334,15 +333,15 @@ Options
 parseOptions(int argc, char** argv)
 {
   Options o;
-  const facyl_cli::Arguments args(argc, argv,
-                                  {"--scenes", "--settings", "--seed", "--threads", "--out",
-                                   "--dump", "--levels", "--methods"},
-                                  {"--quick"});
+  const facyl_cli::Arguments args(
+    argc, argv,
+    {"--scenes", "--settings", "--seed", "--threads", "--out", "--dump", "--levels", "--methods"},
+    {"--quick"});
   o.dump = args.text("--dump", "");
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
   o.scenes =
-      static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1, 1000000));
+    static_cast<int>(args.integer("--scenes", args.has("--quick") ? 50 : 1000, 1, 1000000));
   o.seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0, facyl_cli::kMaxSeed));
   o.threads = static_cast<int>(args.integer("--threads", 0, 0, 256));
   o.out = args.text("--out", o.out);
@@ -373,15 +372,13 @@ dumpScene(const Options& o)
   std::getline(ss, scene, ',');
   for (const auto& l : o.levels)
     if (l.sweep == sweep && !level.empty() && std::abs(l.value - std::stof(level)) < 1e-4f &&
-        (setting == "paper" || setting == "practical" || setting == "random") &&
-        !scene.empty()) {
+        (setting == "paper" || setting == "practical" || setting == "random") && !scene.empty()) {
       const Scene s = makeScene(setting, l, std::stoi(scene), o.seed);
       pcl::io::savePCDFileBinary(o.out + "/scene.pcd", *s.cloud);
       std::printf("{\"file\":%s,\"radius\":%s,\"axis\":%s,\"base\":%s}\n",
                   facyl_cli::quote(o.out + "/scene.pcd").c_str(),
                   facyl_cli::number(s.truth.radius).c_str(),
-                  facyl_cli::vector(s.truth.axis).c_str(),
-                  facyl_cli::vector(s.truth.base).c_str());
+                  facyl_cli::vector(s.truth.axis).c_str(), facyl_cli::vector(s.truth.base).c_str());
       return 0;
     }
   std::fprintf(stderr, "facyl_bench: --dump wants SETTING,SWEEP,LEVEL,SCENE as in fits.csv\n");
@@ -399,10 +396,9 @@ methodSets(const Options& o)
     if (o.method_filter.empty())
       continue;
     const std::string list = "," + o.method_filter + ",";
-    ms.erase(std::remove_if(ms.begin(), ms.end(),
-                            [&](const Method& m) {
-                              return list.find("," + m.name + ",") == std::string::npos;
-                            }),
+    ms.erase(std::remove_if(
+               ms.begin(), ms.end(),
+               [&](const Method& m) { return list.find("," + m.name + ",") == std::string::npos; }),
              ms.end());
     if (ms.empty())
       throw std::invalid_argument("--methods names no method of setting " + s);
@@ -443,8 +439,9 @@ writeSummary(const Options& o, const std::vector<Task>& tasks,
   const int scenes = o.scenes;
   const std::uint64_t seed = o.seed;
   std::ofstream md(o.out + "/summary.md");
-  md << "# facyl_bench summary\n\n" << scenes << " scenes per setting and level, seed " << seed
-     << ", " << workers << " threads, " << fmt(static_cast<float>(elapsed), 0)
+  md << "# facyl_bench summary\n\n"
+     << scenes << " scenes per setting and level, seed " << seed << ", " << workers << " threads, "
+     << fmt(static_cast<float>(elapsed), 0)
      << " s. Failure: axis error > 10 deg or no cylinder. Errors: median / 90th percentile; "
         "radius and position in mm; time: median fit time (normals excluded, shared).\n";
   for (const auto& s : settings) {
@@ -535,8 +532,9 @@ main(int argc, char** argv)
         tasks.push_back({s, l, k});
   std::vector<std::vector<Fit>> results(tasks.size());
   const int workers = facyl::parallelWorkers(tasks.size(), o.threads, 1);
-  std::fprintf(stderr, "facyl_bench: %zu scene-levels (%d scenes x %zu levels x %zu settings) on "
-                       "%d threads\n",
+  std::fprintf(stderr,
+               "facyl_bench: %zu scene-levels (%d scenes x %zu levels x %zu settings) on "
+               "%d threads\n",
                tasks.size(), o.scenes, o.levels.size(), o.settings.size(), workers);
   const auto start = std::chrono::steady_clock::now();
   {
@@ -548,7 +546,7 @@ main(int argc, char** argv)
     });
   }
   const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   writeFits(o, tasks, method_sets, results);
   writeSummary(o, tasks, method_sets, results, workers, elapsed);
   std::fprintf(stderr, "facyl_bench: wrote %s/fits.csv and %s/summary.md in %.0f s\n",

@@ -74,20 +74,20 @@ BM_Fit(benchmark::State& state, facyl::VotingMode mode)
 }
 // Default settings on 900 + 900 points, then growth with points and with N_d.
 BENCHMARK_CAPTURE(BM_Fit, soft_curvature, facyl::VotingMode::SoftCurvature)
-    ->Args({900, 450})
-    ->Args({225, 450})
-    ->Args({450, 450})
-    ->Args({1800, 450})
-    ->Args({3600, 450})
-    ->Args({7200, 450})
-    ->Args({900, 100})
-    ->Args({900, 900})
-    ->Args({900, 1800})
-    ->Args({900, 3600})
-    ->Unit(benchmark::kMillisecond);
+  ->Args({900, 450})
+  ->Args({225, 450})
+  ->Args({450, 450})
+  ->Args({1800, 450})
+  ->Args({3600, 450})
+  ->Args({7200, 450})
+  ->Args({900, 100})
+  ->Args({900, 900})
+  ->Args({900, 1800})
+  ->Args({900, 3600})
+  ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Fit, rabbani, facyl::VotingMode::Rabbani)
-    ->Args({900, 450})
-    ->Unit(benchmark::kMillisecond);
+  ->Args({900, 450})
+  ->Unit(benchmark::kMillisecond);
 
 void
 BM_NormalsAndCurvatures(benchmark::State& state)
@@ -106,11 +106,11 @@ BM_NormalsAndCurvatures(benchmark::State& state)
 }
 // points, k, threads (0: all cores)
 BENCHMARK(BM_NormalsAndCurvatures)
-    ->Args({1800, 16, 1})
-    ->Args({1800, 16, 0})
-    ->Args({1800, 10, 0})
-    ->Args({7200, 16, 0})
-    ->Unit(benchmark::kMillisecond);
+  ->Args({1800, 16, 1})
+  ->Args({1800, 16, 0})
+  ->Args({1800, 10, 0})
+  ->Args({7200, 16, 0})
+  ->Unit(benchmark::kMillisecond);
 
 void
 BM_PclNormalsThenCurvatures(benchmark::State& state)
@@ -194,7 +194,8 @@ makeTrackerStream(int n, int frames)
     facyl::SupportPlane support;
     support.plane.head<3>() = to_camera.linear() * Eigen::Vector3f::UnitZ();
     support.plane[3] = -support.plane.head<3>().dot(to_camera * Eigen::Vector3f::Zero());
-    support.frame = facyl::planeFrame(support.plane, to_camera * Eigen::Vector3f(rng.uniform(-0.1f, 0.1f), 0.f, 0.f));
+    support.frame = facyl::planeFrame(
+      support.plane, to_camera * Eigen::Vector3f(rng.uniform(-0.1f, 0.1f), 0.f, 0.f));
     s.supports.push_back({support});
     std::vector<facyl::RecognizedObject> objects;
     for (int i = 0; i < n; ++i) {
@@ -207,20 +208,23 @@ makeTrackerStream(int n, int frames)
       if (i % 4 != 3) {
         o.is_cylinder = o.evidence.fitted = true;
         o.cylinder.base = to_camera * (places[static_cast<std::size_t>(i)] + jitter);
-        o.cylinder.top = to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.1f));
+        o.cylinder.top =
+          to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.1f));
         o.cylinder.point_on_axis = o.cylinder.base;
         o.cylinder.axis = (o.cylinder.top - o.cylinder.base).normalized();
         o.cylinder.radius = 0.03f * (1.f + 0.02f * rng.normal());
         o.cylinder.angular_coverage = 0.4f;
       }
-      o.cluster.centroid = to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.05f));
+      o.cluster.centroid =
+        to_camera * (places[static_cast<std::size_t>(i)] + jitter + Eigen::Vector3f(0, 0, 0.05f));
       objects.push_back(o);
     }
     s.objects.push_back(std::move(objects));
     facyl::TrackerView view;
     view.camera = cam;
     view.depth = [pose, cam](int u, int v) {
-      const Eigen::Vector3f w = pose.linear() * Eigen::Vector3f((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.f);
+      const Eigen::Vector3f w =
+        pose.linear() * Eigen::Vector3f((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.f);
       return -pose.translation().z() / w.z();
     };
     s.views.push_back(view);

@@ -93,7 +93,8 @@ struct Settings {
 /** Appends the images and rows of objects. */
 class DataWriter {
 public:
-  DataWriter(const std::string& dir, int size) : size_(size)
+  DataWriter(const std::string& dir, int size)
+      : size_(size)
   {
     rgb_.open(dir + "/rgb.u8", std::ios::binary);
     depth_.open(dir + "/depth.u8", std::ios::binary);
@@ -108,10 +109,9 @@ public:
   }
 
   /** One object; \a p_network NaN without a model. */
-  void
-  write(const facyl::ObjectView& view, const std::string& source, const std::string& scene,
-        int object, const std::string& kind, int label, float purity,
-        const facyl::CylinderEvidence& evidence, float p_network)
+  void write(const facyl::ObjectView& view, const std::string& source, const std::string& scene,
+             int object, const std::string& kind, int label, float purity,
+             const facyl::CylinderEvidence& evidence, float p_network)
   {
     for (const auto channels : {facyl::ClassifierChannels::Rgb, facyl::ClassifierChannels::Depth}) {
       std::vector<std::uint8_t> image = facyl::classifierImage(view, {channels, size_});
@@ -121,17 +121,17 @@ public:
                 static_cast<std::streamsize>(image.size()));
     }
     const facyl::CylinderDecision decision;
-    const auto f = facyl::fusionFeatures(std::numeric_limits<float>::quiet_NaN(), evidence, decision);
-    csv_ << rows_++ << "," << source << "," << scene << "," << object << "," << kind << ","
-         << label << "," << purity << "," << view.points.cols() << "," << evidence.fitted << ","
+    const auto f =
+      facyl::fusionFeatures(std::numeric_limits<float>::quiet_NaN(), evidence, decision);
+    csv_ << rows_++ << "," << source << "," << scene << "," << object << "," << kind << "," << label
+         << "," << purity << "," << view.points.cols() << "," << evidence.fitted << ","
          << facyl::acceptGeometry(evidence, decision) << "," << evidence.inlier_ratio << ","
          << evidence.surface_ratio;
     for (const float x : f)
       csv_ << "," << x;
     csv_ << "," << p_network << "\n";
   }
-  std::size_t
-  rows() const
+  std::size_t rows() const
   {
     return rows_;
   }
@@ -186,7 +186,8 @@ simulatedScene(const Settings& s, std::size_t k, Recognizer& rec, DataWriter& ou
       if (c > most)
         id = l, most = c;
     const float purity =
-      static_cast<float>(most) / static_cast<float>(std::max<std::size_t>(1, o.cluster.indices.indices.size()));
+      static_cast<float>(most) /
+      static_cast<float>(std::max<std::size_t>(1, o.cluster.indices.indices.size()));
     // Scenery (far furniture and what stands on it, robots) holds cans and cylindrical
     // links as well as boxes, and its class says nothing about its shape: neither a
     // cylinder nor a distractor, as facyl_tabletop_eval scores it.
@@ -387,8 +388,8 @@ mosdCrops(const Settings& s, Recognizer& rec, DataWriter& out)
           id = l, most = c;
       if (id == 0)
         continue;
-      const float iou = static_cast<float>(most) /
-                        static_cast<float>(indices.size() + truth_size[id] - most);
+      const float iou =
+        static_cast<float>(most) / static_cast<float>(indices.size() + truth_size[id] - most);
       if (iou < 0.5f)
         continue;
       const facyl::ObjectView view = facyl::objectView(*cloud, indices, none);
@@ -402,11 +403,10 @@ mosdCrops(const Settings& s, Recognizer& rec, DataWriter& out)
 Settings
 parseSettings(int argc, char** argv)
 {
-  const facyl_cli::Arguments args(
-    argc, argv,
-    {"--sim", "--seed", "--layout", "--sensor", "--uw", "--mosd", "--mosd-scenes", "--size",
-     "--model"},
-    {});
+  const facyl_cli::Arguments args(argc, argv,
+                                  {"--sim", "--seed", "--layout", "--sensor", "--uw", "--mosd",
+                                   "--mosd-scenes", "--size", "--model"},
+                                  {});
   if (args.positional().size() != 1)
     throw std::invalid_argument("give exactly one output folder (see -h)");
   Settings s;
@@ -471,9 +471,8 @@ int
 main(int argc, char** argv)
 {
   Settings s;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_crops", printHelp, [&] {
-    s = parseSettings(argc, argv);
-  });
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_crops", printHelp,
+                                      [&] { s = parseSettings(argc, argv); });
   if (rc >= 0)
     return rc;
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);

@@ -76,15 +76,14 @@ printHelp(const char* self)
 struct Canvas {
   int width{0}, height{0};
   std::vector<unsigned char> rgb;
-  void
-  put(int u, int v, const std::array<unsigned char, 3>& c)
+  void put(int u, int v, const std::array<unsigned char, 3>& c)
   {
     if (u < 0 || v < 0 || u >= width || v >= height)
       return;
     std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::size_t>(v) * width + u));
   }
-  void
-  line(Eigen::Vector2f a, Eigen::Vector2f b, const std::array<unsigned char, 3>& c, int thick = 1)
+  void line(Eigen::Vector2f a, Eigen::Vector2f b, const std::array<unsigned char, 3>& c,
+            int thick = 1)
   {
     if (!a.allFinite() || !b.allFinite() || (a - b).norm() > 4.f * (width + height))
       return;
@@ -93,7 +92,8 @@ struct Canvas {
       const Eigen::Vector2f p = a + (b - a) * (static_cast<float>(s) / steps);
       for (int dv = 0; dv < thick; ++dv)
         for (int du = 0; du < thick; ++du)
-          put(static_cast<int>(std::lround(p.x())) + du, static_cast<int>(std::lround(p.y())) + dv, c);
+          put(static_cast<int>(std::lround(p.x())) + du, static_cast<int>(std::lround(p.y())) + dv,
+              c);
     }
   }
 };
@@ -153,7 +153,7 @@ struct Settings {
   bool verbose{false}; ///< --verbose: PCL's debug messages (what the segmentation found)
   int roll{0};         ///< --roll: quarter turns of the camera about its optical axis
   facyl::ShapeClassifier::Ptr classifier; ///< --model; nullptr: none
-  bool track{false};   ///< --track: the scenes are one stream
+  bool track{false};                      ///< --track: the scenes are one stream
   facyl::CylinderTrackerParameters tracking;
 };
 
@@ -177,8 +177,8 @@ drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
   for (std::size_t i = 0; i < cloud.size(); i += 17)
     if (pcl::isFinite(cloud[i])) {
       pts.col(n) = cloud[i].getVector3fMap();
-      px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud.width),
-                                    static_cast<float>(i / cloud.width));
+      px.col(n++) =
+        Eigen::Vector2f(static_cast<float>(i % cloud.width), static_cast<float>(i / cloud.width));
     }
   facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), static_cast<int>(cloud.width),
                          static_cast<int>(cloud.height), camera);
@@ -203,7 +203,8 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
       const auto& p = cloud[i];
       canvas.rgb[3 * i] = p.r, canvas.rgb[3 * i + 1] = p.g, canvas.rgb[3 * i + 2] = p.b;
     }
-  } else if (camera.valid()) {
+  }
+  else if (camera.valid()) {
     canvas.width = camera.width;
     canvas.height = camera.height;
     canvas.rgb.assign(3 * static_cast<std::size_t>(camera.width) * camera.height, 0);
@@ -243,8 +244,8 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
 /** Each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png) in \a dir.
  * \return an empty string, or what could not be written. */
 std::string
-saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud,
-             bool has_colour, const std::vector<facyl::RecognizedObject>& objects)
+saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud, bool has_colour,
+             const std::vector<facyl::RecognizedObject>& objects)
 {
   for (std::size_t k = 0; k < objects.size(); ++k) {
     const auto& o = objects[k];
@@ -273,8 +274,8 @@ saveClusters(const std::string& dir, const std::string& name, const Cloud& cloud
 }
 
 bool
-processScene(const std::string& file, const std::string& name, const Settings& s,
-             std::ostream& out, Stream* stream)
+processScene(const std::string& file, const std::string& name, const Settings& s, std::ostream& out,
+             Stream* stream)
 {
   auto fail = [&](const std::string& why) {
     out << "{\"file\":" << facyl_cli::quote(file) << ",\"error\":" << facyl_cli::quote(why);
@@ -398,10 +399,11 @@ checkOutputs(const Settings& s, const std::vector<std::string>& files, const std
   if (!s.overlay.empty()) {
     if (s.many) {
       if (!std::filesystem::is_directory(s.overlay))
-        throw std::invalid_argument("--overlay " + s.overlay + ": with several scenes, a folder "
+        throw std::invalid_argument("--overlay " + s.overlay +
+                                    ": with several scenes, a folder "
                                     "that exists (one <stem>.png per scene). Nothing was written.");
-      facyl_cli::checkOutputFolder("--overlay", s.overlay,
-                                   [&](const std::string& f) { return isName(f, ".png"); }, inputs);
+      facyl_cli::checkOutputFolder(
+        "--overlay", s.overlay, [&](const std::string& f) { return isName(f, ".png"); }, inputs);
     }
     else {
       facyl_cli::checkOutputFile("--overlay", s.overlay, {".png"}, "PNG image", inputs);
@@ -413,8 +415,9 @@ checkOutputs(const Settings& s, const std::vector<std::string>& files, const std
   if (!s.clusters_dir.empty()) {
     if (!std::filesystem::is_directory(s.clusters_dir))
       throw std::invalid_argument("folder '" + s.clusters_dir + "' does not exist");
-    facyl_cli::checkOutputFolder("--save-clusters", s.clusters_dir,
-                                 [&](const std::string& f) { return isName(f, "_obj"); }, inputs);
+    facyl_cli::checkOutputFolder(
+      "--save-clusters", s.clusters_dir, [&](const std::string& f) { return isName(f, "_obj"); },
+      inputs);
   }
 }
 
@@ -439,8 +442,8 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
     std::istringstream in(args.text("--camera", ""));
     char c1 = 0, c2 = 0, c3 = 0;
     facyl::PinholeCamera& cam = s.camera;
-    if (!(in >> cam.fx >> c1 >> cam.fy >> c2 >> cam.cx >> c3 >> cam.cy) || c1 != ',' ||
-        c2 != ',' || c3 != ',' || !in.eof() || !(cam.fx > 0.f && cam.fx <= 1e5f) ||
+    if (!(in >> cam.fx >> c1 >> cam.fy >> c2 >> cam.cx >> c3 >> cam.cy) || c1 != ',' || c2 != ',' ||
+        c3 != ',' || !in.eof() || !(cam.fx > 0.f && cam.fx <= 1e5f) ||
         !(cam.fy > 0.f && cam.fy <= 1e5f) || !(cam.cx >= 0.f && cam.cx <= 4000.f) ||
         !(cam.cy >= 0.f && cam.cy <= 4000.f))
       throw std::invalid_argument("--camera: expected fx,fy,cx,cy with 0 < fx, fy <= 1e5 and "
@@ -459,8 +462,10 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.track = args.has("--track");
   if (!s.track && (args.has("--track-confirm-hits") || args.has("--track-max-misses")))
     throw std::invalid_argument("--track-confirm-hits and --track-max-misses need --track");
-  s.tracking.confirm_hits = static_cast<int>(args.integer("--track-confirm-hits", s.tracking.confirm_hits, 1, 100));
-  s.tracking.max_misses = static_cast<int>(args.integer("--track-max-misses", s.tracking.max_misses, 1, 1000));
+  s.tracking.confirm_hits =
+    static_cast<int>(args.integer("--track-confirm-hits", s.tracking.confirm_hits, 1, 100));
+  s.tracking.max_misses =
+    static_cast<int>(args.integer("--track-max-misses", s.tracking.max_misses, 1, 1000));
   s.many = files.size() > 1;
   checkOutputs(s, files, args.text("--model", ""));
   return s;
@@ -473,9 +478,8 @@ main(int argc, char** argv)
 {
   Settings s;
   std::vector<std::string> files;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_detect", printHelp, [&] {
-    s = parseSettings(argc, argv, files);
-  });
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_detect", printHelp,
+                                      [&] { s = parseSettings(argc, argv, files); });
   if (rc >= 0)
     return rc;
   // PCL's warnings about a file (e.g. a cloud without colour) would drown the output; the

@@ -29,18 +29,18 @@ void
 printHelp(const char* self)
 {
   std::printf(
-      "Usage: %s [options] FILE.pcd...\n"
-      "Fits cylinders to each point cloud (a bare fit: no table) and prints one JSON object\n"
-      "per file: {\"file\", \"method\", \"voting\", \"units\", \"points\", \"cylinders\": [{\n"
-      "\"point_on_axis\", \"axis\", \"radius\", \"height\", \"base\", \"top\", \"inlier_ratio\",\n"
-      "\"n_inliers\", \"confidence\", \"rms_error\", \"angular_coverage\"}], \"timing_ms\"}.\n\n"
-      "%s"
-      "  --inliers            also print each cylinder's inlier indices (\"inliers\")\n"
-      "%s\n"
-      "Normals are estimated unless the file has normal_x/y/z. Writes no file. Exit status: 0\n"
-      "if every file was processed, 1 if some file failed (its object holds \"error\"), 2 on\n"
-      "bad options.\n",
-      self, facyl_cli::fitOptionsHelp(), facyl_cli::commonHelp());
+    "Usage: %s [options] FILE.pcd...\n"
+    "Fits cylinders to each point cloud (a bare fit: no table) and prints one JSON object\n"
+    "per file: {\"file\", \"method\", \"voting\", \"units\", \"points\", \"cylinders\": [{\n"
+    "\"point_on_axis\", \"axis\", \"radius\", \"height\", \"base\", \"top\", \"inlier_ratio\",\n"
+    "\"n_inliers\", \"confidence\", \"rms_error\", \"angular_coverage\"}], \"timing_ms\"}.\n\n"
+    "%s"
+    "  --inliers            also print each cylinder's inlier indices (\"inliers\")\n"
+    "%s\n"
+    "Normals are estimated unless the file has normal_x/y/z. Writes no file. Exit status: 0\n"
+    "if every file was processed, 1 if some file failed (its object holds \"error\"), 2 on\n"
+    "bad options.\n",
+    self, facyl_cli::fitOptionsHelp(), facyl_cli::commonHelp());
 }
 
 struct Settings : facyl_cli::FitSettings {
@@ -61,7 +61,7 @@ fitPclRansac(const Cloud::ConstPtr& cloud, const Cues& cues, const Settings& s)
   const float diagonal = (hi - lo).head<3>().norm();
   facyl_cli::PclCylinderOptions o;
   o.distance_threshold =
-      s.params.distance_threshold > 0.f ? s.params.distance_threshold : 0.01f * diagonal;
+    s.params.distance_threshold > 0.f ? s.params.distance_threshold : 0.01f * diagonal;
   o.radius_min = s.params.radius_min;
   o.radius_max = std::isfinite(s.params.radius_max) ? s.params.radius_max : diagonal;
   o.max_cylinders = s.params.max_cylinders;
@@ -114,13 +114,13 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, s.threads, given);
   if (cues->size() != cloud->size())
     return errorObject(file, "normal estimation failed (too few points for k = " +
-                                 std::to_string(s.neighbours) + "?)");
+                               std::to_string(s.neighbours) + "?)");
   const double normals_ms = normals_watch.getTime();
   if (std::none_of(cues->begin(), cues->end(),
                    [](const facyl::NormalCurvature& c) { return std::isfinite(c.normal_x); }))
-    return errorObject(file, "no point has a normal: " + std::to_string(finite) +
-                                 " finite points are too few or degenerate for k = " +
-                                 std::to_string(s.neighbours));
+    return errorObject(
+      file, "no point has a normal: " + std::to_string(finite) +
+              " finite points are too few or degenerate for k = " + std::to_string(s.neighbours));
 
   pcl::StopWatch fit_watch;
   std::vector<facyl::CylinderModel> models;
@@ -136,12 +136,13 @@ processFile(const std::string& file, const Settings& s, bool& ok)
 
   using facyl_cli::number;
   const char* units_name = s.units == facyl_cli::Units::Millimetres ? "mm" : "m";
-  std::string out = "{\"file\":" + facyl_cli::quote(file) + ",\"method\":" +
-                    facyl_cli::quote(s.method) + ",\"voting\":" +
-                    facyl_cli::quote(s.method == "pcl-ransac" ? std::string("none")
-                                                               : facyl::toString(s.params.voting_mode)) +
-                    ",\"units\":\"" + units_name + "\",\"points\":" + std::to_string(cloud->size()) +
-                    ",\"cylinders\":[";
+  std::string out =
+    "{\"file\":" + facyl_cli::quote(file) + ",\"method\":" + facyl_cli::quote(s.method) +
+    ",\"voting\":" +
+    facyl_cli::quote(s.method == "pcl-ransac" ? std::string("none")
+                                              : facyl::toString(s.params.voting_mode)) +
+    ",\"units\":\"" + units_name + "\",\"points\":" + std::to_string(cloud->size()) +
+    ",\"cylinders\":[";
   for (std::size_t i = 0; i < models.size(); ++i) {
     facyl::CylinderModel m = models[i];
     facyl_cli::scaleModel(m, 1.f / to_metres);

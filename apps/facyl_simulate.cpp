@@ -23,26 +23,25 @@ void
 printHelp(const char* self)
 {
   const facyl::CylinderSimulationParameters d; // the defaults' one home
-  std::printf("Usage: %s [options] OUT.pcd\n"
-              "  --radius R        radius (default %s)\n"
-              "  --height H        height (default %s)\n"
-              "  --axis x,y,z      axis (default %s)\n"
-              "  --base x,y,z      centre of the bottom cap (default %s)\n"
-              "  --random-axis     draw the axis uniformly\n"
-              "  --points N        lateral points |P| (default %zu)\n"
-              "  --lids L          lid outliers of eq. 5, e.g. 1 = 100%% (default %s)\n"
-              "  --noise S         noise std. dev. relative to the radius (default %s)\n"
-              "  --occlusion O     occlusion of eq. 6 in [0, 1) (default %s)\n"
-              "  --seed S          seed (default %llu)\n"
-              "  --with-normals    also write the exact normals\n"
-              "OUT.pcd must end in .pcd (anything else is refused, nothing written).\n%s",
-              self, facyl_cli::compactNumber(d.radius).c_str(),
-              facyl_cli::compactNumber(d.height).c_str(), commaVector(d.axis).c_str(),
-              commaVector(d.base).c_str(), d.lateral_points,
-              facyl_cli::compactNumber(d.lid_ratio).c_str(),
-              facyl_cli::compactNumber(d.noise).c_str(),
-              facyl_cli::compactNumber(d.occlusion).c_str(),
-              static_cast<unsigned long long>(d.seed), facyl_cli::commonHelp());
+  std::printf(
+    "Usage: %s [options] OUT.pcd\n"
+    "  --radius R        radius (default %s)\n"
+    "  --height H        height (default %s)\n"
+    "  --axis x,y,z      axis (default %s)\n"
+    "  --base x,y,z      centre of the bottom cap (default %s)\n"
+    "  --random-axis     draw the axis uniformly\n"
+    "  --points N        lateral points |P| (default %zu)\n"
+    "  --lids L          lid outliers of eq. 5, e.g. 1 = 100%% (default %s)\n"
+    "  --noise S         noise std. dev. relative to the radius (default %s)\n"
+    "  --occlusion O     occlusion of eq. 6 in [0, 1) (default %s)\n"
+    "  --seed S          seed (default %llu)\n"
+    "  --with-normals    also write the exact normals\n"
+    "OUT.pcd must end in .pcd (anything else is refused, nothing written).\n%s",
+    self, facyl_cli::compactNumber(d.radius).c_str(), facyl_cli::compactNumber(d.height).c_str(),
+    commaVector(d.axis).c_str(), commaVector(d.base).c_str(), d.lateral_points,
+    facyl_cli::compactNumber(d.lid_ratio).c_str(), facyl_cli::compactNumber(d.noise).c_str(),
+    facyl_cli::compactNumber(d.occlusion).c_str(), static_cast<unsigned long long>(d.seed),
+    facyl_cli::commonHelp());
 }
 } // namespace
 
@@ -66,11 +65,13 @@ main(int argc, char** argv)
     p.axis = args.vector3("--axis", p.axis);
     p.base = args.vector3("--base", p.base);
     p.random_axis = args.has("--random-axis");
-    p.lateral_points = static_cast<std::size_t>(args.integer("--points", static_cast<long long>(p.lateral_points), 1, 10000000));
+    p.lateral_points = static_cast<std::size_t>(
+      args.integer("--points", static_cast<long long>(p.lateral_points), 1, 10000000));
     p.lid_ratio = static_cast<float>(args.number("--lids", p.lid_ratio, 0.0, 10.0));
     p.noise = static_cast<float>(args.number("--noise", p.noise, 0.0, 10.0));
     p.occlusion = static_cast<float>(args.number("--occlusion", p.occlusion, 0.0, 1.0));
-    p.seed = static_cast<std::uint64_t>(args.integer("--seed", static_cast<long long>(p.seed), 0, facyl_cli::kMaxSeed));
+    p.seed = static_cast<std::uint64_t>(
+      args.integer("--seed", static_cast<long long>(p.seed), 0, facyl_cli::kMaxSeed));
     normals = args.has("--with-normals");
     const std::string why = facyl::validate(p);
     if (!why.empty())
@@ -93,9 +94,11 @@ main(int argc, char** argv)
     return 1;
   }
   const auto& t = sim.truth;
-  std::cout << "{\"file\":" << facyl_cli::quote(out) << ",\"radius\":" << facyl_cli::number(t.radius)
-            << ",\"height\":" << facyl_cli::number(t.height) << ",\"axis\":"
-            << facyl_cli::vector(t.axis) << ",\"base\":" << facyl_cli::vector(t.base)
+  std::cout << "{\"file\":" << facyl_cli::quote(out)
+            << ",\"radius\":" << facyl_cli::number(t.radius)
+            << ",\"height\":" << facyl_cli::number(t.height)
+            << ",\"axis\":" << facyl_cli::vector(t.axis)
+            << ",\"base\":" << facyl_cli::vector(t.base)
             << ",\"lateral_points\":" << t.lateral_points << ",\"lid_points\":" << t.lid_points
             << "}" << std::endl;
   return 0;

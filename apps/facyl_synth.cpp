@@ -3,8 +3,8 @@
  *
  * For each scene PREFIX_NNNN (or PREFIX when --count is 1) it writes PREFIX.pcd (organized
  * XYZRGBA, NaN where the sensor gives no depth), PREFIX_ids.png (16-bit object id per pixel:
- * 0 background, 1 table, 2+ objects), PREFIX_class.png (8-bit class per pixel, see --help), PREFIX_rgb.png and
- * PREFIX.json (ground truth), and prints one JSON line per scene. Scenery (far
+ * 0 background, 1 table, 2+ objects), PREFIX_class.png (8-bit class per pixel, see --help),
+ * PREFIX_rgb.png and PREFIX.json (ground truth), and prints one JSON line per scene. Scenery (far
  * furniture, robots) has ids 1000+ and class 7.
  */
 #include <facyl/tools/cli.h>
@@ -74,10 +74,12 @@ checkPrefix(const std::string& prefix)
 {
   const std::string ext = facyl_cli::lowerExtension(prefix);
   if (prefix.empty() || prefix.back() == '/' || std::filesystem::is_directory(prefix))
-    throw std::invalid_argument("PREFIX '" + prefix + "' is a folder; give DIR/NAME (writes "
+    throw std::invalid_argument("PREFIX '" + prefix +
+                                "' is a folder; give DIR/NAME (writes "
                                 "DIR/NAME.pcd, DIR/NAME_rgb.png, ...). Nothing was written.");
   if (ext == ".pcd" || ext == ".png" || ext == ".json")
-    throw std::invalid_argument("PREFIX '" + prefix + "' ends in " + ext + "; give the name "
+    throw std::invalid_argument("PREFIX '" + prefix + "' ends in " + ext +
+                                "; give the name "
                                 "without extension (facyl_synth adds .pcd, _rgb.png, _ids.png, "
                                 "_class.png and .json). Nothing was written.");
   const auto parent = std::filesystem::path(prefix).parent_path();
@@ -163,8 +165,7 @@ main(int argc, char** argv)
       argc, argv,
       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                         {"--seed", "--count", "--objects", "--cylinder-share", "--lying-share",
-                         "--noise", "--layout", "--sensor", "--sequence", "--orbit",
-                         "--change"}),
+                         "--noise", "--layout", "--sensor", "--sequence", "--orbit", "--change"}),
       {"--no-quantisation"});
     if (args.positional().size() != 1)
       throw std::invalid_argument("give exactly one output prefix (see -h)");
@@ -179,17 +180,19 @@ main(int argc, char** argv)
                                   "--sensor random (its settings are drawn per scene)");
     p.seed = static_cast<std::uint64_t>(args.integer("--seed", 0, 0, facyl_cli::kMaxSeed));
     count = static_cast<std::size_t>(args.integer("--count", 1, 1, 100000));
-    const std::string objects = args.text(
-      "--objects", std::to_string(p.min_objects) + "," + std::to_string(p.max_objects));
+    const std::string objects =
+      args.text("--objects", std::to_string(p.min_objects) + "," + std::to_string(p.max_objects));
     unsigned lo = 0, hi = 0;
     char comma = 0, extra = 0;
     if (std::sscanf(objects.c_str(), "%u%c%u%c", &lo, &comma, &hi, &extra) != 3 || comma != ',')
       throw std::invalid_argument("--objects: expected MIN,MAX, got '" + objects + "'");
     p.min_objects = lo;
     p.max_objects = hi;
-    p.cylinder_share = static_cast<float>(args.number("--cylinder-share", p.cylinder_share, 0.0, 1.0));
+    p.cylinder_share =
+      static_cast<float>(args.number("--cylinder-share", p.cylinder_share, 0.0, 1.0));
     p.lying_share = static_cast<float>(args.number("--lying-share", p.lying_share, 0.0, 1.0));
-    p.sensor.noise_coefficient = static_cast<float>(args.number("--noise", p.sensor.noise_coefficient, 0.0, 0.1));
+    p.sensor.noise_coefficient =
+      static_cast<float>(args.number("--noise", p.sensor.noise_coefficient, 0.0, 0.1));
     if (args.has("--no-quantisation"))
       p.sensor.disparity_step = 0.f;
     facyl_cli::applySceneImageOptions(args, p);

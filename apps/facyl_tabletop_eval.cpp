@@ -35,15 +35,15 @@ using Recognizer = facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>;
 struct Row {
   std::string scene, kind, pose;
   int object{-1};
-  bool positive{false};     ///< ground truth: a cylinder
-  bool touching{false};     ///< ground truth: in contact with another object
-  bool found{false};        ///< an output object maps to it (most of its points are this one's)
-  std::size_t pieces{0};    ///< output objects mapping to it
-  facyl::SegmentOutcome segment; ///< how the segmentation recovered it
+  bool positive{false};  ///< ground truth: a cylinder
+  bool touching{false};  ///< ground truth: in contact with another object
+  bool found{false};     ///< an output object maps to it (most of its points are this one's)
+  std::size_t pieces{0}; ///< output objects mapping to it
+  facyl::SegmentOutcome segment;    ///< how the segmentation recovered it
   facyl::CylinderEvidence evidence; ///< of its best (largest) output object
-  bool is_cylinder{false};  ///< the recognizer's decision on that object
+  bool is_cylinder{false};          ///< the recognizer's decision on that object
   float radius{NAN}, true_radius{NAN}, axis_error_deg{NAN};
-  std::size_t best{0};      ///< index of that output object
+  std::size_t best{0}; ///< index of that output object
 };
 
 /** An output object that matches no ground-truth object: its evidence and the recognizer's
@@ -192,7 +192,7 @@ reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
       const bool is_default = score == base.score && std::abs(t - base.min_score) < 1e-6f;
       std::printf("| %s | %.1f%s | %zu | %zu | %zu | %.3f | %.3f |\n",
                   score == facyl::CylinderDecision::Score::SurfaceRatio ? "surface ratio"
-                                                                         : "inlier ratio (eq. 4)",
+                                                                        : "inlier ratio (eq. 4)",
                   t, is_default ? " (default)" : "", tp, fp, fn,
                   tp + fp ? static_cast<double>(tp) / static_cast<double>(tp + fp) : NAN,
                   tp + fn ? static_cast<double>(tp) / static_cast<double>(tp + fn) : NAN);
@@ -265,8 +265,7 @@ public:
             "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,arc_gap,taper,"
             "radius,true_radius,axis_error_deg,p_network,p_cylinder\n";
   }
-  void
-  write(const std::string& set, const std::vector<Row>& rows)
+  void write(const std::string& set, const std::vector<Row>& rows)
   {
     if (!out_.is_open())
       return;
@@ -275,10 +274,10 @@ public:
       out_ << set << "," << r.scene << "," << r.object << "," << r.kind << "," << r.pose << ","
            << r.positive << "," << r.touching << "," << r.found << "," << r.pieces << ","
            << r.segment.recovered << "," << r.segment.best_iou << "," << r.segment.merged << ","
-           << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << ","
-           << e.surface_ratio << "," << e.curvature_ratio << "," << e.angular_coverage << ","
-           << e.arc_gap << "," << e.taper << "," << r.radius << "," << r.true_radius << ","
-           << r.axis_error_deg << "," << e.p_network << "," << e.p_cylinder << "\n";
+           << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << "," << e.surface_ratio
+           << "," << e.curvature_ratio << "," << e.angular_coverage << "," << e.arc_gap << ","
+           << e.taper << "," << r.radius << "," << r.true_radius << "," << r.axis_error_deg << ","
+           << e.p_network << "," << e.p_cylinder << "\n";
     }
   }
 
@@ -312,9 +311,8 @@ simulatedRows(const facyl::RenderedScene& scene, std::uint64_t seed, std::size_t
 }
 
 void
-reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
-                const Options& opt, std::size_t failures, std::size_t wrong_plane,
-                std::size_t on_scenery)
+reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray, const Options& opt,
+                std::size_t failures, std::size_t wrong_plane, std::size_t on_scenery)
 {
   std::size_t cylinders = 0, touching = 0;
   for (const Row& r : all)
@@ -325,23 +323,21 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray,
   std::printf("## Simulated scenes: %zu (%s layout, %s sensor, %dx%d, %s, seeds "
               "%llu..%llu), %zu objects with >= %zu visible pixels (%zu cylinders, %zu touching "
               "another object); %zu scenes failed (no table), %zu with a wrong support plane\n",
-              opt.sim, opt.layout.c_str(), opt.sensor.c_str(),
-              opt.scene.camera.width, opt.scene.camera.height, dropout,
-              static_cast<unsigned long long>(opt.seed),
+              opt.sim, opt.layout.c_str(), opt.sensor.c_str(), opt.scene.camera.width,
+              opt.scene.camera.height, dropout, static_cast<unsigned long long>(opt.seed),
               static_cast<unsigned long long>(opt.seed + opt.sim - 1), all.size(),
-              opt.params.segmentation.min_cluster_size, cylinders, touching, failures,
-              wrong_plane);
+              opt.params.segmentation.min_cluster_size, cylinders, touching, failures, wrong_plane);
   if (on_scenery > 0)
-    std::printf("Output objects on scenery (far furniture, robots), not scored: %zu\n",
-                on_scenery);
+    std::printf("Output objects on scenery (far furniture, robots), not scored: %zu\n", on_scenery);
   segmentationHeader("Segmentation (output objects as segments):");
   segmentationLine(all, "all", [](const Row&) { return true; });
   segmentationLine(all, "touching another", [](const Row& r) { return r.touching; });
   segmentationLine(all, "free-standing", [](const Row& r) { return !r.touching; });
   segmentationLine(all, "cylinders", [](const Row& r) { return r.positive; });
-  reportDetection(all, stray, "Detection (a ground-truth object is called a cylinder when its "
-                              "largest output object is; an output object matching no object "
-                              "and called a cylinder is a false positive):",
+  reportDetection(all, stray,
+                  "Detection (a ground-truth object is called a cylinder when its "
+                  "largest output object is; an output object matching no object "
+                  "and called a cylinder is a false positive):",
                   opt.params.decision);
   const auto& d = opt.params.decision;
   std::map<std::string, std::pair<std::size_t, std::size_t>> fp_by; // kind: (called, total)
@@ -436,11 +432,12 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       }
       else {
         ++wrong_plane;
-        std::fprintf(stderr, "scene %llu: table (%.3f %.3f %.3f %.3f) is not the true one "
-                           "(%.3f %.3f %.3f %.3f)\n",
-                   static_cast<unsigned long long>(sp.seed), c[0], c[1], c[2], c[3],
-                   scene.table_plane[0], scene.table_plane[1], scene.table_plane[2],
-                   scene.table_plane[3]);
+        std::fprintf(stderr,
+                     "scene %llu: table (%.3f %.3f %.3f %.3f) is not the true one "
+                     "(%.3f %.3f %.3f %.3f)\n",
+                     static_cast<unsigned long long>(sp.seed), c[0], c[1], c[2], c[3],
+                     scene.table_plane[0], scene.table_plane[1], scene.table_plane[2],
+                     scene.table_plane[3]);
       }
     }
     const std::vector<int> truth = truthVector(*cloud, [&](std::size_t i) {
@@ -454,8 +451,8 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
       if (r.positive && r.evidence.fitted) {
         const facyl::CylinderTruth t =
           facyl::cylinderTruth(scene.scene, scene.scene.objects[static_cast<std::size_t>(id - 2)]);
-        r.axis_error_deg =
-          facyl::axisAngle(objects[r.best].cylinder.axis, t.axis) * 180.f / static_cast<float>(M_PI);
+        r.axis_error_deg = facyl::axisAngle(objects[r.best].cylinder.axis, t.axis) * 180.f /
+                           static_cast<float>(M_PI);
       }
       all.push_back(r);
     }
@@ -541,8 +538,8 @@ evaluateMosdSegmentation(const Options& opt, Recognizer& rec, CsvWriter& csv)
         status = 1;
         continue;
       }
-      const std::vector<int> truth = truthVector(
-        *cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
+      const std::vector<int> truth =
+        truthVector(*cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
       std::map<int, Row> rows;
       for (const auto& outcome :
            facyl::scoreSegments(truth, {}, opt.params.segmentation.min_cluster_size)) {
@@ -620,8 +617,8 @@ evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
       r.positive = t[0] == "cylinder" || t[0] == "cylinder_handle";
       rows[id] = r;
     }
-    const std::vector<int> truth = truthVector(
-      *cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
+    const std::vector<int> truth =
+      truthVector(*cloud, [&](std::size_t i) { return mosdObject(labelled[i].label); });
     matchObjects(objects, truth, rows, stray);
     scoreRows(objects, truth, rows);
     for (auto& [id, r] : rows) {
@@ -637,15 +634,14 @@ evaluateMosdDetection(const Options& opt, Recognizer& rec, CsvWriter& csv)
   csv.write("mosd", all);
   std::printf("\n## mOSD learn33-44 (%s): %zu labelled objects\n", opt.mosd.c_str(), all.size());
   for (const Row& r : all)
-    std::printf("- %s obj %d %s %s: pieces %zu%s%s, inlier ratio %.3f, surface ratio %.3f, "
-                "radius %s%s\n",
-                r.scene.c_str(), r.object, r.kind.c_str(), r.pose.c_str(), r.pieces,
-                r.segment.merged ? " (merged with another object)" : "",
-                r.segment.split ? " (split)" : "", r.evidence.inlier_ratio,
-                r.evidence.surface_ratio,
-                r.evidence.fitted ? (std::to_string(r.radius * 1000.f).substr(0, 5) + " mm").c_str()
-                                  : "-",
-                called(r) ? ", called a cylinder" : "");
+    std::printf(
+      "- %s obj %d %s %s: pieces %zu%s%s, inlier ratio %.3f, surface ratio %.3f, "
+      "radius %s%s\n",
+      r.scene.c_str(), r.object, r.kind.c_str(), r.pose.c_str(), r.pieces,
+      r.segment.merged ? " (merged with another object)" : "", r.segment.split ? " (split)" : "",
+      r.evidence.inlier_ratio, r.evidence.surface_ratio,
+      r.evidence.fitted ? (std::to_string(r.radius * 1000.f).substr(0, 5) + " mm").c_str() : "-",
+      called(r) ? ", called a cylinder" : "");
   std::vector<Row> strict = all;
   for (Row& r : strict)
     r.positive = r.kind == "cylinder";
@@ -699,10 +695,10 @@ parseOptions(int argc, char** argv)
   Options opt;
   const facyl_cli::Arguments args(
     argc, argv,
-    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      facyl_cli::joined(facyl_cli::sceneImageOptions(),
-                                        {"--sim", "--first-seed", "--layout", "--sensor",
-                                         "--mosd", "--csv", "--roll"})),
+    facyl_cli::joined(
+      facyl_cli::recognizerValueOptions(),
+      facyl_cli::joined(facyl_cli::sceneImageOptions(), {"--sim", "--first-seed", "--layout",
+                                                         "--sensor", "--mosd", "--csv", "--roll"})),
     facyl_cli::recognizerSwitches(), facyl_cli::recognizerAliases());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
@@ -732,8 +728,8 @@ parseOptions(int argc, char** argv)
       const auto csv = std::filesystem::weakly_canonical(opt.csv, ec).parent_path();
       const auto rel = csv.lexically_relative(data);
       if (!rel.empty() && rel.native().rfind("..", 0) != 0)
-        throw std::invalid_argument("--csv " + opt.csv + ": lies in the --mosd folder " +
-                                    opt.mosd + ", which is an input; facyl never writes into "
+        throw std::invalid_argument("--csv " + opt.csv + ": lies in the --mosd folder " + opt.mosd +
+                                    ", which is an input; facyl never writes into "
                                     "the data it reads. Nothing was written.");
     }
   }
@@ -754,9 +750,8 @@ int
 main(int argc, char** argv)
 {
   Options opt;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_tabletop_eval", printHelp, [&] {
-    opt = parseOptions(argc, argv);
-  });
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_tabletop_eval", printHelp,
+                                      [&] { opt = parseOptions(argc, argv); });
   if (rc >= 0)
     return rc;
   CsvWriter csv(opt.csv);

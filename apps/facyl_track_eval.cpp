@@ -67,7 +67,8 @@ float
 segmentDistance(const Eigen::Vector3f& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b)
 {
   const Eigen::Vector3f d = b - a;
-  const float t = d.squaredNorm() > 0.f ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.f, 1.f) : 0.f;
+  const float t =
+    d.squaredNorm() > 0.f ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.f, 1.f) : 0.f;
   return (p - (a + t * d)).norm();
 }
 
@@ -122,8 +123,10 @@ scoreReports(const std::vector<facyl::CylinderModel>& reports, const std::vector
     if (!t.visible)
       continue;
     ++score.tp;
-    score.radius_error.push_back(std::abs(reports[r].radius - t.cylinder.radius) / t.cylinder.radius);
-    score.axis_error_deg.push_back(facyl::axisAngle(reports[r].axis, t.cylinder.axis) * 180.0 / M_PI);
+    score.radius_error.push_back(std::abs(reports[r].radius - t.cylinder.radius) /
+                                 t.cylinder.radius);
+    score.axis_error_deg.push_back(facyl::axisAngle(reports[r].axis, t.cylinder.axis) * 180.0 /
+                                   M_PI);
   }
   for (std::size_t t = 0; t < truth.size(); ++t)
     score.fn += truth[t].visible && !used[t];
@@ -142,12 +145,12 @@ struct Totals {
    * sequence: what remains when every frame's noise is averaged away (the fits' bias per
    * object, which no temporal filter removes). */
   std::vector<double> paired_radius_bias;
-  std::size_t id_switches{0}, track_frames{0};           ///< every object
-  std::size_t cyl_id_switches{0}, cyl_track_frames{0};   ///< the cylinders
-  std::vector<double> confirm_delay, frame_delay;        ///< frames after first visible
+  std::size_t id_switches{0}, track_frames{0};         ///< every object
+  std::size_t cyl_id_switches{0}, cyl_track_frames{0}; ///< the cylinders
+  std::vector<double> confirm_delay, frame_delay;      ///< frames after first visible
   std::size_t never_confirmed{0}, never_detected{0}, new_objects{0};
-  std::vector<double> added_delay;                       ///< objects put down half-way
-  std::size_t removed{0}, removed_reported_frames{0};    ///< objects taken away
+  std::vector<double> added_delay;                    ///< objects put down half-way
+  std::size_t removed{0}, removed_reported_frames{0}; ///< objects taken away
   std::vector<double> tracker_ms;
   /** Re-anchoring against the true camera motion: per frame, how far the tracker's world
    * moved against the table (the in-plane turn in degrees, the shift in mm, the tilt in
@@ -182,8 +185,9 @@ truthOfObjects(const std::vector<facyl::RecognizedObject>& objects,
 }
 
 void
-evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequenceParameters::Change change,
-                 Recognizer& rec, Totals& totals, std::ofstream* csv)
+evaluateSequence(const Options& opt, std::uint64_t seed,
+                 facyl::TabletopSequenceParameters::Change change, Recognizer& rec, Totals& totals,
+                 std::ofstream* csv)
 {
   facyl::TabletopSceneParameters p = opt.scene;
   p.seed = seed;
@@ -200,8 +204,8 @@ evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequence
   std::vector<std::vector<double>> signed_radius_frame(n_objects); ///< per-frame fits
   std::vector<int> paired_objects;
   for (std::size_t f = 0; f < seq.cameras.size(); ++f) {
-    const facyl::RenderedScene r = facyl::renderSequenceFrame(
-      seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(seed, f));
+    const facyl::RenderedScene r =
+      facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(seed, f));
     Cloud::Ptr cloud(new Cloud(r.cloud));
     rec.setInputCloud(cloud);
     std::vector<facyl::RecognizedObject> objects;
@@ -224,11 +228,11 @@ evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequence
         const Eigen::Affine3f d = a * first_anchor.inverse();
         const Eigen::Vector3f x = d.linear().col(0);
         totals.anchor_yaw_deg.push_back(std::abs(std::atan2(x.y(), x.x())) * 180.0 / M_PI);
-        totals.anchor_tilt_deg.push_back(
-          std::acos(std::min(1.f, d.linear().col(2).z())) * 180.0 / M_PI);
+        totals.anchor_tilt_deg.push_back(std::acos(std::min(1.f, d.linear().col(2).z())) * 180.0 /
+                                         M_PI);
         // The shift where the objects are: at the true world's origin (the table's centre).
-        totals.anchor_shift_mm.push_back(1e3 * (a * Eigen::Vector3f::Zero() -
-                                                first_anchor * Eigen::Vector3f::Zero()).norm());
+        totals.anchor_shift_mm.push_back(
+          1e3 * (a * Eigen::Vector3f::Zero() - first_anchor * Eigen::Vector3f::Zero()).norm());
       }
     }
     ++totals.frames;
@@ -269,8 +273,10 @@ evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequence
       total.tp += s->tp;
       total.fp += s->fp;
       total.fn += s->fn;
-      total.radius_error.insert(total.radius_error.end(), s->radius_error.begin(), s->radius_error.end());
-      total.axis_error_deg.insert(total.axis_error_deg.end(), s->axis_error_deg.begin(), s->axis_error_deg.end());
+      total.radius_error.insert(total.radius_error.end(), s->radius_error.begin(),
+                                s->radius_error.end());
+      total.axis_error_deg.insert(total.axis_error_deg.end(), s->axis_error_deg.begin(),
+                                  s->axis_error_deg.end());
     }
     // Paired errors and first detections.
     for (const Truth& t : truth) {
@@ -283,23 +289,28 @@ evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequence
         first_detected[i] = static_cast<long>(f);
       if (fr != frame_truth.end())
         signed_radius_frame[i].push_back(
-          (frame_reports[static_cast<std::size_t>(fr - frame_truth.begin())].radius - t.cylinder.radius) /
+          (frame_reports[static_cast<std::size_t>(fr - frame_truth.begin())].radius -
+           t.cylinder.radius) /
           t.cylinder.radius);
       if (tr != tracked_truth.end() && first_tracked[i] < 0)
         first_tracked[i] = static_cast<long>(f);
       if (fr != frame_truth.end() && tr != tracked_truth.end()) {
         const auto& a = frame_reports[static_cast<std::size_t>(fr - frame_truth.begin())];
         const auto& b = tracked_reports[static_cast<std::size_t>(tr - tracked_truth.begin())];
-        totals.paired_radius_frame.push_back(std::abs(a.radius - t.cylinder.radius) / t.cylinder.radius);
+        totals.paired_radius_frame.push_back(std::abs(a.radius - t.cylinder.radius) /
+                                             t.cylinder.radius);
         paired_objects.push_back(t.object);
-        totals.paired_radius_tracked.push_back(std::abs(b.radius - t.cylinder.radius) / t.cylinder.radius);
-        totals.paired_axis_frame.push_back(facyl::axisAngle(a.axis, t.cylinder.axis) * 180.0 / M_PI);
-        totals.paired_axis_tracked.push_back(facyl::axisAngle(b.axis, t.cylinder.axis) * 180.0 / M_PI);
+        totals.paired_radius_tracked.push_back(std::abs(b.radius - t.cylinder.radius) /
+                                               t.cylinder.radius);
+        totals.paired_axis_frame.push_back(facyl::axisAngle(a.axis, t.cylinder.axis) * 180.0 /
+                                           M_PI);
+        totals.paired_axis_tracked.push_back(facyl::axisAngle(b.axis, t.cylinder.axis) * 180.0 /
+                                             M_PI);
       }
     }
     // The taken-away object: frames after the change in which a track still reports it.
-    if (seq.change == facyl::TabletopSequenceParameters::Change::Remove && seq.changed_object >= 0 &&
-        f >= seq.change_frame) {
+    if (seq.change == facyl::TabletopSequenceParameters::Change::Remove &&
+        seq.changed_object >= 0 && f >= seq.change_frame) {
       const auto& gone = seq.scene.objects[static_cast<std::size_t>(seq.changed_object)];
       if (gone.cls == facyl::SceneClass::Cylinder) {
         const facyl::CylinderTruth c = facyl::cylinderTruth(r.scene, gone);
@@ -378,10 +389,12 @@ evaluateSequence(const Options& opt, std::uint64_t seed, facyl::TabletopSequence
       totals.added_delay.push_back(static_cast<double>(first_tracked[i] - first_visible[i]));
   }
   if (seq.change == facyl::TabletopSequenceParameters::Change::Remove && seq.changed_object >= 0 &&
-      seq.scene.objects[static_cast<std::size_t>(seq.changed_object)].cls == facyl::SceneClass::Cylinder)
+      seq.scene.objects[static_cast<std::size_t>(seq.changed_object)].cls ==
+        facyl::SceneClass::Cylinder)
     ++totals.removed;
   for (const int o : paired_objects)
-    totals.paired_radius_bias.push_back(std::abs(median(signed_radius_frame[static_cast<std::size_t>(o)])));
+    totals.paired_radius_bias.push_back(
+      std::abs(median(signed_radius_frame[static_cast<std::size_t>(o)])));
 }
 
 void
@@ -398,18 +411,21 @@ printTotals(const Options& opt, const Totals& t)
               opt.sequences, opt.sequence.frames, opt.sensor.c_str(), opt.change.c_str(),
               static_cast<unsigned long long>(opt.seed));
   std::printf("frames %zu (recognition failed: %zu), new scenes detected: %zu, tracks started: "
-              "%zu\n\n", t.frames, t.failed_frames, t.new_scenes, t.tracks_started);
+              "%zu\n\n",
+              t.frames, t.failed_frames, t.new_scenes, t.tracks_started);
   std::printf("| cylinders (>= %zu visible pixels) | TP | FP | FN | precision | recall | radius "
               "error median (p90) | axis error median (p90) |\n|---|---|---|---|---|---|---|---|\n",
               kMinVisiblePixels);
-  std::printf("| per frame | %zu | %zu | %zu | %.3f | %.3f | %.2f %% (%.2f %%) | %.2f deg (%.2f deg) |\n",
-              t.frame.tp, t.frame.fp, t.frame.fn, fp_, fr_, 100 * median(t.frame.radius_error),
-              100 * percentile(t.frame.radius_error, 0.9), median(t.frame.axis_error_deg),
-              percentile(t.frame.axis_error_deg, 0.9));
-  std::printf("| tracked | %zu | %zu | %zu | %.3f | %.3f | %.2f %% (%.2f %%) | %.2f deg (%.2f deg) |\n\n",
-              t.tracked.tp, t.tracked.fp, t.tracked.fn, tp_, tr_, 100 * median(t.tracked.radius_error),
-              100 * percentile(t.tracked.radius_error, 0.9), median(t.tracked.axis_error_deg),
-              percentile(t.tracked.axis_error_deg, 0.9));
+  std::printf(
+    "| per frame | %zu | %zu | %zu | %.3f | %.3f | %.2f %% (%.2f %%) | %.2f deg (%.2f deg) |\n",
+    t.frame.tp, t.frame.fp, t.frame.fn, fp_, fr_, 100 * median(t.frame.radius_error),
+    100 * percentile(t.frame.radius_error, 0.9), median(t.frame.axis_error_deg),
+    percentile(t.frame.axis_error_deg, 0.9));
+  std::printf(
+    "| tracked | %zu | %zu | %zu | %.3f | %.3f | %.2f %% (%.2f %%) | %.2f deg (%.2f deg) |\n\n",
+    t.tracked.tp, t.tracked.fp, t.tracked.fn, tp_, tr_, 100 * median(t.tracked.radius_error),
+    100 * percentile(t.tracked.radius_error, 0.9), median(t.tracked.axis_error_deg),
+    percentile(t.tracked.axis_error_deg, 0.9));
   std::printf("Paired (%zu cylinder-frames reported by both): radius error median %.2f %% per "
               "frame, %.2f %% tracked; axis %.2f deg per frame, %.2f deg tracked\n",
               t.paired_radius_frame.size(), 100 * median(t.paired_radius_frame),
@@ -422,11 +438,16 @@ printTotals(const Options& opt, const Totals& t)
   std::printf("Identities: %zu switches in %zu track-frames (%.2f per 100) of all objects; "
               "cylinders %zu in %zu (%.2f per 100)\n",
               t.id_switches, t.track_frames,
-              t.track_frames ? 100.0 * static_cast<double>(t.id_switches) / static_cast<double>(t.track_frames) : NAN,
+              t.track_frames
+                ? 100.0 * static_cast<double>(t.id_switches) / static_cast<double>(t.track_frames)
+                : NAN,
               t.cyl_id_switches, t.cyl_track_frames,
-              t.cyl_track_frames ? 100.0 * static_cast<double>(t.cyl_id_switches) / static_cast<double>(t.cyl_track_frames) : NAN);
+              t.cyl_track_frames ? 100.0 * static_cast<double>(t.cyl_id_switches) /
+                                     static_cast<double>(t.cyl_track_frames)
+                                 : NAN);
   const auto mean = [](const std::vector<double>& v) {
-    return v.empty() ? NAN : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+    return v.empty() ? NAN
+                     : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
   };
   std::printf("Frames from a cylinder's first visible frame to its first report: tracked median "
               "%.1f (mean %.2f, never %zu of %zu), per frame median %.1f (mean %.2f, never %zu)\n",
@@ -444,7 +465,8 @@ printTotals(const Options& opt, const Totals& t)
   std::printf("Tracker per frame (update incl. its view of the cloud): median %.3f ms, p90 %.3f "
               "ms, max %.3f ms\n",
               median(t.tracker_ms), percentile(t.tracker_ms, 0.9),
-              t.tracker_ms.empty() ? NAN : *std::max_element(t.tracker_ms.begin(), t.tracker_ms.end()));
+              t.tracker_ms.empty() ? NAN
+                                   : *std::max_element(t.tracker_ms.begin(), t.tracker_ms.end()));
 }
 
 void
@@ -475,8 +497,8 @@ parseOptions(int argc, char** argv)
     facyl_cli::joined(facyl_cli::recognizerValueOptions(),
                       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                                         {"--sequences", "--frames", "--first-seed", "--sensor",
-                                         "--layout", "--change", "--orbit",
-                                         "--track-confirm-hits", "--track-max-misses", "--csv"})),
+                                         "--layout", "--change", "--orbit", "--track-confirm-hits",
+                                         "--track-max-misses", "--csv"})),
     facyl_cli::recognizerSwitches(), facyl_cli::recognizerAliases());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
@@ -513,9 +535,8 @@ int
 main(int argc, char** argv)
 {
   Options opt;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_track_eval", printHelp, [&] {
-    opt = parseOptions(argc, argv);
-  });
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_track_eval", printHelp,
+                                      [&] { opt = parseOptions(argc, argv); });
   if (rc >= 0)
     return rc;
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);

@@ -131,10 +131,10 @@ struct Settings {
   std::string screenshot;
   int width{kDefaultWidth}, height{kDefaultHeight};
   facyl::ShapeClassifier::Ptr classifier;
-  std::string stream;     ///< --stream SOURCE
-  float rate{0.f};        ///< --rate
-  bool loop{false};       ///< --loop
-  long long frames{0};    ///< --frames; 0: all
+  std::string stream;  ///< --stream SOURCE
+  float rate{0.f};     ///< --rate
+  bool loop{false};    ///< --loop
+  long long frames{0}; ///< --frames; 0: all
 };
 
 /** The file as an XYZRGBA cloud (grey without colour). \throws std::runtime_error. */
@@ -180,9 +180,10 @@ tableOutline(const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec)
     return outline;
   // The support whose plane is the table's.
   const Eigen::Vector4f table(t[0], t[1], t[2], t[3]);
-  const auto best = std::min_element(supports.begin(), supports.end(), [&](const auto& a, const auto& b) {
-    return (a.plane - table).norm() < (b.plane - table).norm();
-  });
+  const auto best =
+    std::min_element(supports.begin(), supports.end(), [&](const auto& a, const auto& b) {
+      return (a.plane - table).norm() < (b.plane - table).norm();
+    });
   for (const auto& q : best->polygon)
     outline.push_back(best->frame * Eigen::Vector3f(q.x(), q.y(), 0.f));
   return outline;
@@ -220,7 +221,8 @@ jsonVector(const facyl_cli::JsonValue* v)
 {
   if (!v || v->items.size() != 3)
     throw std::runtime_error("a vector of 3 numbers is missing");
-  return Eigen::Vector3f(static_cast<float>(v->items[0].number), static_cast<float>(v->items[1].number),
+  return Eigen::Vector3f(static_cast<float>(v->items[0].number),
+                         static_cast<float>(v->items[1].number),
                          static_cast<float>(v->items[2].number));
 }
 
@@ -311,7 +313,8 @@ cylinderMesh(const facyl::CylinderModel& m, int segments)
   pcl::PointCloud<pcl::PointXYZ> vertices;
   for (int ring = 0; ring < 2; ++ring)
     for (int k = 0; k < segments; ++k) {
-      const float t = 2.f * static_cast<float>(M_PI) * static_cast<float>(k) / static_cast<float>(segments);
+      const float t =
+        2.f * static_cast<float>(M_PI) * static_cast<float>(k) / static_cast<float>(segments);
       const Eigen::Vector3f p = m.base + (ring ? a : Eigen::Vector3f::Zero()) +
                                 m.radius * (std::cos(t) * u + std::sin(t) * v);
       vertices.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
@@ -338,7 +341,8 @@ std::string
 labelOf(const ViewObject& o, std::size_t id)
 {
   char buf[160];
-  const std::string p = std::isfinite(o.p_cylinder) ? " p=" + std::to_string(o.p_cylinder).substr(0, 4) : "";
+  const std::string p =
+    std::isfinite(o.p_cylinder) ? " p=" + std::to_string(o.p_cylinder).substr(0, 4) : "";
   if (o.is_cylinder)
     std::snprintf(buf, sizeof buf, "#%zu r=%.1fmm h=%.1fmm%s", id, o.cylinder.radius * 1e3f,
                   o.cylinder.height * 1e3f, p.c_str());
@@ -358,8 +362,10 @@ drawCylinder(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderMod
 {
   // Meshes live with the clouds in PCLVisualizer: their properties are point-cloud ones.
   viewer.addPolygonMesh(cylinderMesh(m, kMeshSegments), id, viewport);
-  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, r, g, b, id, viewport);
-  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY, 0.85, id, viewport);
+  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, r, g, b, id,
+                                          viewport);
+  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY, 0.85, id,
+                                          viewport);
 }
 
 void
@@ -374,12 +380,13 @@ drawObjects(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const
     if (!o.is_cylinder && layers.boxes) {
       viewer.addCube(o.box_min.x(), o.box_max.x(), o.box_min.y(), o.box_max.y(), o.box_min.z(),
                      o.box_max.z(), 1.0, 0.1, 0.1, id + "_box", viewport);
-      viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
-                                         pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME,
-                                         id + "_box", viewport);
+      viewer.setShapeRenderingProperties(
+        pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
+        pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME, id + "_box", viewport);
     }
     if (layers.labels) {
-      const Eigen::Vector3f at = o.is_cylinder ? Eigen::Vector3f(o.cylinder.top) : Eigen::Vector3f(o.box_min);
+      const Eigen::Vector3f at =
+        o.is_cylinder ? Eigen::Vector3f(o.cylinder.top) : Eigen::Vector3f(o.box_min);
       viewer.addText3D(labelOf(o, k), pcl::PointXYZ(at.x(), at.y(), at.z()), 0.008,
                        o.is_cylinder ? 0.6 : 1.0, o.is_cylinder ? 1.0 : 0.5, 0.6, id + "_label",
                        viewport);
@@ -397,7 +404,8 @@ drawTable(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const s
   for (const auto& p : scene.table_outline)
     polygon->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   viewer.addPolygon<pcl::PointXYZ>(polygon, 0.2, 0.5, 1.0, tag + "table", viewport);
-  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3, tag + "table", viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3,
+                                     tag + "table", viewport);
 }
 
 /** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does.
@@ -414,7 +422,8 @@ sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int 
   const Eigen::Vector3f o = pose.translation();
   const Eigen::Matrix3f r = pose.linear();
   const Eigen::Vector3f look = o + r.col(2), up = -r.col(1);
-  viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(), up.z(), viewport);
+  viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(),
+                           up.z(), viewport);
   double fov = 49.0 * M_PI / 180.0; // a Kinect's vertical field of view
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   if (cloud.isOrganized() && cloud.height > 1) {
@@ -426,16 +435,16 @@ sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int 
     for (std::size_t i = 0; i < cloud.size(); i += step)
       if (pcl::isFinite(cloud[i])) {
         pts.col(n) = to_sensor * cloud[i].getVector3fMap();
-        px.col(n++) = Eigen::Vector2f(static_cast<float>(i % cloud.width),
-                                      static_cast<float>(i / cloud.width));
+        px.col(n++) =
+          Eigen::Vector2f(static_cast<float>(i % cloud.width), static_cast<float>(i / cloud.width));
       }
     facyl::PinholeCamera camera;
     const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
-    if (facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), w, h, camera) &&
-        camera.fy > 0.f) {
+    if (facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), w, h, camera) && camera.fy > 0.f) {
       fov = 2.0 * std::atan(0.5 * h / camera.fy);
       // VTK moves the optical axis to -WindowCenter in normalized device coordinates.
-      centre = Eigen::Vector2d(1.0 - 2.0 * (camera.cx + 0.5) / w, 2.0 * (camera.cy + 0.5) / h - 1.0);
+      centre =
+        Eigen::Vector2d(1.0 - 2.0 * (camera.cx + 0.5) / w, 2.0 * (camera.cy + 0.5) / h - 1.0);
     }
   }
   viewer.setCameraFieldOfView(fov, viewport);
@@ -545,24 +554,32 @@ drawAccumulators(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, 
       }
     const std::string tag = std::string("acc_") + names[m];
     viewer.addPointCloud<pcl::PointXYZRGB>(cells, tag, viewports[m]);
-    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_POINT_SIZE, 6, tag, viewports[m]);
+    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_POINT_SIZE, 6, tag,
+                                            viewports[m]);
     Eigen::Index best = 0;
     votes.maxCoeff(&best);
     const Eigen::Vector3f a = acc.directions().col(best) * radius * 1.3f;
-    viewer.addLine(pcl::PointXYZ(o.centroid.x() - a.x(), o.centroid.y() - a.y(), o.centroid.z() - a.z()),
-                   pcl::PointXYZ(o.centroid.x() + a.x(), o.centroid.y() + a.y(), o.centroid.z() + a.z()),
-                   0.1, 1.0, 0.2, tag + "_axis", viewports[m]);
-    viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 4, tag + "_axis", viewports[m]);
+    viewer.addLine(
+      pcl::PointXYZ(o.centroid.x() - a.x(), o.centroid.y() - a.y(), o.centroid.z() - a.z()),
+      pcl::PointXYZ(o.centroid.x() + a.x(), o.centroid.y() + a.y(), o.centroid.z() + a.z()), 0.1,
+      1.0, 0.2, tag + "_axis", viewports[m]);
+    viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 4,
+                                       tag + "_axis", viewports[m]);
     viewer.addPointCloud<pcl::PointXYZ>(points, tag + "_points", viewports[m]);
     pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
     pcl::copyPointCloud(*cues, *normals);
-    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, normals, 10, 0.01f, tag + "_normals", viewports[m]);
+    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, normals, 10, 0.01f,
+                                                            tag + "_normals", viewports[m]);
     pcl::PointCloud<pcl::Normal>::Ptr directions(new pcl::PointCloud<pcl::Normal>);
     for (const auto& c : *cues)
-      directions->push_back(pcl::Normal(c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z));
-    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, directions, 10, 0.01f, tag + "_dirs", viewports[m]);
-    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, 1.0, 0.9, 0.1, tag + "_dirs", viewports[m]);
-    viewer.addText(std::string(names[m]) + " voting", 10, 10, 14, 1, 1, 1, tag + "_title", viewports[m]);
+      directions->push_back(
+        pcl::Normal(c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z));
+    viewer.addPointCloudNormals<pcl::PointXYZ, pcl::Normal>(points, directions, 10, 0.01f,
+                                                            tag + "_dirs", viewports[m]);
+    viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, 1.0, 0.9, 0.1,
+                                            tag + "_dirs", viewports[m]);
+    viewer.addText(std::string(names[m]) + " voting", 10, 10, 14, 1, 1, 1, tag + "_title",
+                   viewports[m]);
   }
 }
 
@@ -570,7 +587,9 @@ drawAccumulators(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, 
 
 class Viewer {
 public:
-  explicit Viewer(const Settings& s) : s_(s), viewer_("facyl_viewer")
+  explicit Viewer(const Settings& s)
+      : s_(s)
+      , viewer_("facyl_viewer")
   {
     viewer_.setSize(s.width, s.height);
     viewer_.setBackgroundColor(0.05, 0.05, 0.08);
@@ -579,8 +598,7 @@ public:
       [this](const pcl::visualization::KeyboardEvent& e) { onKey(e); });
   }
   /** Loads and draws scene \a k. \return false (with a message) when it cannot be shown. */
-  bool
-  show(std::size_t k)
+  bool show(std::size_t k)
   {
     current_ = k;
     viewer_.removeAllPointClouds();
@@ -596,22 +614,19 @@ public:
     draw();
     return true;
   }
-  void
-  screenshot(const std::string& path)
+  void screenshot(const std::string& path)
   {
     viewer_.spinOnce(1, true);
     viewer_.saveScreenshot(path);
   }
-  void
-  run()
+  void run()
   {
     while (!viewer_.wasStopped())
       viewer_.spinOnce(50);
   }
 
 private:
-  Scene
-  load(const std::string& file) const
+  Scene load(const std::string& file) const
   {
     Scene scene;
     scene.file = file;
@@ -626,8 +641,7 @@ private:
       detectObjects(s_, scene);
     return scene;
   }
-  const std::vector<facyl_cli::JsonValue>&
-  detections_() const
+  const std::vector<facyl_cli::JsonValue>& detections_() const
   {
     if (!lines_loaded_) {
       lines_ = readDetections(s_.detections);
@@ -635,16 +649,17 @@ private:
     }
     return lines_;
   }
-  void
-  draw()
+  void draw()
   {
     const Cloud::ConstPtr drawn = drawnCloud(*scene_.cloud);
     pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(drawn);
     if (s_.accumulator >= 0) {
       if (static_cast<std::size_t>(s_.accumulator) >= scene_.objects.size() ||
           scene_.objects[static_cast<std::size_t>(s_.accumulator)].indices.empty()) {
-        std::fprintf(stderr, "facyl_viewer: --accumulator %lld: the scene has %zu objects (with "
-                             "points: --detect)\n", s_.accumulator, scene_.objects.size());
+        std::fprintf(stderr,
+                     "facyl_viewer: --accumulator %lld: the scene has %zu objects (with "
+                     "points: --detect)\n",
+                     s_.accumulator, scene_.objects.size());
         return;
       }
       int vp[3];
@@ -673,15 +688,15 @@ private:
       drawObjects(viewer_, pcl_scene, layers_, "p_", right);
       sensorCamera(viewer_, *scene_.cloud, right);
       char text[200];
-      std::snprintf(text, sizeof text, "facyl: %.1f ms (classification + fitting)", scene_.facyl_ms);
+      std::snprintf(text, sizeof text, "facyl: %.1f ms (classification + fitting)",
+                    scene_.facyl_ms);
       viewer_.addText(text, 10, 10, 16, 1, 1, 1, "title_f", left);
       std::snprintf(text, sizeof text, "PCL SACMODEL_CYLINDER: %.1f ms (normals + RANSAC)", pcl_ms);
       viewer_.addText(text, 10, 10, 16, 1, 1, 1, "title_p", right);
     }
     viewer_.addText(scene_.file, 10, s_.height - 24, 14, 0.8, 0.8, 0.8, "file", left);
   }
-  void
-  onKey(const pcl::visualization::KeyboardEvent& e)
+  void onKey(const pcl::visualization::KeyboardEvent& e)
   {
     if (!e.keyDown())
       return;
@@ -702,11 +717,11 @@ private:
                     o.cylinder.base.y(), o.cylinder.base.z());
       std::printf("\n");
       std::fflush(stdout);
-      viewer_.setCameraPosition(o.centroid.x(), o.centroid.y(), o.centroid.z() - 0.5, o.centroid.x(),
-                                o.centroid.y(), o.centroid.z(), 0, -1, 0);
+      viewer_.setCameraPosition(o.centroid.x(), o.centroid.y(), o.centroid.z() - 0.5,
+                                o.centroid.x(), o.centroid.y(), o.centroid.z(), 0, -1, 0);
       return;
     }
-    bool* layer = key == "t" ? &layers_.table
+    bool* layer = key == "t"   ? &layers_.table
                   : key == "c" ? &layers_.cylinders
                   : key == "b" ? &layers_.boxes
                   : key == "l" ? &layers_.labels
@@ -737,7 +752,8 @@ trackColour(int id)
   const double h = std::fmod(0.13 + 0.618034 * id, 1.0) * 6.0;
   const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
   const int sector = static_cast<int>(h);
-  const std::array<std::array<double, 3>, 6> rgb{{{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}}};
+  const std::array<std::array<double, 3>, 6> rgb{
+    {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}}};
   auto c = rgb[static_cast<std::size_t>(sector % 6)];
   for (auto& v : c)
     v = 0.25 + 0.75 * v;
@@ -778,7 +794,8 @@ drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cl
                                                 seen ? 0.85 : 0.3, id + "_cyl", 0);
       }
       std::snprintf(buf, sizeof buf, "#%d r=%.1fmm h=%.1fmm p=%.2f%s", t.id, m.radius * 1e3f,
-                    m.height * 1e3f, t.pCylinder(), seen ? "" : (" " + facyl::toString(t.status)).c_str());
+                    m.height * 1e3f, t.pCylinder(),
+                    seen ? "" : (" " + facyl::toString(t.status)).c_str());
       label_at = m.top;
     }
     else if (seen && t.object >= 0 && static_cast<std::size_t>(t.object) < objects.size()) {
@@ -787,9 +804,9 @@ drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cl
       if (layers.boxes) {
         viewer.addCube(o.box_min.x(), o.box_max.x(), o.box_min.y(), o.box_max.y(), o.box_min.z(),
                        o.box_max.z(), c[0], c[1], c[2], id + "_box");
-        viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
-                                           pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME,
-                                           id + "_box");
+        viewer.setShapeRenderingProperties(
+          pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
+          pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME, id + "_box");
         viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH,
                                            t.confirmed ? 2 : 1, id + "_box");
       }
@@ -821,8 +838,8 @@ streamLine(std::size_t frame, const std::string& file, const facyl::CylinderTrac
     out += std::string(first ? "" : ",") + "{\"track_id\":" + std::to_string(t.id) +
            ",\"confirmed\":" + (t.confirmed ? "true" : "false") +
            ",\"is_cylinder\":" + (tracker->isCylinder(t) ? "true" : "false") + ",\"status\":\"" +
-           facyl::toString(t.status) + "\",\"object\":" +
-           (t.object >= 0 ? std::to_string(t.object) : "null") + "}";
+           facyl::toString(t.status) +
+           "\",\"object\":" + (t.object >= 0 ? std::to_string(t.object) : "null") + "}";
     first = false;
   }
   return out + "]}";
@@ -845,8 +862,11 @@ runStream(const Settings& s)
     if (!e.keyDown())
       return;
     const std::string key = e.getKeySym();
-    bool* layer = key == "t" ? &layers.table : key == "c" ? &layers.cylinders
-                  : key == "b" ? &layers.boxes : key == "l" ? &layers.labels : nullptr;
+    bool* layer = key == "t"   ? &layers.table
+                  : key == "c" ? &layers.cylinders
+                  : key == "b" ? &layers.boxes
+                  : key == "l" ? &layers.labels
+                               : nullptr;
     if (layer) {
       *layer = !*layer;
       redraw = true;
@@ -906,8 +926,10 @@ runStream(const Settings& s)
     viewer.spinOnce(1, true);
   }
   if (stream.dropped() > 0)
-    std::fprintf(stderr, "facyl_viewer: %zu frames arrived while one was processed and were "
-                         "dropped\n", stream.dropped());
+    std::fprintf(stderr,
+                 "facyl_viewer: %zu frames arrived while one was processed and were "
+                 "dropped\n",
+                 stream.dropped());
   if (!shown) {
     std::fprintf(stderr, "facyl_viewer: --stream %s: no frame could be shown\n", s.stream.c_str());
     return 1;
@@ -916,7 +938,8 @@ runStream(const Settings& s)
     viewer.spinOnce(1, true);
     viewer.saveScreenshot(s.screenshot);
     std::printf("{\"stream\":%s,\"frames\":%zu,\"screenshot\":%s}\n",
-                facyl_cli::quote(s.stream).c_str(), processed, facyl_cli::quote(s.screenshot).c_str());
+                facyl_cli::quote(s.stream).c_str(), processed,
+                facyl_cli::quote(s.screenshot).c_str());
     return 0;
   }
   while (!viewer.wasStopped()) { // the last frame stays on screen
@@ -971,7 +994,8 @@ parseSettings(int argc, char** argv)
   s.compare_pcl = args.has("--compare-pcl");
   s.accumulator = args.integer("--accumulator", -1, -1, 100000);
   if ((s.compare_pcl || s.accumulator >= 0) && !s.detect)
-    throw std::invalid_argument("--compare-pcl and --accumulator need the objects' points: use --detect");
+    throw std::invalid_argument(
+      "--compare-pcl and --accumulator need the objects' points: use --detect");
   if (s.compare_pcl && s.accumulator >= 0)
     throw std::invalid_argument("--compare-pcl and --accumulator exclude each other");
   s.screenshot = args.text("--screenshot", "");
@@ -1001,9 +1025,8 @@ int
 main(int argc, char** argv)
 {
   Settings s;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_viewer", printHelp, [&] {
-    s = parseSettings(argc, argv);
-  });
+  const int rc = facyl_cli::startTool(argc, argv, "facyl_viewer", printHelp,
+                                      [&] { s = parseSettings(argc, argv); });
   if (rc >= 0)
     return rc;
   const char* display = std::getenv("DISPLAY");

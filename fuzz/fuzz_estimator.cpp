@@ -18,10 +18,12 @@ namespace {
 
 class Bytes {
 public:
-  Bytes(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-  template <typename T>
-  T
-  take()
+  Bytes(const std::uint8_t* data, std::size_t size)
+      : data_(data)
+      , size_(size)
+  {
+  }
+  template <typename T> T take()
   {
     T v{};
     if (pos_ + sizeof(T) <= size_)
@@ -29,8 +31,7 @@ public:
     pos_ += sizeof(T);
     return v;
   }
-  std::size_t
-  left() const
+  std::size_t left() const
   {
     return pos_ < size_ ? size_ - pos_ : 0;
   }

@@ -1,7 +1,8 @@
 /*
  * libFuzzer target: PCD bytes -> what facyl_fit and facyl_detect do with a file: the checked
- * reader (apps/common/include/facyl/tools/pcd_input.h), the conversion, then (for clouds small enough to keep the fuzzer
- * fast) normals and curvatures, the Hough fit and the tabletop recognizer.
+ * reader (apps/common/include/facyl/tools/pcd_input.h), the conversion, then (for clouds small
+ * enough to keep the fuzzer fast) normals and curvatures, the Hough fit and the tabletop
+ * recognizer.
  */
 #include <facyl/tools/pcd_input.h>
 

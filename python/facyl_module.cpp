@@ -52,23 +52,25 @@ floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame
 {
   // numpy arrays, and anything with the buffer protocol (Open3D's Vector3dVector, memoryview).
   if (!py::isinstance<py::array>(obj) && !py::isinstance<py::buffer>(obj))
-    throw py::type_error(std::string(name) + ": expected a numpy array (or an Open3D "
+    throw py::type_error(std::string(name) +
+                         ": expected a numpy array (or an Open3D "
                          "Vector3dVector), got " +
                          std::string(py::str(py::type::of(obj).attr("__name__"))));
-  const auto a = py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
-                                                : py::array(py::reinterpret_borrow<py::buffer>(obj));
+  const auto a = py::isinstance<py::array>(obj)
+                   ? py::reinterpret_borrow<py::array>(obj)
+                   : py::array(py::reinterpret_borrow<py::buffer>(obj));
   const auto kind = a.dtype().kind();
   if (kind != 'f')
     throw py::type_error(std::string(name) + ": expected float32 or float64 values, got dtype " +
                          std::string(py::str(a.dtype())));
-  const bool ok = frame ? (a.ndim() == 3 && a.shape(2) == cols) : (a.ndim() == 2 && a.shape(1) == cols);
+  const bool ok =
+    frame ? (a.ndim() == 3 && a.shape(2) == cols) : (a.ndim() == 2 && a.shape(1) == cols);
   if (!ok) {
     std::string shape = "(";
     for (py::ssize_t i = 0; i < a.ndim(); ++i)
       shape += (i ? ", " : "") + std::to_string(a.shape(i));
-    throw py::value_error(std::string(name) + ": expected shape " +
-                          (frame ? "(H, W, " : "(N, ") + std::to_string(cols) + "), got " +
-                          shape + (a.ndim() == 1 ? ",)" : ")"));
+    throw py::value_error(std::string(name) + ": expected shape " + (frame ? "(H, W, " : "(N, ") +
+                          std::to_string(cols) + "), got " + shape + (a.ndim() == 1 ? ",)" : ")"));
   }
   if (a.size() == 0)
     throw py::value_error(std::string(name) + ": the array is empty");
@@ -142,7 +144,8 @@ void
 appendOptions(std::vector<std::string>& words, const py::dict& options)
 {
   for (const auto& [key, value] : options) {
-    const std::string name = "--" + std::regex_replace(key.cast<std::string>(), std::regex("_"), "-");
+    const std::string name =
+      "--" + std::regex_replace(key.cast<std::string>(), std::regex("_"), "-");
     if (value.is_none())
       continue;
     if (py::isinstance<py::bool_>(value)) {
@@ -188,12 +191,13 @@ checkK(int k, std::size_t points)
   if (k < 3 || k > 1000)
     throw py::value_error("neighbours: " + std::to_string(k) + " is not in [3, 1000]");
   if (points < static_cast<std::size_t>(k))
-    throw py::value_error("points: " + std::to_string(points) + " rows are fewer than k = " +
-                          std::to_string(k) + " neighbours");
+    throw py::value_error("points: " + std::to_string(points) +
+                          " rows are fewer than k = " + std::to_string(k) + " neighbours");
 }
 
 py::tuple
-estimateNormalsCurvatures(const py::object& points, int neighbours, const std::optional<int>& k_alias)
+estimateNormalsCurvatures(const py::object& points, int neighbours,
+                          const std::optional<int>& k_alias)
 {
   if (k_alias && neighbours != 16 && *k_alias != neighbours)
     throw py::value_error("give neighbours once (k is its old spelling)");
@@ -249,8 +253,8 @@ fitSettings(const py::dict& options)
     if (args.has("--method") || args.has("--threads") || args.has("--radius-min") ||
         args.has("--radius-max"))
       throw std::invalid_argument("unknown option --" +
-                                  std::string(args.has("--method")    ? "method"
-                                              : args.has("--threads") ? "threads"
+                                  std::string(args.has("--method")       ? "method"
+                                              : args.has("--threads")    ? "threads"
                                               : args.has("--radius-min") ? "radius-min"
                                                                          : "radius-max") +
                                   " (facyl_fit only; here: radius_limits=(min, max))");
@@ -262,8 +266,8 @@ fitSettings(const py::dict& options)
   return s;
 }
 
-/** The fit of facyl_fit (apps/common/include/facyl/tools/cylinder_fit.h) on \a cloud (already in metres): cues estimated
- * unless \a normals. */
+/** The fit of facyl_fit (apps/common/include/facyl/tools/cylinder_fit.h) on \a cloud (already in
+ * metres): cues estimated unless \a normals. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
          const FitSettings& s, std::string* why = nullptr)
@@ -302,7 +306,8 @@ fitCylinders(const py::object& points, const py::object& normals, const py::dict
   const FitSettings s = fitSettings(options);
   // Millimetres are converted in double precision, before the points become floats.
   const float to_metres = facyl_cli::metresPerUnit(s.units);
-  const Cloud::Ptr cloud = toCloud(a, "points", s.units == facyl_cli::Units::Millimetres ? 1e-3 : 1.0);
+  const Cloud::Ptr cloud =
+    toCloud(a, "points", s.units == facyl_cli::Units::Millimetres ? 1e-3 : 1.0);
   const auto given = toNormals(normals, cloud->size());
   checkK(s.neighbours, cloud->size());
   const std::string units = facyl_cli::unitsProblem(*cloud, s.units, "units=\"mm\"", "units=\"m\"");
@@ -347,7 +352,8 @@ timeFitInCpp(const py::object& points, int repeats, int k)
   for (int r = 0; r < repeats; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto models = fitCloud(cloud, nullptr, s);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ms.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];
@@ -371,8 +377,9 @@ frameCloud(const py::object& points, const py::object& colors, bool& organized)
     const auto c = py::reinterpret_borrow<py::array>(colors);
     if (c.dtype().kind() != 'u' || c.itemsize() != 1)
       throw py::type_error("colors: expected dtype uint8, got " + std::string(py::str(c.dtype())));
-    const bool same = organized ? (c.ndim() == 3 && c.shape(0) == h && c.shape(1) == w && c.shape(2) == 3)
-                                : (c.ndim() == 2 && c.shape(0) == w && c.shape(1) == 3);
+    const bool same = organized
+                        ? (c.ndim() == 3 && c.shape(0) == h && c.shape(1) == w && c.shape(2) == 3)
+                        : (c.ndim() == 2 && c.shape(0) == w && c.shape(1) == 3);
     if (!same)
       throw py::value_error("colors: expected the shape of points (RGB, uint8)");
     rgb = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(c);
@@ -417,8 +424,11 @@ detect(const py::object& points, const py::object& colors,
                            c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
       throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
                             "0 <= cx, cy <= 4000 (pixels)");
-    cam = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]),
-           static_cast<float>(c[3]), static_cast<int>(std::ceil(2 * c[2] + 1)),
+    cam = {static_cast<float>(c[0]),
+           static_cast<float>(c[1]),
+           static_cast<float>(c[2]),
+           static_cast<float>(c[3]),
+           static_cast<int>(std::ceil(2 * c[2] + 1)),
            static_cast<int>(std::ceil(2 * c[3] + 1))};
   }
   // The recognizer's options: facyl_detect's, by the same parser.
@@ -463,8 +473,9 @@ detect(const py::object& points, const py::object& colors,
   py::list list = out["objects"];
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const auto& idx = objects[i].cluster.indices.indices;
-    list[i]["indices"] = py::array_t<std::int64_t>(
-      static_cast<py::ssize_t>(idx.size()), std::vector<std::int64_t>(idx.begin(), idx.end()).data());
+    list[i]["indices"] =
+      py::array_t<std::int64_t>(static_cast<py::ssize_t>(idx.size()),
+                                std::vector<std::int64_t>(idx.begin(), idx.end()).data());
   }
   return out;
 }
@@ -483,8 +494,11 @@ public:
                              c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
         throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
                               "0 <= cx, cy <= 4000 (pixels)");
-      camera_ = {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]),
-                 static_cast<float>(c[3]), static_cast<int>(std::ceil(2 * c[2] + 1)),
+      camera_ = {static_cast<float>(c[0]),
+                 static_cast<float>(c[1]),
+                 static_cast<float>(c[2]),
+                 static_cast<float>(c[3]),
+                 static_cast<int>(std::ceil(2 * c[2] + 1)),
                  static_cast<int>(std::ceil(2 * c[3] + 1))};
     }
     py::dict all(options);
@@ -523,8 +537,7 @@ public:
     rec_.setUpDirection(up_direction);
   }
 
-  py::dict
-  update(const py::object& points, const py::object& colors)
+  py::dict update(const py::object& points, const py::object& colors)
   {
     bool organized = false;
     RgbCloud::Ptr cloud;
@@ -547,10 +560,13 @@ public:
       ok = rec_.recognize(objects);
       if (ok) {
         tracker_.update(rec_, objects);
-        json = facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9) + "}";
+        json =
+          facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9) +
+          "}";
         for (const auto& o : objects) {
           sizes.push_back(o.cluster.indices.indices.size());
-          flat.insert(flat.end(), o.cluster.indices.indices.begin(), o.cluster.indices.indices.end());
+          flat.insert(flat.end(), o.cluster.indices.indices.begin(),
+                      o.cluster.indices.indices.end());
         }
       }
       else
@@ -570,24 +586,21 @@ public:
     return out;
   }
 
-  void
-  skip()
+  void skip()
   {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(mutex_);
     tracker_.skipFrame();
   }
 
-  void
-  reset()
+  void reset()
   {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(mutex_);
     tracker_.reset();
   }
 
-  py::list
-  tracks()
+  py::list tracks()
   {
     std::string json;
     {
@@ -598,8 +611,7 @@ public:
     return py::module_::import("json").attr("loads")(json)["tracks"];
   }
 
-  std::size_t
-  frame()
+  std::size_t frame()
   {
     std::lock_guard<std::mutex> lock(mutex_);
     return tracker_.getFrameInfo().frame;
@@ -700,7 +712,8 @@ renderTabletopScene(long long seed, const std::string& layout, const std::string
   out["colors"] = rgb;
   out["object_id"] = ids;
   out["truth"] = py::module_::import("json").attr("loads")(facyl::groundTruthJson(scene));
-  out["camera"] = std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
+  out["camera"] =
+    std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
   return out;
 }
 
@@ -734,8 +747,9 @@ renderSequenceFrame(long long seed, long long frame, long long frames, const std
   {
     py::gil_scoped_release release;
     const facyl::TabletopSequence seq = facyl::generateTabletopSequence(p, sp);
-    scene = facyl::renderSequenceFrame(seq, static_cast<std::size_t>(frame), p.camera, p.sensor,
-                                       facyl::sequenceFrameSeed(p.seed, static_cast<std::size_t>(frame)));
+    scene =
+      facyl::renderSequenceFrame(seq, static_cast<std::size_t>(frame), p.camera, p.sensor,
+                                 facyl::sequenceFrameSeed(p.seed, static_cast<std::size_t>(frame)));
     sequence = facyl::sequenceJson(seq);
   }
   const py::ssize_t h = scene.cloud.height, w = scene.cloud.width;
@@ -757,7 +771,8 @@ renderSequenceFrame(long long seed, long long frame, long long frames, const std
   out["object_id"] = ids;
   out["truth"] = py::module_::import("json").attr("loads")(facyl::groundTruthJson(scene));
   out["sequence"] = py::module_::import("json").attr("loads")(sequence);
-  out["camera"] = std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
+  out["camera"] =
+    std::vector<float>{scene.camera.fx, scene.camera.fy, scene.camera.cx, scene.camera.cy};
   return out;
 }
 
@@ -773,56 +788,77 @@ PYBIND11_MODULE(facyl, m)
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
 
   py::class_<PyCylinder>(m, "Cylinder", "A fitted finite cylinder (metres).")
-    .def_property_readonly("point_on_axis", [](const PyCylinder& c) { return vector3(c.model.point_on_axis); },
-                           "(3,) float32: a point on the axis (the base centre)")
-    .def_property_readonly("axis", [](const PyCylinder& c) { return vector3(c.model.axis); },
-                           "(3,) float32: unit axis, base to top")
-    .def_property_readonly("radius", [](const PyCylinder& c) { return c.model.radius; }, "radius (the cloud's units: metres)")
-    .def_property_readonly("height", [](const PyCylinder& c) { return c.model.height; }, "|top - base|")
-    .def_property_readonly("base", [](const PyCylinder& c) { return vector3(c.model.base); },
-                           "(3,) float32: centre of the lowest inlier section")
-    .def_property_readonly("top", [](const PyCylinder& c) { return vector3(c.model.top); },
-                           "(3,) float32: centre of the highest inlier section")
-    .def_property_readonly("inliers", [](const PyCylinder& c) {
+    .def_property_readonly(
+      "point_on_axis", [](const PyCylinder& c) { return vector3(c.model.point_on_axis); },
+      "(3,) float32: a point on the axis (the base centre)")
+    .def_property_readonly(
+      "axis", [](const PyCylinder& c) { return vector3(c.model.axis); },
+      "(3,) float32: unit axis, base to top")
+    .def_property_readonly(
+      "radius", [](const PyCylinder& c) { return c.model.radius; },
+      "radius (the cloud's units: metres)")
+    .def_property_readonly(
+      "height", [](const PyCylinder& c) { return c.model.height; }, "|top - base|")
+    .def_property_readonly(
+      "base", [](const PyCylinder& c) { return vector3(c.model.base); },
+      "(3,) float32: centre of the lowest inlier section")
+    .def_property_readonly(
+      "top", [](const PyCylinder& c) { return vector3(c.model.top); },
+      "(3,) float32: centre of the highest inlier section")
+    .def_property_readonly(
+      "inliers",
+      [](const PyCylinder& c) {
         std::vector<std::int64_t> v(c.model.inliers.begin(), c.model.inliers.end());
         return py::array_t<std::int64_t>(static_cast<py::ssize_t>(v.size()), v.data());
-      }, "(K,) int64: row indices of the inliers in points, ascending")
-    .def_property_readonly("n_inliers", [](const PyCylinder& c) { return c.model.inliers.size(); },
-                           "number of inliers (len(inliers))")
-    .def_property_readonly("inlier_ratio", [](const PyCylinder& c) { return c.model.inlier_ratio; },
-                           "inliers / rows given (paper eq. 4)")
-    .def_property_readonly("confidence", [](const PyCylinder& c) { return c.model.confidence; },
-                           "share of the orientation evidence its inliers carry, in [0, 1]")
-    .def_property_readonly("rms_error", [](const PyCylinder& c) { return c.model.rms_error; },
-                           "RMS distance of the inliers to the surface")
-    .def_property_readonly("angular_coverage", [](const PyCylinder& c) { return c.model.angular_coverage; },
-                           "share of the circumference with inliers")
-    .def_property_readonly("coefficients", [](const PyCylinder& c) {
+      },
+      "(K,) int64: row indices of the inliers in points, ascending")
+    .def_property_readonly(
+      "n_inliers", [](const PyCylinder& c) { return c.model.inliers.size(); },
+      "number of inliers (len(inliers))")
+    .def_property_readonly(
+      "inlier_ratio", [](const PyCylinder& c) { return c.model.inlier_ratio; },
+      "inliers / rows given (paper eq. 4)")
+    .def_property_readonly(
+      "confidence", [](const PyCylinder& c) { return c.model.confidence; },
+      "share of the orientation evidence its inliers carry, in [0, 1]")
+    .def_property_readonly(
+      "rms_error", [](const PyCylinder& c) { return c.model.rms_error; },
+      "RMS distance of the inliers to the surface")
+    .def_property_readonly(
+      "angular_coverage", [](const PyCylinder& c) { return c.model.angular_coverage; },
+      "share of the circumference with inliers")
+    .def_property_readonly(
+      "coefficients",
+      [](const PyCylinder& c) {
         pcl::ModelCoefficients mc;
         c.model.toCoefficients(mc);
         return py::array_t<float>(7, mc.values.data());
-      }, "(7,) float32: PCL's SACMODEL_CYLINDER layout (point on axis, axis direction, radius)")
-    .def("as_dict", [](const PyCylinder& c) {
-        return py::module_::import("json").attr("loads")(facyl_cli::cylinderJson(c.model, false, 9));
-      }, "The fields facyl_fit prints for this cylinder (no inlier indices), as a dict.")
+      },
+      "(7,) float32: PCL's SACMODEL_CYLINDER layout (point on axis, axis direction, radius)")
+    .def(
+      "as_dict",
+      [](const PyCylinder& c) {
+        return py::module_::import("json").attr("loads")(
+          facyl_cli::cylinderJson(c.model, false, 9));
+      },
+      "The fields facyl_fit prints for this cylinder (no inlier indices), as a dict.")
     .def("__repr__", [](const PyCylinder& c) {
-        const auto& m = c.model;
-        char buf[256];
-        std::snprintf(buf, sizeof buf,
-                      "Cylinder(radius=%.4f, height=%.4f, axis=[%.3f, %.3f, %.3f], "
-                      "point_on_axis=[%.3f, %.3f, %.3f], inliers=%zu)",
-                      m.radius, m.height, m.axis.x(), m.axis.y(), m.axis.z(), m.point_on_axis.x(),
-                      m.point_on_axis.y(), m.point_on_axis.z(), m.inliers.size());
-        return std::string(buf);
-      });
+      const auto& m = c.model;
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    "Cylinder(radius=%.4f, height=%.4f, axis=[%.3f, %.3f, %.3f], "
+                    "point_on_axis=[%.3f, %.3f, %.3f], inliers=%zu)",
+                    m.radius, m.height, m.axis.x(), m.axis.y(), m.axis.z(), m.point_on_axis.x(),
+                    m.point_on_axis.y(), m.point_on_axis.z(), m.inliers.size());
+      return std::string(buf);
+    });
 
   m.def(
     "fit_cylinders",
     [](const py::object& points, const py::object& normals, const py::object& radius_limits,
        const py::object& prior, const py::object& up, const std::string& voting, int neighbours,
-       int orientations, int accumulators, const py::object& distance_threshold,
-       int max_cylinders, bool outward_normals, long long seed, const std::string& units,
-       const py::object& k) {
+       int orientations, int accumulators, const py::object& distance_threshold, int max_cylinders,
+       bool outward_normals, long long seed, const std::string& units, const py::object& k) {
       py::dict o;
       o["radius_limits"] = radius_limits;
       o["prior"] = prior;
@@ -912,10 +948,10 @@ support -1. Raises ValueError for bad input.)");
   const auto shown = [](float v) { return std::round(1e6 * static_cast<double>(v)) / 1e6; };
   m.def("simulate_cylinder", &simulateCylinder, py::kw_only(),
         py::arg("radius") = shown(sim.radius), py::arg("height") = shown(sim.height),
-        py::arg("axis") = std::vector<double>{shown(sim.axis.x()), shown(sim.axis.y()),
-                                              shown(sim.axis.z())},
-        py::arg("base") = std::vector<double>{shown(sim.base.x()), shown(sim.base.y()),
-                                              shown(sim.base.z())},
+        py::arg("axis") =
+          std::vector<double>{shown(sim.axis.x()), shown(sim.axis.y()), shown(sim.axis.z())},
+        py::arg("base") =
+          std::vector<double>{shown(sim.base.x()), shown(sim.base.y()), shown(sim.base.z())},
         py::arg("points") = sim.lateral_points, py::arg("lid_ratio") = shown(sim.lid_ratio),
         py::arg("noise") = shown(sim.noise), py::arg("occlusion") = shown(sim.occlusion),
         py::arg("random_axis") = sim.random_axis, py::arg("seed") = sim.seed,
@@ -940,7 +976,8 @@ an object away / puts one down half-way. The same keys as render_tabletop_scene 
 2 + i is the sequence's object i in every frame), plus "sequence": the change and, per frame,
 the camera pose and the object ids present.)");
 
-  py::class_<PyTracker>(m, "Tracker", R"(Objects and cylinders tracked across the frames of one stream
+  py::class_<PyTracker>(m, "Tracker",
+                        R"(Objects and cylinders tracked across the frames of one stream
 (facyl_detect --track; C++ facyl::CylinderTracker): a camera moving over a static table.
 
 Tracker(camera=None, up=None, model="default", track_confirm_hits=2, track_max_misses=5,

@@ -89,7 +89,9 @@ TEST(ClassifierInput, DepthImageHasTheMaskAndTheRelativeDepth)
   for (int i = 0; i < 256; ++i)
     ASSERT_EQ(image[static_cast<std::size_t>(i)], 255) << i;
   // Nearer in the middle column (the cylinder's front), farther at the sides.
-  const auto depth = [&](int x, int y) { return image[256 + static_cast<std::size_t>(y * 16 + x)]; };
+  const auto depth = [&](int x, int y) {
+    return image[256 + static_cast<std::size_t>(y * 16 + x)];
+  };
   EXPECT_LT(depth(8, 8), depth(0, 8));
   EXPECT_LT(depth(8, 8), depth(15, 8));
   EXPECT_EQ(depth(3, 2), depth(3, 13)); // constant along the axis
@@ -110,8 +112,8 @@ TEST(ClassifierInput, RgbImageIsTheCropPaddedToASquare)
   EXPECT_EQ(view.box, (facyl::PixelBox{10, 5, 29, 14}));
   const auto image = facyl::classifierImage(view, {facyl::ClassifierChannels::Rgb, 20});
   ASSERT_EQ(image.size(), 3u * 20 * 20);
-  EXPECT_EQ(image[0], 0);              // row 0: padding
-  EXPECT_EQ(image[10 * 20 + 5], 200);  // row 10: the crop (red)
+  EXPECT_EQ(image[0], 0);                  // row 0: padding
+  EXPECT_EQ(image[10 * 20 + 5], 200);      // row 10: the crop (red)
   EXPECT_EQ(image[400 + 10 * 20 + 5], 10); // green plane
 }
 
@@ -137,7 +139,8 @@ TEST(ClassifierInput, DepthRgbImageIsTheDepthPlanesThenTheRgbPlanes)
   facyl::ObjectView grey = facyl::objectView(*cloud, idx, facyl::PinholeCamera{});
   grey.crop = facyl::RgbImage{};
   EXPECT_TRUE(facyl::classifierImage(grey, {facyl::ClassifierChannels::DepthRgb, 24}).empty());
-  EXPECT_TRUE(facyl::classifierImage(facyl::ObjectView{}, {facyl::ClassifierChannels::DepthRgb, 24}).empty());
+  EXPECT_TRUE(
+    facyl::classifierImage(facyl::ObjectView{}, {facyl::ClassifierChannels::DepthRgb, 24}).empty());
   EXPECT_EQ(facyl::channelCount(facyl::ClassifierChannels::DepthRgb), 5);
   facyl::ClassifierChannels c = facyl::ClassifierChannels::Rgb;
   ASSERT_TRUE(facyl::parseClassifierChannels("depthrgb", c));
@@ -158,17 +161,21 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
   EXPECT_EQ(info.input.size, 227);
   EXPECT_FALSE(info.softmax);
   EXPECT_FALSE(info.has_fusion);
-  EXPECT_EQ(facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info), "");
+  EXPECT_EQ(
+    facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info),
+    "");
   EXPECT_TRUE(info.has_fusion);
   EXPECT_EQ(info.fusion[8], 9.f);
   EXPECT_EQ(facyl::parseClassifierModelInfo("channels depthrgb\nsize 64\n", info), "");
   EXPECT_EQ(info.input.channels, facyl::ClassifierChannels::DepthRgb);
   EXPECT_NE(facyl::parseClassifierModelInfo("size 64\n", info), "");
-  EXPECT_NE(facyl::parseClassifierModelInfo("channels hsv\nsize 64\n", info).find("line 1"), std::string::npos);
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels hsv\nsize 64\n", info).find("line 1"),
+            std::string::npos);
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 4\n", info), "");
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2\n", info), "");
-  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nwidth 3\n", info).find("unknown key"),
-            std::string::npos);
+  EXPECT_NE(
+    facyl::parseClassifierModelInfo("channels rgb\nsize 64\nwidth 3\n", info).find("unknown key"),
+    std::string::npos);
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb 3\nsize 64\n", info), "");
 }
 
@@ -323,10 +330,10 @@ TEST(CylinderClassifier, BadModelsGiveErrorsThatNameTheFile)
     return std::string("no error");
   };
   const std::string paper_cfg = writeFile("paper.cfg", "channels rgb\nsize 227\n");
-  EXPECT_NE(caffe_message("/nonexistent/deploy.prototxt", "/nonexistent/squeezenet.caffemodel",
-                          paper_cfg)
-              .find("/nonexistent/deploy.prototxt: no such file"),
-            std::string::npos);
+  EXPECT_NE(
+    caffe_message("/nonexistent/deploy.prototxt", "/nonexistent/squeezenet.caffemodel", paper_cfg)
+      .find("/nonexistent/deploy.prototxt: no such file"),
+    std::string::npos);
   EXPECT_NE(caffe_message("a", "b", "/nonexistent/paper.cfg").find("paper.cfg: no such file"),
             std::string::npos);
   const std::string prototxt = writeFile("deploy.prototxt", "this is not a prototxt {");

@@ -190,8 +190,8 @@ TEST(ClutteredScenes, ObjectsTouchStackAndLeanWithoutPassingThroughEachOther)
       // A stacked object stands on its support's flat top.
       ++stacked;
       const auto& s = scene.objects[static_cast<std::size_t>(o.support)];
-      const float top = s.pose.translation().z() +
-                        (s.cls == facyl::SceneClass::Box ? s.size.z() : s.height);
+      const float top =
+        s.pose.translation().z() + (s.cls == facyl::SceneClass::Box ? s.size.z() : s.height);
       const float bottom = o.lying ? o.pose.translation().z() - o.radius : o.pose.translation().z();
       EXPECT_NEAR(bottom, top, 1e-4f) << "seed " << seed << " object " << i;
     }
@@ -252,7 +252,8 @@ TEST(ObjectSegmentation, FocalLengthAndImageDownFromTheData)
   const Eigen::Affine3f world(Eigen::AngleAxisf(1.2f, Eigen::Vector3f(1.f, 2.f, 3.f).normalized()));
   pcl::PointCloud<pcl::PointXYZ> moved;
   pcl::transformPointCloud(xyz, moved, world);
-  EXPECT_GT(facyl::imageDownDirection(moved, world.translation()).dot(world.linear() * Eigen::Vector3f::UnitY()),
+  EXPECT_GT(facyl::imageDownDirection(moved, world.translation())
+              .dot(world.linear() * Eigen::Vector3f::UnitY()),
             0.99f);
 }
 
@@ -322,10 +323,8 @@ TEST(SegmentationScore, RecoveredMergedAndSplit)
 
 TEST(SupportPlanes, CoplanarGroupsAndHeights)
 {
-  const std::vector<Eigen::Vector4f> planes{{0.f, 0.f, 1.f, -0.7f},
-                                            {0.f, 0.01f, 1.f, -0.705f},
-                                            {0.f, 0.f, 1.f, 0.f},
-                                            {1.f, 0.f, 0.f, 0.f}};
+  const std::vector<Eigen::Vector4f> planes{
+    {0.f, 0.f, 1.f, -0.7f}, {0.f, 0.01f, 1.f, -0.705f}, {0.f, 0.f, 1.f, 0.f}, {1.f, 0.f, 0.f, 0.f}};
   const auto groups = facyl::groupCoplanar(planes, {0, 1, 2, 3}, 0.05f, 0.015f);
   ASSERT_EQ(groups.size(), 3u);
   EXPECT_EQ(groups[0], (std::vector<std::size_t>{0, 1}));
@@ -334,17 +333,19 @@ TEST(SupportPlanes, CoplanarGroupsAndHeights)
   Eigen::Matrix3Xf pts(3, 100);
   for (int i = 0; i < 100; ++i)
     pts.col(i) = Eigen::Vector3f(0.f, 0.f, 0.02f + 0.001f * static_cast<float>(i));
-  const facyl::HeightProfile h = facyl::heightProfile(pts, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.1f);
+  const facyl::HeightProfile h =
+    facyl::heightProfile(pts, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.1f);
   EXPECT_NEAR(h.base, 0.021f, 1e-3f);
   EXPECT_NEAR(h.top, 0.117f, 1e-3f);
   EXPECT_NEAR(h.in_band, 0.805f, 0.01f);
   EXPECT_TRUE(facyl::standsOn(h, 0.03f, 0.5f, 0.02f));
-  EXPECT_FALSE(facyl::standsOn(h, 0.01f, 0.5f, 0.02f)); // does not reach down
+  EXPECT_FALSE(facyl::standsOn(h, 0.01f, 0.5f, 0.02f));  // does not reach down
   EXPECT_FALSE(facyl::standsOn(h, 0.03f, 0.12f, 0.02f)); // reaches the band's top: a leg
   Eigen::Matrix3Xf wide = pts;
   wide.row(0).setLinSpaced(0.f, 0.8f); // 80 cm wide: the foot of a wall, not an object
-  EXPECT_FALSE(facyl::standsOn(facyl::heightProfile(wide, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.5f),
-                               0.03f, 0.5f, 0.02f));
+  EXPECT_FALSE(
+    facyl::standsOn(facyl::heightProfile(wide, Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), 0.01f, 0.5f),
+                    0.03f, 0.5f, 0.02f));
 }
 
 TEST(CylinderEvidence, ArcGapTaperAndJunctions)
@@ -358,7 +359,8 @@ TEST(CylinderEvidence, ArcGapTaperAndJunctions)
   for (int k = 0; k < 180; ++k) {
     const float a = static_cast<float>(k) * kPi / 180.f;
     const float b = k < 90 ? a * 0.5f : kPi + a * 0.5f;
-    half.col(k) = Eigen::Vector3f(0.05f * std::cos(a), 0.05f * std::sin(a), 0.0005f * static_cast<float>(k));
+    half.col(k) =
+      Eigen::Vector3f(0.05f * std::cos(a), 0.05f * std::sin(a), 0.0005f * static_cast<float>(k));
     two.col(k) = Eigen::Vector3f(0.05f * std::cos(b), 0.05f * std::sin(b), 0.05f);
     normals.col(k) = Eigen::Vector3f(std::cos(a), std::sin(a), 0.f);
   }
@@ -518,7 +520,8 @@ TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
   for (const auto& [eye, what] : views) {
     const facyl::RenderedScene s = render(scene, eye, {0.f, 0.f, 0.04f});
     if (std::getenv("FACYL_TEST_DUMP"))
-      pcl::io::savePCDFileBinary(std::string("/tmp/support_") + (eye.z() > 1.f ? "floor" : "wall") + ".pcd", s.cloud);
+      pcl::io::savePCDFileBinary(
+        std::string("/tmp/support_") + (eye.z() > 1.f ? "floor" : "wall") + ".pcd", s.cloud);
     Cloud::Ptr cloud(new Cloud(s.cloud));
     for (const bool given_up : {false, true}) {
       facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
@@ -576,15 +579,16 @@ TEST(ClutterRecognition, StackedCoaxialCylindersAndACanAgainstABox)
   scene.objects.push_back(can(0.04f, 0.13f, {0.15f, -0.0795f, 0.f}));
   scene.objects.push_back(box({0.16f, 0.08f, 0.18f}, {0.15f, 0.f, 0.f}));
   for (const std::string sensor : {"kinect", "stereo"}) {
-    const facyl::RenderedScene s =
-      render(scene, {0.f, -0.8f, 0.45f}, {0.f, 0.f, 0.06f}, sensor);
+    const facyl::RenderedScene s = render(scene, {0.f, -0.8f, 0.45f}, {0.f, 0.f, 0.06f}, sensor);
     const auto objects = recognize(s);
-    for (const auto& [id, radius] : std::vector<std::pair<int, float>>{{2, 0.08f}, {3, 0.035f}, {4, 0.04f}}) {
+    for (const auto& [id, radius] :
+         std::vector<std::pair<int, float>>{{2, 0.08f}, {3, 0.035f}, {4, 0.04f}}) {
       const facyl::RecognizedObject* o = objectOf(objects, s, id);
       ASSERT_NE(o, nullptr) << sensor << " object " << id;
       EXPECT_TRUE(o->is_cylinder) << sensor << " object " << id;
       EXPECT_NEAR(o->cylinder.radius, radius, 0.06f * radius) << sensor << " object " << id;
-      const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, s.scene.objects[static_cast<std::size_t>(id - 2)]);
+      const facyl::CylinderTruth t =
+        facyl::cylinderTruth(s.scene, s.scene.objects[static_cast<std::size_t>(id - 2)]);
       EXPECT_LT(facyl::axisAngle(o->cylinder.axis, t.axis), 0.05f) << sensor << " object " << id;
     }
     const facyl::RecognizedObject* b = objectOf(objects, s, 5);
@@ -661,8 +665,9 @@ TEST(RealData, MosdSegmentationByGroup)
       pcl::copyPointCloud(labelled, *cloud);
       std::vector<int> truth(labelled.size());
       for (std::size_t i = 0; i < labelled.size(); ++i)
-        truth[i] = !pcl::isFinite(labelled[i]) ? -1
-                                              : (labelled[i].label >= 20 ? static_cast<int>(labelled[i].label / 10) : 0);
+        truth[i] = !pcl::isFinite(labelled[i])
+                     ? -1
+                     : (labelled[i].label >= 20 ? static_cast<int>(labelled[i].label / 10) : 0);
       rec.setInputCloud(cloud);
       std::vector<facyl::RecognizedObject> objects;
       ASSERT_TRUE(rec.recognize(objects)) << "learn" << k;

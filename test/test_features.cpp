@@ -61,8 +61,8 @@ TEST(NeighbourSearch, MatchesBruteForce)
     ASSERT_EQ(knn.count(i), 8u);
     for (std::size_t j = 0; j < 8; ++j)
       EXPECT_FLOAT_EQ((pts.col(knn.begin(i)[j]) - pts.col(i)).squaredNorm(), all[j].first);
-    const auto inside = std::count_if(all.begin(), all.end(),
-                                      [](const auto& d) { return d.first <= 0.09f; });
+    const auto inside =
+      std::count_if(all.begin(), all.end(), [](const auto& d) { return d.first <= 0.09f; });
     EXPECT_EQ(ball.count(i), static_cast<std::size_t>(inside));
   }
   EXPECT_THROW(search.nearest(pts, 0), std::invalid_argument);
@@ -88,7 +88,8 @@ TEST(NormalCurvatureEstimation, CylinderNormalsAreRadialAndCurvatureCircumferent
     const Eigen::Vector3f radial = Eigen::Vector3f(p.x(), p.y(), 0.f).normalized();
     const Eigen::Vector3f n(cues[i].normal_x, cues[i].normal_y, cues[i].normal_z);
     const Eigen::Vector3f c = cues[i].principalCurvatureVector3fMap();
-    good_normal += std::abs(n.dot(radial)) > std::cos(5.f * M_PI / 180.f); // PCA tilts on curved, uneven patches
+    good_normal +=
+      std::abs(n.dot(radial)) > std::cos(5.f * M_PI / 180.f); // PCA tilts on curved, uneven patches
     good_direction += std::abs(c.z()) < 0.1f;
     anisotropic += facyl::curvatureAnisotropy(cues[i].pc1, cues[i].pc2) > 0.8f;
     // oriented towards the view point (the origin lies on the axis: inward)
@@ -174,7 +175,8 @@ TEST(NormalCurvatureEstimation, ThreadsAndSearchMethodsAgree)
   ne.compute(one);
   ne.setNumberOfThreads(2);
   ne.compute(two);
-  ne.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
+  ne.setSearchMethod(
+    pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
   ne.compute(pcl_tree);
   for (std::size_t i = 0; i < cloud->size(); ++i) {
     EXPECT_EQ(one[i].normal_x, two[i].normal_x);

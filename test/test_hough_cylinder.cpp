@@ -89,8 +89,8 @@ sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = tru
               "fits: axis error median %.3f deg, p90 %.3f deg, %d off by > 10 deg; radius error "
               "median %.3f%%\n",
               facyl::toString(mode).c_str(), 100.f * lid_ratio, 100.f * noise, refine ? 1 : 0,
-              point_candidates, runs, quantile(s.axis_deg, 0.5), quantile(s.axis_deg, 0.9), s.failures,
-              100.f * quantile(s.radius_rel, 0.5));
+              point_candidates, runs, quantile(s.axis_deg, 0.5), quantile(s.axis_deg, 0.9),
+              s.failures, 100.f * quantile(s.radius_rel, 0.5));
   return s;
 }
 
@@ -143,7 +143,7 @@ TEST(HoughCylinderEstimation, HoldsAtHighNoise)
   // (facyl 0.1: 13-52% failures on these levels in facyl_bench) on the same clouds.
   constexpr int kRuns = 60;
   const std::vector<std::pair<float, float>> targets{
-      {0.10f, 0.02f}, {0.15f, 0.05f}, {0.20f, 0.10f}, {0.30f, 0.35f}};
+    {0.10f, 0.02f}, {0.15f, 0.05f}, {0.20f, 0.10f}, {0.30f, 0.35f}};
   for (const auto& [noise, rate] : targets) {
     const Sweep now = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns);
     const Sweep before = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns, true, 0);
@@ -268,7 +268,7 @@ TEST(HoughCylinderEstimation, PclStyleOutputAndIndices)
   ASSERT_TRUE(hough.segment(inliers, coefficients));
   ASSERT_EQ(coefficients.values.size(), 7u);
   const Eigen::Vector3f point(coefficients.values[0], coefficients.values[1],
-                             coefficients.values[2]);
+                              coefficients.values[2]);
   const Eigen::Vector3f axis(coefficients.values[3], coefficients.values[4],
                              coefficients.values[5]);
   EXPECT_NEAR(axis.norm(), 1.f, 1e-5f);
@@ -339,7 +339,7 @@ TEST(HoughCylinderEstimation, WorksWithPlainPclTypes)
   const auto cues = facyl_test::estimateCues(sim.cloud.makeShared());
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   pcl::PointCloud<pcl::PrincipalCurvatures>::Ptr curvatures(
-      new pcl::PointCloud<pcl::PrincipalCurvatures>);
+    new pcl::PointCloud<pcl::PrincipalCurvatures>);
   pcl::copyPointCloud(*cues, *normals);
   pcl::copyPointCloud(*cues, *curvatures);
 
@@ -455,7 +455,8 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
     h.setInputCloud(cloud);
     EXPECT_TRUE(fails(h)); // no normals
     EXPECT_EQ(h.getFailureReason(), R::NoNormals);
-    pcl::PointCloud<facyl::NormalCurvature>::Ptr fewer(new pcl::PointCloud<facyl::NormalCurvature>(*cues));
+    pcl::PointCloud<facyl::NormalCurvature>::Ptr fewer(
+      new pcl::PointCloud<facyl::NormalCurvature>(*cues));
     fewer->resize(10);
     h.setInputNormals(fewer);
     EXPECT_TRUE(fails(h)); // sizes differ
@@ -497,8 +498,8 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
   }
   {
     // No cylinder in a plane: false, not a made-up cylinder.
-    const auto plane = facyl::simulatePlane(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(),
-                                            1.f, 1.f, 2000, 0.001f, 1);
+    const auto plane = facyl::simulatePlane(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 1.f,
+                                            1.f, 2000, 0.001f, 1);
     Hough h;
     h.setInputCloud(plane.makeShared());
     h.setInputNormals(facyl_test::estimateCues(plane.makeShared()));
@@ -529,7 +530,7 @@ TEST(HoughCylinderEstimation, SearchFailuresSayWhy)
     EXPECT_TRUE(models.empty());
     EXPECT_EQ(h.getFailureReason(), R::RadiusLimits) << h.getFailureMessage();
     EXPECT_NE(h.getFailureMessage().find("radius limits [0.1, 0.2]"), std::string::npos)
-        << h.getFailureMessage();
+      << h.getFailureMessage();
     // Without the diagnosis (one fit per cluster in a pipeline): no second search.
     h.setDiagnoseFailures(false);
     EXPECT_FALSE(h.segment(models));
@@ -649,8 +650,8 @@ TEST(CylinderFitting, VotesPeakAtTheAxis)
   }
   Eigen::Matrix3Xf cells(3, 4);
   cells << 0, 1, 0, 0.6f, //
-      0, 0, 1, 0,         //
-      1, 0, 0, 0.8f;
+    0, 0, 1, 0,           //
+    1, 0, 0, 0.8f;
   for (const auto mode : {VotingMode::Rabbani, VotingMode::SoftNormal, VotingMode::SoftCurvature})
     for (const int p : {1, 2, 3}) {
       Eigen::VectorXf votes;

@@ -60,8 +60,8 @@ TEST(OrientationAccumulator, SameSeedSameSamples)
 
 TEST(OrientationAccumulator, SamplesAreUnitAndFolded)
 {
-  const auto d = facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Uniform),
-                                           1000, 1);
+  const auto d =
+    facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Uniform), 1000, 1);
   for (Eigen::Index i = 0; i < d.cols(); ++i) {
     EXPECT_NEAR(d.col(i).norm(), 1.f, 1e-5f);
     EXPECT_GE(d(2, i), 0.f);
@@ -71,8 +71,8 @@ TEST(OrientationAccumulator, SamplesAreUnitAndFolded)
 TEST(OrientationAccumulator, UniformPriorIsUniformOnTheSphere)
 {
   const int n = 20000;
-  const auto d = facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Uniform),
-                                           n, 3);
+  const auto d =
+    facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Uniform), n, 3);
   // On the uniform sphere, |z| is uniform on [0, 1]: mean 1/2, variance 1/12; and the
   // mean direction of the folded samples has no x, y part.
   const double tol = 4.0 * std::sqrt(1.0 / 12.0 / n);
@@ -106,12 +106,12 @@ TEST(OrientationAccumulator, MeanAndSpreadMatchTheMixture)
 TEST(OrientationAccumulator, PriorsConcentrateWhereTheySay)
 {
   const int n = 5000;
-  const auto strong = facyl::sampleOrientations(
-      GaussianMixture::fromPrior(OrientationPrior::VerticalStrong), n, 5);
+  const auto strong =
+    facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::VerticalStrong), n, 5);
   const auto mild =
-      facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Vertical), n, 5);
+    facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Vertical), n, 5);
   const auto flat =
-      facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Horizontal), n, 5);
+    facyl::sampleOrientations(GaussianMixture::fromPrior(OrientationPrior::Horizontal), n, 5);
   const auto near_up = [](const Eigen::Matrix3Xf& d) {
     return (d.row(2).array() > std::cos(20.0 * M_PI / 180.0)).cast<double>().mean();
   };
@@ -125,7 +125,7 @@ TEST(OrientationAccumulator, FrameRotatesThePrior)
   Eigen::Matrix3f frame;
   frame << Eigen::Vector3f::UnitY(), Eigen::Vector3f::UnitZ(), Eigen::Vector3f::UnitX();
   const auto d = facyl::sampleOrientations(
-      GaussianMixture::fromPrior(OrientationPrior::VerticalStrong), 2000, 9, frame);
+    GaussianMixture::fromPrior(OrientationPrior::VerticalStrong), 2000, 9, frame);
   // "up" is now x: the samples gather around +-x.
   EXPECT_GT(d.row(0).array().abs().mean(), 0.9f);
 }
@@ -143,14 +143,13 @@ TEST(OrientationAccumulator, InvalidMixturesAreRejected)
   bad = GaussianMixture::fromPrior(OrientationPrior::Uniform);
   bad.components[0].weight = 0.f;
   EXPECT_FALSE(bad.isValid());
-  EXPECT_THROW(facyl::OrientationAccumulator(Eigen::Matrix3Xf::Zero(3, 2)),
-               std::invalid_argument);
+  EXPECT_THROW(facyl::OrientationAccumulator(Eigen::Matrix3Xf::Zero(3, 2)), std::invalid_argument);
 }
 
 TEST(OrientationAccumulator, CellSizeMatchesThePaper)
 {
   const auto acc = facyl::OrientationAccumulator::sample(
-      GaussianMixture::fromPrior(OrientationPrior::Uniform), 450, 0);
+    GaussianMixture::fromPrior(OrientationPrior::Uniform), 450, 0);
   EXPECT_EQ(acc.size(), 450u);
   EXPECT_NEAR(acc.cellRadius() * 180.f / M_PI, 3.82f, 0.01f);
   // Random cells are closer than a lattice to their nearest neighbour half the time.

@@ -31,9 +31,11 @@ namespace {
 /** Standard normal samples of a seeded generator. */
 struct Gauss {
   facyl::Random rng;
-  explicit Gauss(std::uint64_t seed) : rng(seed) {}
-  float
-  operator()()
+  explicit Gauss(std::uint64_t seed)
+      : rng(seed)
+  {
+  }
+  float operator()()
   {
     return rng.normal();
   }
@@ -166,8 +168,9 @@ TEST(PlaneRegion, GrowsANoisyBentTableFromOnePieceAndStaysOffTheWall)
 
 TEST(AnyTable, NoisyFarTableIsOneSupport)
 {
-  // Active stereo at 1.6-2.2 m with 1.5 times the stereo preset's noise (sigma 18 mm at 2 m): a fixed 15 mm band would cut
-  // the table into pieces; the measured band keeps it whole and finds the objects on it.
+  // Active stereo at 1.6-2.2 m with 1.5 times the stereo preset's noise (sigma 18 mm at 2 m): a
+  // fixed 15 mm band would cut the table into pieces; the measured band keeps it whole and finds
+  // the objects on it.
   for (const std::uint64_t seed : {1000u, 1003u, 1004u}) {
     facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
     facyl::parseSensorPreset("stereo", p.sensor, p.camera);
@@ -182,7 +185,8 @@ TEST(AnyTable, NoisyFarTableIsOneSupport)
     ASSERT_TRUE(seg.segment(clusters));
     ASSERT_TRUE(seg.tableFound()) << seed;
     const auto& c = seg.getTableCoefficients().values;
-    EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), std::cos(0.03f)) << seed;
+    EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), std::cos(0.03f))
+      << seed;
     EXPECT_NEAR(c[3], s.table_plane[3], 0.02f) << seed;
     const auto& table = seg.getSupports()[seg.getTableIndex()];
     const float range = table.frame.translation().norm();
@@ -227,7 +231,8 @@ TEST(AnyTable, DarkTableFullOfHolesIsFound)
     if (!seg.tableFound())
       continue;
     const auto& c = seg.getTableCoefficients().values;
-    EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), std::cos(0.05f)) << seed;
+    EXPECT_GT(Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>()), std::cos(0.05f))
+      << seed;
     EXPECT_NEAR(c[3], s.table_plane[3], 0.03f) << seed;
     found_visible += seen;
   }
@@ -248,8 +253,8 @@ TEST(AnyTable, RolledCamerasNeedNoUpDirection)
     for (const auto& o : upright)
       upright_cylinders += o.is_cylinder;
     for (int turns = 1; turns <= 3; ++turns) {
-      const std::string what = "seed " + std::to_string(seed) + ", " +
-                               std::to_string(90 * turns) + " degrees";
+      const std::string what =
+        "seed " + std::to_string(seed) + ", " + std::to_string(90 * turns) + " degrees";
       const auto objects =
         recognize(Cloud::ConstPtr(new Cloud(facyl::rollFrame(s.cloud, turns))), rec);
       ASSERT_TRUE(rec.tableFound()) << what;
@@ -328,11 +333,11 @@ TEST(AnyTable, UnorganizedCloudsGetAClassifierView)
     known += std::isfinite(o.evidence.p_network);
   EXPECT_EQ(known, objects.size());
   // The view itself: about one point per pixel of its box, in front of the virtual camera.
-  const facyl::ObjectView view =
-    facyl::lookAtObjectView(*points, objects.front().cluster.indices.indices,
-                            Eigen::Vector3f::Zero());
+  const facyl::ObjectView view = facyl::lookAtObjectView(
+    *points, objects.front().cluster.indices.indices, Eigen::Vector3f::Zero());
   ASSERT_GE(view.box[0], 0);
-  const float box = static_cast<float>((view.box[2] - view.box[0] + 1) * (view.box[3] - view.box[1] + 1));
+  const float box =
+    static_cast<float>((view.box[2] - view.box[0] + 1) * (view.box[3] - view.box[1] + 1));
   const float n = static_cast<float>(objects.front().cluster.indices.indices.size());
   EXPECT_GT(box, 0.5f * n);
   EXPECT_LT(box, 2.f * n);
@@ -403,9 +408,9 @@ TEST(RealFrames, OtherSensorsAndRooms)
       for (const auto& o : objects) {
         const auto& b = o.cluster.box;
         if (b[0] <= l.u && l.u <= b[2] && b[1] <= l.v && l.v <= b[3] &&
-            (!best || (b[2] - b[0]) * (b[3] - b[1]) <
-                        (best->cluster.box[2] - best->cluster.box[0]) *
-                          (best->cluster.box[3] - best->cluster.box[1])))
+            (!best ||
+             (b[2] - b[0]) * (b[3] - b[1]) < (best->cluster.box[2] - best->cluster.box[0]) *
+                                               (best->cluster.box[3] - best->cluster.box[1])))
           best = &o;
       }
       if (l.cls == "cylinder") {

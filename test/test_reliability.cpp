@@ -3,8 +3,8 @@
  * clouds, frames stored in world coordinates, high resolutions, missing pixels), the parallel
  * loop, and thread safety and determinism of the pipeline.
  */
-#include <facyl/tools/cli.h>
 #include "test_helpers.h"
+#include <facyl/tools/cli.h>
 
 #include <facyl/features/parallel.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
@@ -68,8 +68,8 @@ fingerprint(const std::vector<facyl::RecognizedObject>& objects)
 {
   std::string s;
   for (const auto& o : objects) {
-    s += std::to_string(o.cluster.indices.indices.size()) + " " +
-         std::to_string(o.is_cylinder) + " " + facyl_cli::vector(o.cluster.centroid) + " " +
+    s += std::to_string(o.cluster.indices.indices.size()) + " " + std::to_string(o.is_cylinder) +
+         " " + facyl_cli::vector(o.cluster.centroid) + " " +
          facyl_cli::number(o.evidence.surface_ratio) + " " +
          facyl_cli::number(o.evidence.inlier_ratio);
     if (o.evidence.fitted)
@@ -106,8 +106,8 @@ TEST(Reliability, NarrowOrganizedCloudsAreSearchedAsPointSets)
   bool ok = false;
   const auto objects = recognize(rings, &ok);
   EXPECT_TRUE(ok);
-  EXPECT_GE(std::count_if(objects.begin(), objects.end(), [](const auto& o) { return o.is_cylinder; }),
-            3);
+  EXPECT_GE(
+    std::count_if(objects.begin(), objects.end(), [](const auto& o) { return o.is_cylinder; }), 3);
 }
 
 // --------------------------------------------------------------------------- sensor pose
@@ -149,7 +149,8 @@ TEST(Reliability, AFrameInWorldCoordinatesGivesTheSameAnswer)
   ASSERT_EQ(c.size(), 4u);
   const Eigen::Vector4f mine(c[0], c[1], c[2], c[3]);
   const auto& r = a.getTableCoefficients().values;
-  const Eigen::Vector4f expected = facyl::transformPlane(Eigen::Vector4f(r[0], r[1], r[2], r[3]), pose);
+  const Eigen::Vector4f expected =
+    facyl::transformPlane(Eigen::Vector4f(r[0], r[1], r[2], r[3]), pose);
   EXPECT_LT((mine - expected).norm(), 1e-4f);
   EXPECT_GT(mine.head<3>().dot(pose.translation()) + mine[3], 0.f);
   EXPECT_TRUE(b.getTableFrame().isApprox(pose * a.getTableFrame(), 1e-4f));
@@ -211,8 +212,8 @@ TEST(Reliability, AViewerOrientationThatPutsThePointsBehindTheSensorIsIgnored)
 TEST(Reliability, SensorPoseHelpers)
 {
   const Eigen::Vector4f plane(0.f, 0.f, 1.f, -2.f); // z = 2
-  const Eigen::Affine3f t = Eigen::Translation3f(1.f, 2.f, 3.f) *
-                            Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitX());
+  const Eigen::Affine3f t =
+    Eigen::Translation3f(1.f, 2.f, 3.f) * Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitX());
   const Eigen::Vector4f moved = facyl::transformPlane(plane, t);
   const Eigen::Vector3f on = t * Eigen::Vector3f(5.f, -1.f, 2.f);
   EXPECT_NEAR(moved.head<3>().dot(on) + moved[3], 0.f, 1e-5f);
@@ -220,8 +221,8 @@ TEST(Reliability, SensorPoseHelpers)
   EXPECT_TRUE(facyl::isIdentityPose(Eigen::Affine3f::Identity()));
   EXPECT_FALSE(facyl::isIdentityPose(t));
   // A zero or NaN quaternion is no rotation; a NaN origin no translation.
-  EXPECT_TRUE(facyl::isIdentityPose(facyl::sensorPose(
-    Eigen::Vector4f(NAN, 0.f, 0.f, 0.f), Eigen::Quaternionf(0.f, 0.f, 0.f, 0.f))));
+  EXPECT_TRUE(facyl::isIdentityPose(facyl::sensorPose(Eigen::Vector4f(NAN, 0.f, 0.f, 0.f),
+                                                      Eigen::Quaternionf(0.f, 0.f, 0.f, 0.f))));
 }
 
 // ---------------------------------------------------------------- resolution and holes
@@ -331,9 +332,15 @@ TEST(Reliability, CuesDoNotDependOnTheNumberOfThreads)
   }
   // Every field, bit for bit (NaN included; the structure's padding is not compared).
   const auto bits = [](const facyl::NormalCurvature& c) {
-    const float f[] = {c.normal_x, c.normal_y, c.normal_z, c.curvature,
-                       c.principal_curvature_x, c.principal_curvature_y,
-                       c.principal_curvature_z, c.pc1, c.pc2};
+    const float f[] = {c.normal_x,
+                       c.normal_y,
+                       c.normal_z,
+                       c.curvature,
+                       c.principal_curvature_x,
+                       c.principal_curvature_y,
+                       c.principal_curvature_z,
+                       c.pc1,
+                       c.pc2};
     std::array<std::uint32_t, 9> b;
     std::memcpy(b.data(), f, sizeof f);
     return b;
@@ -369,6 +376,9 @@ TEST(Reliability, IntegerOptionsNeitherWrapNorSaturate)
   EXPECT_THROW(parse({"--n", "1e3"}, 0, 10000), std::invalid_argument);
   EXPECT_EQ(parse({"--n", "-3"}, -5, 5), -3);
   // JSON strings stay valid UTF-8 whatever bytes a file name or a corrupt header holds.
-  EXPECT_EQ(facyl_cli::quote("a\xff" "b"), "\"a\xef\xbf\xbd" "b\"");
+  EXPECT_EQ(facyl_cli::quote("a\xff"
+                             "b"),
+            "\"a\xef\xbf\xbd"
+            "b\"");
   EXPECT_EQ(facyl_cli::quote("\xc3\xa9"), "\"\xc3\xa9\"");
 }

@@ -118,16 +118,15 @@ TEST(CylinderSimulation, RejectsInvalidParameters)
   p = {};
   p.noise = -1.f;
   EXPECT_FALSE(facyl::validate(p).empty());
-  EXPECT_THROW(facyl::simulatePlane(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 0.f, 1.f,
-                                    10, 0.f, 0),
-               std::invalid_argument);
+  EXPECT_THROW(
+    facyl::simulatePlane(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 0.f, 1.f, 10, 0.f, 0),
+    std::invalid_argument);
 }
 
 TEST(PlaneSimulation, PointsLieOnThePlane)
 {
   const Eigen::Vector3f n(0, 1, 1);
-  const auto plane =
-      facyl::simulatePlane(Eigen::Vector3f(1, 2, 3), n, 2.f, 1.f, 500, 0.f, 7);
+  const auto plane = facyl::simulatePlane(Eigen::Vector3f(1, 2, 3), n, 2.f, 1.f, 500, 0.f, 7);
   ASSERT_EQ(plane.size(), 500u);
   for (const auto& q : plane)
     EXPECT_NEAR((q.getVector3fMap() - Eigen::Vector3f(1, 2, 3)).dot(n.normalized()), 0.f, 1e-5f);
@@ -298,8 +297,8 @@ TEST(RealSensorArtefacts, RandomSensorVariesAcrossSeedsAndIsDeterministic)
   EXPECT_EQ(a.camera.fx, facyl::drawSensor(p.camera, 9).camera.fx);
   std::size_t same = 0;
   for (std::size_t i = 0; i < a.cloud.size(); ++i)
-    same += (a.cloud[i].z == b.cloud[i].z || (!std::isfinite(a.cloud[i].z) &&
-                                              !std::isfinite(b.cloud[i].z))) &&
+    same += (a.cloud[i].z == b.cloud[i].z ||
+             (!std::isfinite(a.cloud[i].z) && !std::isfinite(b.cloud[i].z))) &&
             a.cloud[i].rgba == b.cloud[i].rgba;
   EXPECT_EQ(same, a.cloud.size());
   EXPECT_NE(facyl::groundTruthJson(a).find("\"sensor\":{\"family\":"), std::string::npos);
@@ -310,14 +309,14 @@ TEST(RealSensorArtefacts, BiasNumerics)
   facyl::DepthSensorModel s;
   EXPECT_EQ(facyl::depthBias(s, 2.f, 1.f, 0.3f), 0.f); // off by default
   s.radial_depth_bias = 0.004f;
-  EXPECT_NEAR(facyl::depthBias(s, 1.f, 1.f, 1.f), 0.004f, 1e-7f); // 4 mm at 1 m, corner
-  EXPECT_NEAR(facyl::depthBias(s, 2.f, 1.f, 1.f), 0.016f, 1e-7f); // grows with z^2
+  EXPECT_NEAR(facyl::depthBias(s, 1.f, 1.f, 1.f), 0.004f, 1e-7f);   // 4 mm at 1 m, corner
+  EXPECT_NEAR(facyl::depthBias(s, 2.f, 1.f, 1.f), 0.016f, 1e-7f);   // grows with z^2
   EXPECT_NEAR(facyl::depthBias(s, 2.f, 0.25f, 1.f), 0.004f, 1e-7f); // and with r^2
   EXPECT_EQ(facyl::depthBias(s, 2.f, 0.f, 1.f), 0.f);               // none in the centre
   s = {};
   s.incidence_bias = 0.002f;
-  EXPECT_NEAR(facyl::depthBias(s, 1.f, 0.f, 0.5f), 0.002f, 1e-7f); // 60 degrees
-  EXPECT_NEAR(facyl::depthBias(s, 1.f, 0.f, 1.f), 0.f, 1e-9f);    // head on
+  EXPECT_NEAR(facyl::depthBias(s, 1.f, 0.f, 0.5f), 0.002f, 1e-7f);  // 60 degrees
+  EXPECT_NEAR(facyl::depthBias(s, 1.f, 0.f, 1.f), 0.f, 1e-9f);      // head on
   EXPECT_NEAR(facyl::depthBias(s, 1.f, 0.f, 0.01f), 0.018f, 1e-6f); // capped at cos 0.1
   s = {};
   s.depth_scale_error = 0.01f;
@@ -449,8 +448,7 @@ TEST(RealSensorArtefacts, CurvedTableCarriesItsObjects)
     }
   }
   // Rendered without noise, the table's pixels lie on the curved top (world frame).
-  const facyl::RenderedScene r =
-    facyl::renderTabletopScene(scene, p.camera, idealSensor(), p.seed);
+  const facyl::RenderedScene r = facyl::renderTabletopScene(scene, p.camera, idealSensor(), p.seed);
   const Eigen::Isometry3f& to_world = scene.camera_to_world;
   std::size_t on_top = 0, above_flat = 0;
   for (std::size_t i = 0; i < r.cloud.size(); ++i) {

@@ -78,8 +78,8 @@ TEST(TabletopGeometry, FitPlaneOrientsTowardsTheViewpoint)
     line.col(i) = Eigen::Vector3f(static_cast<float>(i), 0.f, 0.f);
   EXPECT_FALSE(facyl::fitPlane(line, Eigen::Vector3f::Zero(), plane));
   EXPECT_FALSE(facyl::fitPlane(Eigen::Matrix3Xf(3, 2), Eigen::Vector3f::Zero(), plane));
-  const Eigen::Vector4f flipped = facyl::orientPlane(Eigen::Vector4f(0.f, 0.f, 2.f, -4.f),
-                                                     Eigen::Vector3f::Zero());
+  const Eigen::Vector4f flipped =
+    facyl::orientPlane(Eigen::Vector4f(0.f, 0.f, 2.f, -4.f), Eigen::Vector3f::Zero());
   EXPECT_TRUE(flipped.isApprox(Eigen::Vector4f(0.f, 0.f, -1.f, 2.f)));
 }
 
@@ -112,8 +112,7 @@ TEST(TabletopGeometry, BoxesAndPolygons)
 
 TEST(TabletopGeometry, RowExtremesHoldThePlanesHull)
 {
-  EXPECT_EQ(facyl::rowExtremes({12, 3, 25, 14, 11, 99, -1}, 10, 3),
-            (pcl::Indices{3, 11, 14, 25}));
+  EXPECT_EQ(facyl::rowExtremes({12, 3, 25, 14, 11, 99, -1}, 10, 3), (pcl::Indices{3, 11, 14, 25}));
   // Pixels of a random blob seen on a tilted plane: the hull of each row's extremes, on the
   // plane, is the hull of every pixel (a projective map keeps convex hulls).
   const facyl::PinholeCamera cam{525.f, 525.f, 319.5f, 239.5f, 640, 480};
@@ -131,7 +130,8 @@ TEST(TabletopGeometry, RowExtremesHoldThePlanesHull)
   const auto flat = [&](const pcl::Indices& idx) {
     std::vector<Eigen::Vector2f> out;
     for (const auto i : idx) {
-      const Eigen::Vector3f ray((i % cam.width - cam.cx) / cam.fx, (i / cam.width - cam.cy) / cam.fy, 1.f);
+      const Eigen::Vector3f ray((i % cam.width - cam.cx) / cam.fx,
+                                (i / cam.width - cam.cy) / cam.fy, 1.f);
       const Eigen::Vector3f p = ray * (-d / n.dot(ray));
       out.emplace_back(p.x(), p.z() * 0.5f + p.y()); // any affine chart of the plane
     }
@@ -225,7 +225,8 @@ TEST(TabletopScene, DeterministicAndConsistentWithItsGroundTruth)
       ++table;
       on_plane += std::abs(d) < 0.01f;
       EXPECT_EQ(a.pixel_class[i], facyl::SceneClass::Table);
-    } else if (a.object_id[i] >= 2) {
+    }
+    else if (a.object_id[i] >= 2) {
       EXPECT_GT(d, -0.01f);
       ++visible[a.object_id[i] - 2u];
     }
@@ -283,12 +284,12 @@ TEST(TabletopSegmentation, FindsTheTableAndEveryObject)
     ASSERT_TRUE(seg.segment(clusters));
     const auto& c = seg.getTableCoefficients().values;
     ASSERT_EQ(c.size(), 4u);
-    EXPECT_LT(facyl_test::degrees(std::acos(std::min(
-                1.f, Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>())))),
+    EXPECT_LT(facyl_test::degrees(std::acos(
+                std::min(1.f, Eigen::Vector3f(c[0], c[1], c[2]).dot(s.table_plane.head<3>())))),
               0.5f);
     EXPECT_NEAR(c[3], s.table_plane[3], 0.005f);
-    EXPECT_TRUE(seg.getTableFrame().linear().col(2).isApprox(Eigen::Vector3f(c[0], c[1], c[2]),
-                                                             1e-4f));
+    EXPECT_TRUE(
+      seg.getTableFrame().linear().col(2).isApprox(Eigen::Vector3f(c[0], c[1], c[2]), 1e-4f));
     std::map<int, int> clusters_of;
     for (const auto& cl : clusters) {
       const int id = majorityId(s, cl.indices.indices);
@@ -419,8 +420,8 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
     std::map<int, const facyl::RecognizedObject*> by_id;
     for (const auto& o : objects) {
       const int id = majorityId(s, o.cluster.indices.indices);
-      if (id >= 2 && (!by_id.count(id) || o.cluster.indices.indices.size() >
-                                             by_id[id]->cluster.indices.indices.size()))
+      if (id >= 2 && (!by_id.count(id) ||
+                      o.cluster.indices.indices.size() > by_id[id]->cluster.indices.indices.size()))
         by_id[id] = &o;
       if (o.is_cylinder) {
         EXPECT_TRUE(o.evidence.fitted);
@@ -452,14 +453,16 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
       ++detected;
       const facyl::CylinderTruth gt = facyl::cylinderTruth(s.scene, truth);
       radius_error.push_back(std::abs(it->second->cylinder.radius - gt.radius) / gt.radius);
-      axis_error.push_back(facyl_test::degrees(facyl::axisAngle(it->second->cylinder.axis, gt.axis)));
+      axis_error.push_back(
+        facyl_test::degrees(facyl::axisAngle(it->second->cylinder.axis, gt.axis)));
     }
   }
   std::printf("[ figures ] 16 scenes: %zu/%zu cylinders detected, %zu/%zu boxes, spheres and "
               "bowls and %zu/%zu cones called cylinders, median radius error %.2f%%, median axis "
               "error %.2f deg\n",
               detected, cylinders, false_positives, distractors, cones_called, cones,
-              100.f * facyl_test::quantile(radius_error, 0.5), facyl_test::quantile(axis_error, 0.5));
+              100.f * facyl_test::quantile(radius_error, 0.5),
+              facyl_test::quantile(axis_error, 0.5));
   ASSERT_GT(cylinders, 10u);
   EXPECT_GE(detected, cylinders * 9 / 10);
   ASSERT_GT(distractors, 10u);
@@ -472,17 +475,18 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
 /** Always says "not a cylinder", or NaN. */
 class FixedClassifier : public facyl::ShapeClassifier {
 public:
-  explicit FixedClassifier(float p) : p_(p) {}
-  float
-  cylinderProbability(const facyl::ObjectView& view) override
+  explicit FixedClassifier(float p)
+      : p_(p)
+  {
+  }
+  float cylinderProbability(const facyl::ObjectView& view) override
   {
     ++calls;
     crop_ok = crop_ok && !view.crop.empty() && view.box[0] >= 0 &&
               view.crop.width == view.box[2] - view.box[0] + 1 && view.points.cols() > 0;
     return p_;
   }
-  std::string
-  name() const override
+  std::string name() const override
   {
     return "fixed";
   }
@@ -658,11 +662,11 @@ TEST(RealData, MosdLabelledScenes)
           ++votes[static_cast<int>(labelled_cloud[i].label / 10)];
       if (votes.empty())
         continue;
-      const auto best = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) {
-        return a.second < b.second;
-      });
+      const auto best = std::max_element(votes.begin(), votes.end(),
+                                         [](auto& a, auto& b) { return a.second < b.second; });
       seen[best->first] = true;
-      const bool small = o.evidence.fitted && o.cylinder.radius < 0.05f && o.cylinder.radius > 0.03f;
+      const bool small =
+        o.evidence.fitted && o.cylinder.radius < 0.05f && o.cylinder.radius > 0.03f;
       mugs += o.is_cylinder && small;
     }
     objects_seen += seen.size();

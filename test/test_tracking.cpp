@@ -51,13 +51,12 @@ struct SyntheticTable {
              {true, {-0.1f, -0.12f, 0.f}, 0.025f, 0.15f}};
   }
   /** Camera to world of frame \a k (x right, y down, z forward). */
-  Eigen::Affine3f
-  camera(int k) const
+  Eigen::Affine3f camera(int k) const
   {
     const float az = azimuth0 + step * static_cast<float>(k);
-    const Eigen::Vector3f eye = distance * Eigen::Vector3f(std::sin(az) * std::cos(elevation),
-                                                           -std::cos(az) * std::cos(elevation),
-                                                           std::sin(elevation));
+    const Eigen::Vector3f eye =
+      distance * Eigen::Vector3f(std::sin(az) * std::cos(elevation),
+                                 -std::cos(az) * std::cos(elevation), std::sin(elevation));
     const Eigen::Vector3f f = (-eye).normalized();
     const Eigen::Vector3f right = f.cross(Eigen::Vector3f::UnitZ()).normalized();
     Eigen::Affine3f pose = Eigen::Affine3f::Identity();
@@ -67,8 +66,7 @@ struct SyntheticTable {
     pose.translation() = eye;
     return pose;
   }
-  std::vector<facyl::SupportPlane>
-  supports(int k)
+  std::vector<facyl::SupportPlane> supports(int k)
   {
     const Eigen::Affine3f to_camera = camera(k).inverse();
     Eigen::Vector4f plane;
@@ -80,8 +78,8 @@ struct SyntheticTable {
     s.frame = facyl::planeFrame(plane, to_camera * hint);
     return {s};
   }
-  facyl::RecognizedObject
-  observe(const Item& it, const Eigen::Affine3f& to_camera, bool noise = true)
+  facyl::RecognizedObject observe(const Item& it, const Eigen::Affine3f& to_camera,
+                                  bool noise = true)
   {
     facyl::RecognizedObject o;
     o.cluster.support = 0;
@@ -105,11 +103,11 @@ struct SyntheticTable {
     }
     else
       o.cluster.centroid =
-        to_camera * (it.base + n * 0.01f * Eigen::Vector3f(rng.normal(), rng.normal(), rng.normal()));
+        to_camera *
+        (it.base + n * 0.01f * Eigen::Vector3f(rng.normal(), rng.normal(), rng.normal()));
     return o;
   }
-  std::vector<facyl::RecognizedObject>
-  objects(int k, const std::vector<int>& hidden = {})
+  std::vector<facyl::RecognizedObject> objects(int k, const std::vector<int>& hidden = {})
   {
     const Eigen::Affine3f to_camera = camera(k).inverse();
     std::vector<facyl::RecognizedObject> out;
@@ -164,7 +162,8 @@ TEST(TrackingNumerics, PlanarRigidFromNoisyPoints)
   EXPECT_NEAR(fit.yaw, truth.yaw, 5.f * yaw_sigma);
   EXPECT_LT((fit.t - truth.t).norm(), 5.f * sigma);
   // One point: the rotation cannot be observed; the fallback is kept.
-  const auto one = facyl::fitPlanarRigid(from.leftCols(1), to.leftCols(1), Eigen::VectorXf::Ones(1), 0.25f);
+  const auto one =
+    facyl::fitPlanarRigid(from.leftCols(1), to.leftCols(1), Eigen::VectorXf::Ones(1), 0.25f);
   EXPECT_FLOAT_EQ(one.yaw, 0.25f);
   EXPECT_LT((one.apply(from.col(0)) - to.col(0)).norm(), 1e-5f);
   // inPlaneComponent of a planar motion is itself.
@@ -183,7 +182,8 @@ TEST(TrackingNumerics, RegistrationIgnoresWrongCandidates)
   Eigen::Matrix2Xf objects(2, n), tracks(2, n);
   for (int i = 0; i < n; ++i) {
     objects.col(i) = Eigen::Vector2f(rng.uniform(-0.25f, 0.25f), rng.uniform(-0.25f, 0.25f));
-    tracks.col(i) = truth.apply(objects.col(i)) + 0.001f * Eigen::Vector2f(rng.normal(), rng.normal());
+    tracks.col(i) =
+      truth.apply(objects.col(i)) + 0.001f * Eigen::Vector2f(rng.normal(), rng.normal());
   }
   std::vector<facyl::RegistrationCandidate> candidates;
   for (int i = 0; i < n; ++i)
@@ -196,7 +196,8 @@ TEST(TrackingNumerics, RegistrationIgnoresWrongCandidates)
   EXPECT_NEAR(reg.transform.yaw, truth.yaw, 0.01f);
   EXPECT_LT((reg.transform.t - truth.t).norm(), 0.004f);
   for (const int c : reg.inliers)
-    EXPECT_EQ(candidates[static_cast<std::size_t>(c)].object, candidates[static_cast<std::size_t>(c)].track);
+    EXPECT_EQ(candidates[static_cast<std::size_t>(c)].object,
+              candidates[static_cast<std::size_t>(c)].track);
   // No candidate: the prior.
   const auto none = facyl::registerInPlane(objects, tracks, {}, prior);
   EXPECT_TRUE(none.from_prior);
@@ -211,7 +212,8 @@ TEST(TrackingNumerics, AssignmentIsOptimalAgainstBruteForce)
     Eigen::MatrixXf cost(rows, cols);
     for (int i = 0; i < rows; ++i)
       for (int j = 0; j < cols; ++j)
-        cost(i, j) = rng.chance(0.2) ? std::numeric_limits<float>::infinity() : rng.uniform(0.f, 12.f);
+        cost(i, j) =
+          rng.chance(0.2) ? std::numeric_limits<float>::infinity() : rng.uniform(0.f, 12.f);
     const float gate = 9.f;
     const std::vector<int> a = facyl::assignMinimumCost(cost, gate);
     ASSERT_EQ(a.size(), static_cast<std::size_t>(rows));
@@ -464,7 +466,7 @@ TEST(CylinderTracker, FramesWithoutSupportOrFailedKeepTheTracks)
     }
     else if (k == 6)
       tracker.skipFrame(); // unreadable, empty, failed
-    else if (k == 7) { // an empty frame: no support, no object
+    else if (k == 7) {     // an empty frame: no support, no object
       ASSERT_TRUE(tracker.update({}, -1, {}));
       for (const auto& t : tracker.getTracks())
         EXPECT_EQ(t.status, facyl::TrackStatus::NotUpdated);
@@ -503,8 +505,8 @@ TEST(CylinderTracker, UnanchoredStreamDoesNotPileUpTentativeTracks)
       auto& o = objects[i];
       o.cluster.support = -1;
       o.cluster.indices.indices.resize(800);
-      o.cluster.centroid = Eigen::Vector3f(rng.uniform(-2.f, 2.f), rng.uniform(-2.f, 2.f),
-                                           rng.uniform(1.f, 4.f));
+      o.cluster.centroid =
+        Eigen::Vector3f(rng.uniform(-2.f, 2.f), rng.uniform(-2.f, 2.f), rng.uniform(1.f, 4.f));
       o.evidence.p_cylinder = 0.3f;
     }
     ASSERT_TRUE(tracker.update({}, -1, objects));
@@ -578,7 +580,8 @@ TEST(CylinderTracker, NewSceneStartsNewTracks)
   // Another table, seen from elsewhere (its plane does not continue the tracks' and its
   // objects match none): every track ends, new ones start.
   SyntheticTable first, second;
-  second.items = {{true, {0.3f, 0.3f, 0.f}, 0.09f, 0.05f}, {false, {-0.2f, 0.25f, 0.06f}, 0.f, 0.f},
+  second.items = {{true, {0.3f, 0.3f, 0.f}, 0.09f, 0.05f},
+                  {false, {-0.2f, 0.25f, 0.06f}, 0.f, 0.f},
                   {true, {0.f, 0.35f, 0.f}, 0.02f, 0.2f}};
   second.distance = 0.7f;
   second.elevation = 1.2f;
@@ -624,10 +627,12 @@ TEST(TabletopSequence, KeepsTheSceneAndMovesSmoothly)
   const auto r = facyl::renderSequenceFrame(seq, seq.change_frame, p.camera, p.sensor, 1);
   EXPECT_EQ(r.visible_pixels.size(), seq.scene.objects.size());
   EXPECT_EQ(r.visible_pixels[gone], 0u);
-  EXPECT_EQ(std::count(r.object_id.begin(), r.object_id.end(), static_cast<std::uint16_t>(2 + gone)), 0);
+  EXPECT_EQ(
+    std::count(r.object_id.begin(), r.object_id.end(), static_cast<std::uint16_t>(2 + gone)), 0);
   for (std::size_t i = 0; i < seq.scene.objects.size(); ++i)
     EXPECT_EQ(static_cast<std::size_t>(std::count(r.object_id.begin(), r.object_id.end(),
-                                                  static_cast<std::uint16_t>(2 + i))) >= r.visible_pixels[i],
+                                                  static_cast<std::uint16_t>(2 + i))) >=
+                r.visible_pixels[i],
               true);
   // Deterministic.
   const auto again = facyl::generateTabletopSequence(p, sp);
@@ -650,7 +655,8 @@ TEST(CylinderTracker, IdsAreStableOnASimulatedStream)
   std::map<int, std::map<int, int>> ids_of; // true object -> track id -> frames
   std::size_t frame_found = 0, tracked_found = 0, frame_false = 0, tracked_false = 0;
   for (std::size_t f = 0; f < sp.frames; ++f) {
-    const auto r = facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(p.seed, f));
+    const auto r =
+      facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(p.seed, f));
     pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGBA>(r.cloud));
     rec.setInputCloud(cloud);
     std::vector<facyl::RecognizedObject> objects;
@@ -663,7 +669,8 @@ TEST(CylinderTracker, IdsAreStableOnASimulatedStream)
         if (o.cls != facyl::SceneClass::Cylinder)
           continue;
         const auto c = facyl::cylinderTruth(r.scene, o);
-        const Eigen::Vector3f centre = 0.5f * (m.base + m.top), a = c.base, b = c.base + c.height * c.axis;
+        const Eigen::Vector3f centre = 0.5f * (m.base + m.top), a = c.base,
+                              b = c.base + c.height * c.axis;
         const float t = std::clamp((centre - a).dot(b - a) / (b - a).squaredNorm(), 0.f, 1.f);
         if ((centre - (a + t * (b - a))).norm() < 0.5f * c.radius + 0.02f)
           return static_cast<int>(i);
@@ -722,9 +729,12 @@ TEST(FrameStream, PcdGrabberPlaysAFolderOfFrames)
   const auto seq = facyl::generateTabletopSequence(p, sp);
   for (std::size_t f = 0; f < sp.frames; ++f) {
     const auto r = facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, f);
-    pcl::io::savePCDFileBinaryCompressed((dir / ("frame" + std::to_string(f) + ".pcd")).string(), r.cloud);
+    pcl::io::savePCDFileBinaryCompressed((dir / ("frame" + std::to_string(f) + ".pcd")).string(),
+                                         r.cloud);
   }
-  { std::ofstream((dir / "frame1_notes.pcd").string()) << "not a point cloud\n"; }
+  {
+    std::ofstream((dir / "frame1_notes.pcd").string()) << "not a point cloud\n";
+  }
   std::ofstream((dir / "frame2_empty.pcd").string())
     << "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 0\nHEIGHT 1\n"
        "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n";
@@ -732,7 +742,8 @@ TEST(FrameStream, PcdGrabberPlaysAFolderOfFrames)
     const auto full = (dir / "frame0.pcd").string();
     std::ifstream in(full, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::ofstream((dir / "frame3_truncated.pcd").string(), std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+    std::ofstream((dir / "frame3_truncated.pcd").string(), std::ios::binary)
+      << bytes.substr(0, bytes.size() / 3);
   }
   facyl_cli::FrameStream stream(dir.string(), 0.f, false);
   EXPECT_EQ(stream.rejected().size(), 3u);
@@ -753,7 +764,8 @@ TEST(FrameStream, PcdGrabberPlaysAFolderOfFrames)
         if (t.confirmed)
           confirmed_ids.insert(t.id);
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"frame0.pcd", "frame1.pcd", "frame2.pcd", "frame3.pcd"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"frame0.pcd", "frame1.pcd", "frame2.pcd", "frame3.pcd"}));
   ASSERT_FALSE(confirmed_ids.empty());
   std::size_t kept = 0;
   for (const int id : confirmed_ids)
@@ -768,8 +780,11 @@ TEST(FrameStream, PcdGrabberPlaysAFolderOfFrames)
   // No usable frame, no such folder: clear errors.
   const auto bad = dir / "bad";
   std::filesystem::create_directories(bad);
-  { std::ofstream((bad / "x.pcd").string()) << "junk\n"; }
+  {
+    std::ofstream((bad / "x.pcd").string()) << "junk\n";
+  }
   EXPECT_THROW(facyl_cli::FrameStream(bad.string(), 0.f, false), std::invalid_argument);
-  EXPECT_THROW(facyl_cli::FrameStream((dir / "missing").string(), 0.f, false), std::invalid_argument);
+  EXPECT_THROW(facyl_cli::FrameStream((dir / "missing").string(), 0.f, false),
+               std::invalid_argument);
   std::filesystem::remove_all(dir);
 }

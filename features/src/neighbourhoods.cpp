@@ -7,10 +7,10 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
-#include <limits>
-#include <memory>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <stdexcept>
 
 namespace facyl {
@@ -32,19 +32,15 @@ struct FiniteColumns {
         xyz.insert(xyz.end(), {p(0, i), p(1, i), p(2, i)});
       }
   }
-  std::size_t
-  kdtree_get_point_count() const
+  std::size_t kdtree_get_point_count() const
   {
     return columns.size();
   }
-  float
-  kdtree_get_pt(std::size_t idx, std::size_t dim) const
+  float kdtree_get_pt(std::size_t idx, std::size_t dim) const
   {
     return xyz[3 * idx + dim];
   }
-  template <class BBox>
-  bool
-  kdtree_get_bbox(BBox&) const
+  template <class BBox> bool kdtree_get_bbox(BBox&) const
   {
     return false;
   }
@@ -62,7 +58,8 @@ struct NeighbourSearch::Impl {
   FiniteColumns data;
   Tree tree;
   explicit Impl(const Eigen::Matrix3Xf& surface)
-  : data(surface), tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(10))
+      : data(surface)
+      , tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(10))
   {
     if (!data.columns.empty())
       tree.buildIndex();
@@ -70,8 +67,9 @@ struct NeighbourSearch::Impl {
 };
 
 NeighbourSearch::NeighbourSearch(const Eigen::Matrix3Xf& surface)
-: impl_(std::make_unique<Impl>(surface))
-{}
+    : impl_(std::make_unique<Impl>(surface))
+{
+}
 
 NeighbourSearch::~NeighbourSearch() = default;
 
@@ -114,7 +112,7 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
 {
   if (!(radius > 0.f) || !std::isfinite(radius))
     throw std::invalid_argument(
-        "facyl::NeighbourSearch::within: radius must be positive and finite");
+      "facyl::NeighbourSearch::within: radius must be positive and finite");
   const auto& data = impl_->data;
   const auto& tree = impl_->tree;
   const std::size_t n = static_cast<std::size_t>(queries.cols());
@@ -127,8 +125,7 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
       const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
       if (!q.allFinite())
         continue;
-      tree.radiusSearch(q.data(), radius * radius, matches,
-                        nanoflann::SearchParams(32, 0.f, true));
+      tree.radiusSearch(q.data(), radius * radius, matches, nanoflann::SearchParams(32, 0.f, true));
       auto& list = lists[i];
       list.reserve(matches.size());
       for (const auto& m : matches)

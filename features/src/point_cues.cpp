@@ -53,8 +53,8 @@ estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbou
     float variation = 0.f;
     if (count(i) < 3 ||
         !estimateNormal(
-            count(i), [&](std::size_t j) { return Eigen::Vector3f(points.col(list[j])); },
-            normal, variation))
+          count(i), [&](std::size_t j) { return Eigen::Vector3f(points.col(list[j])); }, normal,
+          variation))
       continue;
     if (oriented && normal.dot(reference.col(i)) < 0.f)
       normal = -normal;
@@ -66,8 +66,8 @@ estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbou
     const int* list = nb.begin(static_cast<std::size_t>(i));
     PrincipalCurvatures pc;
     if (!principalCurvaturesFromNormals(
-            out.normals.col(i), count(i),
-            [&](std::size_t j) { return Eigen::Vector3f(out.normals.col(list[j])); }, pc))
+          out.normals.col(i), count(i),
+          [&](std::size_t j) { return Eigen::Vector3f(out.normals.col(list[j])); }, pc))
       continue;
     out.curvature_directions.col(i) = pc.direction;
     out.weights(i) = curvatureAnisotropy(pc.k_max, pc.k_min);

@@ -170,6 +170,5 @@ classifierImage(const ObjectView& view, const ClassifierInputSpec& spec)
 
 } // namespace facyl
 
-FACYL_INSTANTIATE_objectView(pcl::PointXYZ)
-FACYL_INSTANTIATE_objectView(pcl::PointXYZRGB)
-FACYL_INSTANTIATE_objectView(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_objectView(pcl::PointXYZ) FACYL_INSTANTIATE_objectView(pcl::PointXYZRGB)
+  FACYL_INSTANTIATE_objectView(pcl::PointXYZRGBA)

@@ -8,11 +8,11 @@
 #include <opencv2/dnn.hpp>
 
 #include <cmath>
+#include <dlfcn.h>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
-#include <dlfcn.h>
 #include <sys/stat.h>
 
 namespace facyl {
@@ -117,10 +117,9 @@ CylinderClassifier::load(const std::string& onnx_path)
   net_.reset();
   const auto dot = onnx_path.find_last_of('.');
   const auto slash = onnx_path.find_last_of('/');
-  const std::string stem =
-    (dot == std::string::npos || (slash != std::string::npos && dot < slash))
-      ? onnx_path
-      : onnx_path.substr(0, dot);
+  const std::string stem = (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+                             ? onnx_path
+                             : onnx_path.substr(0, dot);
   const std::string cfg = stem + ".cfg";
   const std::string why = parseClassifierModelInfo(readText(cfg, call), info_);
   if (!why.empty())
@@ -134,7 +133,8 @@ CylinderClassifier::load(const std::string& onnx_path)
   catch (const cv::Exception& e) {
     throw std::runtime_error(call + " " + onnx_path +
                              ": OpenCV cannot read it as an ONNX network (truncated or not "
-                             "ONNX?): " + e.err);
+                             "ONNX?): " +
+                             e.err);
   }
   net_ = std::move(network);
   name_ = "cnn:" + onnx_path;
@@ -191,8 +191,8 @@ CylinderClassifier::check(const std::string& what)
   catch (const cv::Exception& e) {
     net_.reset();
     std::ostringstream m;
-    m << what << ": the network does not take the described input (" << c << " x " << s
-      << " x " << s << ", channels " << toString(info_.input.channels) << "): " << e.err;
+    m << what << ": the network does not take the described input (" << c << " x " << s << " x "
+      << s << ", channels " << toString(info_.input.channels) << "): " << e.err;
     throw std::runtime_error(m.str());
   }
 }

@@ -152,8 +152,8 @@ onInnerWall(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::V
 {
   const AxialPosition x = axial(model, p);
   const float rho = x.radial.norm();
-  if (x.t < 0.f || x.t > length(model) || rho > model.radius ||
-      rho < inner_ratio * model.radius || !(rho > 0.f))
+  if (x.t < 0.f || x.t > length(model) || rho > model.radius || rho < inner_ratio * model.radius ||
+      !(rho > 0.f))
     return false;
   return -n.dot(x.radial) >= cos_max * rho; // the normal points at the axis
 }
@@ -190,7 +190,8 @@ explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     const AxialPosition x = axial(model, points.col(i));
     const float rho = x.radial.norm();
     const bool normal_known = with_normals && normals.col(i).allFinite();
-    const Eigen::Vector3f n = normal_known ? Eigen::Vector3f(normals.col(i)) : Eigen::Vector3f::Zero();
+    const Eigen::Vector3f n =
+      normal_known ? Eigen::Vector3f(normals.col(i)) : Eigen::Vector3f::Zero();
     bool lateral = std::abs(rho - model.radius) <= d && x.t >= -s.axial_margin &&
                    x.t <= h + s.axial_margin && rho > 0.f;
     if (lateral && normal_known) {
@@ -256,7 +257,8 @@ taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   for (std::size_t k = 0; k < t.size(); ++k)
     residual[k] = std::abs(rho[k] - (offset + slope * t[k]));
   std::vector<float> sorted = residual;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                   sorted.end());
   const float cut = 3.f * 1.4826f * sorted[sorted.size() / 2] + 1e-6f;
   for (std::size_t k = 0; k < t.size(); ++k)
     use[k] = residual[k] <= cut;
@@ -306,8 +308,8 @@ arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points)
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3f d = points.col(i) - model.base;
     const float angle = std::atan2(d.dot(e2), d.dot(e1)); // (-pi, pi]
-    const int k = static_cast<int>(std::floor((angle + static_cast<float>(M_PI)) /
-                                              (2.f * static_cast<float>(M_PI)) * sectors));
+    const int k = static_cast<int>(
+      std::floor((angle + static_cast<float>(M_PI)) / (2.f * static_cast<float>(M_PI)) * sectors));
     ++count[std::clamp(k, 0, sectors - 1)];
   }
   int occupied = 0;

@@ -60,8 +60,8 @@ namespace {
 
 FACYL_VOTE_CLONES float
 softVotes(float dx, float dy, float dz, const float* nx, const float* ny, const float* nz,
-          const float* cx, const float* cy, const float* cz, const float* w, Eigen::Index n,
-          int p, bool curvature)
+          const float* cx, const float* cy, const float* cz, const float* w, Eigen::Index n, int p,
+          bool curvature)
 {
   float acc = 0.f;
   if (curvature && p == 1) {
@@ -142,18 +142,17 @@ castVotes(const Eigen::Matrix3Xf& directions, const VotingCues& cues, VotingMode
   const bool curvature = mode == VotingMode::SoftCurvature;
   for (Eigen::Index i = 0; i < directions.cols(); ++i) {
     const float dx = directions(0, i), dy = directions(1, i), dz = directions(2, i);
-    votes(i) = mode == VotingMode::Rabbani
-                   ? hardVotes(dx, dy, dz, cues.nx.data(), cues.ny.data(), cues.nz.data(), n,
-                               hard_threshold)
-                   : softVotes(dx, dy, dz, cues.nx.data(), cues.ny.data(), cues.nz.data(),
-                               cues.cx.data(), cues.cy.data(), cues.cz.data(),
-                               cues.weight.data(), n, p, curvature);
+    votes(i) =
+      mode == VotingMode::Rabbani
+        ? hardVotes(dx, dy, dz, cues.nx.data(), cues.ny.data(), cues.nz.data(), n, hard_threshold)
+        : softVotes(dx, dy, dz, cues.nx.data(), cues.ny.data(), cues.nz.data(), cues.cx.data(),
+                    cues.cy.data(), cues.cz.data(), cues.weight.data(), n, p, curvature);
   }
 }
 
 std::vector<Eigen::Index>
-findPeaks(const Eigen::Matrix3Xf& directions, const Eigen::VectorXf& votes,
-          std::size_t max_peaks, float min_separation)
+findPeaks(const Eigen::Matrix3Xf& directions, const Eigen::VectorXf& votes, std::size_t max_peaks,
+          float min_separation)
 {
   std::vector<Eigen::Index> order(static_cast<std::size_t>(votes.size()));
   std::iota(order.begin(), order.end(), Eigen::Index{0});
@@ -208,7 +207,7 @@ refineAxis(const VotingCues& cues, const Eigen::Vector3f& initial, float initial
         residuals.push_back(std::abs(dn(i)));
     const float sigma = 1.4826f * medianOf(residuals);
     const float next_tolerance =
-        std::clamp(std::asin(std::min(1.f, 3.5f * sigma)), kOneDegree, tolerance);
+      std::clamp(std::asin(std::min(1.f, 3.5f * sigma)), kOneDegree, tolerance);
     const bool settled = change < 1e-5f && next_tolerance == tolerance;
     tolerance = next_tolerance;
     if (settled)

@@ -17,9 +17,8 @@ using detail::basisFor;
 void
 CylinderModel::toCoefficients(pcl::ModelCoefficients& coefficients) const
 {
-  coefficients.values = {point_on_axis.x(), point_on_axis.y(), point_on_axis.z(),
-                         axis.x(),          axis.y(),          axis.z(),
-                         radius};
+  coefficients.values = {
+    point_on_axis.x(), point_on_axis.y(), point_on_axis.z(), axis.x(), axis.y(), axis.z(), radius};
 }
 
 float
@@ -71,8 +70,7 @@ describeInliers(const Eigen::Matrix3Xf& points, CylinderModel& m)
   m.point_on_axis = m.base;
   m.height = t_max - t_min;
   m.rms_error = points.cols() == 0 ? 0.f : static_cast<float>(std::sqrt(sq / points.cols()));
-  m.angular_coverage =
-      static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
+  m.angular_coverage = static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
 }
 
 } // namespace facyl

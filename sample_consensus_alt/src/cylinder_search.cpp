@@ -36,8 +36,7 @@ validate(const HoughCylinderParameters& p)
   else if (!(p.radius_min >= 0.f) || !std::isfinite(p.radius_min))
     why << "minimum radius " << p.radius_min << " is not a finite value >= 0";
   else if (!(p.radius_max > p.radius_min))
-    why << "radius limits [" << p.radius_min << ", " << p.radius_max
-        << "] are empty or inverted";
+    why << "radius limits [" << p.radius_min << ", " << p.radius_max << "] are empty or inverted";
   else if (!(p.distance_threshold >= 0.f) || !std::isfinite(p.distance_threshold))
     why << "distance threshold " << p.distance_threshold << " is not a finite value >= 0";
   else if (!(p.normal_angle_threshold > 0.f) ||
@@ -108,13 +107,13 @@ struct Candidate {
 
 /** Robust noise estimate: 1.4826 MAD of the surface distances of the points near it. */
 float
-estimateThreshold(const CylinderCues& cues, const std::vector<int>& columns,
-                  const Candidate& c)
+estimateThreshold(const CylinderCues& cues, const std::vector<int>& columns, const Candidate& c)
 {
   std::vector<float> residuals;
   residuals.reserve(columns.size());
   for (const int s : columns) {
-    const float e = std::abs(distanceToLine(cues.points.col(s), c.point_on_axis, c.axis) - c.radius);
+    const float e =
+      std::abs(distanceToLine(cues.points.col(s), c.point_on_axis, c.axis) - c.radius);
     if (e < 0.3f * c.radius)
       residuals.push_back(e);
   }
@@ -267,8 +266,8 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
       break;
     if (auto_threshold)
       next.threshold = estimateThreshold(cues, support, next);
-    const bool settled = axisAngle(next.axis, c.axis) < 1e-5f &&
-                         std::abs(next.radius - c.radius) < 1e-6f * c.radius;
+    const bool settled =
+      axisAngle(next.axis, c.axis) < 1e-5f && std::abs(next.radius - c.radius) < 1e-6f * c.radius;
     c = next;
     if (settled)
       break;
@@ -288,7 +287,7 @@ describe(const CylinderCues& cues, const std::vector<int>& active, const Candida
   m.distance_threshold = c.threshold;
   const float normal_angle = c.normal_angle > 0.f ? c.normal_angle : params.normal_angle_threshold;
   const std::vector<int> inliers =
-      selectInliers(cues, active, c, std::cos(normal_angle), params.outward_normals);
+    selectInliers(cues, active, c, std::cos(normal_angle), params.outward_normals);
   m.inliers.assign(inliers.begin(), inliers.end());
   describeInliers(cues.points(Eigen::all, inliers), m);
   return m;
@@ -309,8 +308,7 @@ struct AxisSeed {
  * refinement reaches that far), the peaks' separation for another mode's. */
 void
 addVotePeaks(const OrientationAccumulator& acc, const VotingCues& voting, VotingMode mode,
-             const HoughCylinderParameters& params, std::size_t count,
-             std::vector<AxisSeed>& seeds)
+             const HoughCylinderParameters& params, std::size_t count, std::vector<AxisSeed>& seeds)
 {
   const float cell = acc.cellRadius();
   const float separation = std::max(4.f * cell, 10.f * kOneDegree);
@@ -355,9 +353,9 @@ addPlanarNormalsSeed(const VotingCues& voting, float cell, std::vector<AxisSeed>
 double
 candidateScore(const CylinderCues& cues, const CylinderModel& m, bool curvature)
 {
-  const double slope = normalRotationSlope(cues.points(Eigen::all, m.inliers),
-                                           cues.normals(Eigen::all, m.inliers),
-                                           m.point_on_axis, m.axis);
+  const double slope =
+    normalRotationSlope(cues.points(Eigen::all, m.inliers), cues.normals(Eigen::all, m.inliers),
+                        m.point_on_axis, m.axis);
   if (!curvature)
     return slope * static_cast<double>(m.inliers.size());
   double sum = 0.0;
@@ -382,10 +380,11 @@ struct Contender {
 class LocalNoise {
 public:
   LocalNoise(const CylinderCues& cues, const std::vector<int>& active)
-  : cues_(cues), active_(active)
-  {}
-  float
-  value() const
+      : cues_(cues)
+      , active_(active)
+  {
+  }
+  float value() const
   {
     if (!value_)
       value_ = estimateLocalNoise(cues_.points(Eigen::all, active_), 12, 128);
@@ -422,9 +421,9 @@ probeNoise(const CylinderCues& cues, const std::vector<int>& active, Candidate c
   std::vector<float> distances;
   const std::vector<int> support = supporters(cues, active, candidate.axis, params);
   for (const int col : support)
-    distances.push_back(std::abs(
-        distanceToLine(cues.points.col(col), candidate.point_on_axis, candidate.axis) -
-        candidate.radius));
+    distances.push_back(
+      std::abs(distanceToLine(cues.points.col(col), candidate.point_on_axis, candidate.axis) -
+               candidate.radius));
   float window = candidate.radius;
   float scale = 0.f;
   std::vector<float> near;
@@ -464,8 +463,8 @@ struct Settled {
  * params.normal_angle_threshold and at most 85 deg. Noisy normals then do not drop true points
  * and clean ones still keep a table or a lid's rim out. */
 NormalGate
-gateFor(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-        const RobustCylinder& fit, float window, const HoughCylinderParameters& params)
+gateFor(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals, const RobustCylinder& fit,
+        float window, const HoughCylinderParameters& params)
 {
   NormalGate gate{params.normal_angle_threshold, params.outward_normals};
   gate.max_angle = std::clamp(2.6f * normalDeviation(points, normals, fit, window),
@@ -510,8 +509,8 @@ advanceOnPoints(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   c.scale = s.fit.scale;
   c.normal_angle = s.gate.max_angle;
   c.threshold = params.distance_threshold > 0.f
-                    ? params.distance_threshold
-                    : std::clamp(3.f * c.scale, 1e-3f * c.radius, 0.5f * c.radius);
+                  ? params.distance_threshold
+                  : std::clamp(3.f * c.scale, 1e-3f * c.radius, 0.5f * c.radius);
   return true;
 }
 
@@ -549,9 +548,9 @@ settleOnPoints(const CylinderCues& cues, const std::vector<int>& active,
   };
   if (settled.size() == 1)
     return finish(settled.front());
-  const auto sharpest = std::min_element(
-      settled.begin(), settled.end(),
-      [](const Settled& a, const Settled& b) { return a.fit.scale < b.fit.scale; });
+  const auto sharpest =
+    std::min_element(settled.begin(), settled.end(),
+                     [](const Settled& a, const Settled& b) { return a.fit.scale < b.fit.scale; });
   const float scale = sharpest->fit.scale;
   const NormalGate gate = sharpest->gate;
   Settled* best = nullptr;
@@ -559,10 +558,9 @@ settleOnPoints(const CylinderCues& cues, const std::vector<int>& active,
   for (Settled& s : settled) {
     const Candidate& c = s.candidate;
     const std::vector<int> inliers =
-        selectInliers(cues, active, c, std::cos(c.normal_angle), params.outward_normals);
-    const double slope = normalRotationSlope(cues.points(Eigen::all, inliers),
-                                             cues.normals(Eigen::all, inliers),
-                                             c.point_on_axis, c.axis);
+      selectInliers(cues, active, c, std::cos(c.normal_angle), params.outward_normals);
+    const double slope = normalRotationSlope(
+      cues.points(Eigen::all, inliers), cues.normals(Eigen::all, inliers), c.point_on_axis, c.axis);
     const double score = slope * pointSupport(points, normals, gate, s.fit, scale);
     if (score > best_score) {
       best_score = score;
@@ -599,34 +597,34 @@ class SeedCompetition {
 public:
   SeedCompetition(const CylinderCues& cues, const std::vector<int>& active,
                   const VotingCues& refining, const HoughCylinderParameters& params)
-  : cues_(cues), active_(active), refining_(refining), params_(params),
-    curvature_(params.voting_mode == VotingMode::SoftCurvature)
-  {}
+      : cues_(cues)
+      , active_(active)
+      , refining_(refining)
+      , params_(params)
+      , curvature_(params.voting_mode == VotingMode::SoftCurvature)
+  {
+  }
 
-  void
-  run(const std::vector<AxisSeed>& seeds)
+  void run(const std::vector<AxisSeed>& seeds)
   {
     for (const AxisSeed& seed : seeds)
       tryOne(seed);
   }
   /** Whether the best candidate is convincing: a quarter of the points, half the
    * circumference. */
-  bool
-  convincing() const
+  bool convincing() const
   {
     const auto b = ranked(contenders_, 1);
     return !b.empty() && b[0]->model.angular_coverage >= 0.5f &&
            4 * b[0]->model.inliers.size() >= active_.size();
   }
-  std::vector<Contender>
-  contenders() &&
+  std::vector<Contender> contenders() &&
   {
     return std::move(contenders_);
   }
 
 private:
-  void
-  tryOne(const AxisSeed& seed)
+  void tryOne(const AxisSeed& seed)
   {
     Eigen::Vector3f axis = seed.axis;
     if (params_.refine) {
@@ -670,9 +668,8 @@ competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
   const VotingCues voting = gatherVotingCues(cues, voters, curvature);
   // The axis refinement needs fewer normals than the votes (the final least squares uses all
   // inliers anyway).
-  const VotingCues refining = voters.size() > 400
-                                  ? gatherVotingCues(cues, subsample(voters, 400), curvature)
-                                  : voting;
+  const VotingCues refining =
+    voters.size() > 400 ? gatherVotingCues(cues, subsample(voters, 400), curvature) : voting;
   std::vector<AxisSeed> seeds;
   for (const auto& acc : accumulators)
     addVotePeaks(acc, voting, params.voting_mode, params, params.orientation_candidates, seeds);
@@ -711,7 +708,7 @@ coarserCues(const CylinderCues& cues, const std::vector<int>& active, float radi
     if (curvature) {
       const bool measured = coarse.curvature_directions.col(i).allFinite();
       out.curvature_directions.col(s) =
-          measured ? Eigen::Vector3f(coarse.curvature_directions.col(i)) : Eigen::Vector3f::Zero();
+        measured ? Eigen::Vector3f(coarse.curvature_directions.col(i)) : Eigen::Vector3f::Zero();
       out.weights(s) = measured ? coarse.weights(i) : 0.f;
     }
   }
@@ -731,7 +728,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   if (contenders.empty())
     return std::nullopt;
   const std::vector<const Contender*> finalists =
-      ranked(contenders, std::max<std::size_t>(1, params.point_candidates));
+    ranked(contenders, std::max<std::size_t>(1, params.point_candidates));
   const Contender& best = *finalists.front();
   if (!params.refine)
     return best.model;
@@ -752,7 +749,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   // coarse cues judge them against the winner so far.
   const CylinderCues coarse = coarserCues(cues, active, params.coarse_scale * settled->radius);
   const std::vector<Contender> coarse_contenders =
-      competeSeeds(coarse, active, accumulators, params);
+    competeSeeds(coarse, active, accumulators, params);
   Contender leader;
   leader.candidate = *settled;
   std::vector<const Contender*> judged_ones{&leader};
@@ -777,9 +774,9 @@ fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>
   HoughCylinderParameters p = params;
   if (params.voting_mode == VotingMode::SoftCurvature && !curvature)
     p.voting_mode = VotingMode::SoftNormal; // the caller checks; this is a last guard
-  const std::size_t min_inliers =
-      p.min_inliers > 0 ? p.min_inliers
-                        : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+  const std::size_t min_inliers = p.min_inliers > 0
+                                    ? p.min_inliers
+                                    : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
   const double total_weight = curvature ? cues.weights.cast<double>().sum() : double(n);
 
   std::vector<char> alive(static_cast<std::size_t>(n), 1);
@@ -797,8 +794,8 @@ fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>
     for (const auto s : model->inliers)
       w += curvature ? cues.weights(s) : 1.0;
     model->confidence = total_weight > 0.0 ? static_cast<float>(w / total_weight) : 0.f;
-    model->inlier_ratio =
-        static_cast<float>(model->inliers.size()) / static_cast<float>(std::max<std::size_t>(1, total_points));
+    model->inlier_ratio = static_cast<float>(model->inliers.size()) /
+                          static_cast<float>(std::max<std::size_t>(1, total_points));
     // Remove the inliers and whatever lies inside the finite cylinder (its lids).
     for (const auto s : model->inliers)
       alive[static_cast<std::size_t>(s)] = 0;

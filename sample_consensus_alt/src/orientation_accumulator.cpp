@@ -100,9 +100,11 @@ namespace {
 /** Standard normal deviates from mt19937_64 bits, identical on every platform. */
 class NormalSource {
 public:
-  explicit NormalSource(std::uint64_t seed) : engine_(seed) {}
-  double
-  operator()()
+  explicit NormalSource(std::uint64_t seed)
+      : engine_(seed)
+  {
+  }
+  double operator()()
   {
     if (has_spare_) {
       has_spare_ = false;
@@ -117,8 +119,7 @@ public:
     has_spare_ = true;
     return r * std::cos(t);
   }
-  double
-  uniform()
+  double uniform()
   {
     return static_cast<double>(engine_() >> 11) * 0x1.0p-53;
   }
@@ -155,8 +156,8 @@ sampleOrientations(const GaussianMixture& mixture, std::size_t count, std::uint6
       std::size_t m = 0;
       if (cumulative.size() > 1) {
         const double u = rng.uniform() * total;
-        m = static_cast<std::size_t>(
-            std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin());
+        m = static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) -
+                                     cumulative.begin());
         m = std::min(m, cumulative.size() - 1);
       }
       const Eigen::Vector3f z(static_cast<float>(rng()), static_cast<float>(rng()),
@@ -188,12 +189,13 @@ medianCellSpacing(const Eigen::Matrix3Xf& d)
 }
 
 OrientationAccumulator::OrientationAccumulator(const Eigen::Matrix3Xf& directions)
-: directions_(directions)
+    : directions_(directions)
 {
   for (Eigen::Index i = 0; i < directions_.cols(); ++i) {
     const float len = directions_.col(i).norm();
     if (!(len > 0.f) || !std::isfinite(len))
-      throw std::invalid_argument("facyl::OrientationAccumulator: a direction is zero or not finite");
+      throw std::invalid_argument(
+        "facyl::OrientationAccumulator: a direction is zero or not finite");
     directions_.col(i) = foldToHemisphere(directions_.col(i) / len);
   }
 }

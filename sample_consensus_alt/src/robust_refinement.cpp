@@ -23,8 +23,8 @@ constexpr float kScaleWindow = 4.685f;
 
 /** Surface distances e = |P(x - p)| - r of \a points to the cylinder (p, a, r). */
 void
-surfaceDistances(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& p,
-                 const Eigen::Vector3f& a, float r, Eigen::ArrayXf& e)
+surfaceDistances(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& p, const Eigen::Vector3f& a,
+                 float r, Eigen::ArrayXf& e)
 {
   const Eigen::Matrix3Xf w = points.colwise() - p;
   const Eigen::RowVectorXf along = a.transpose() * w;
@@ -95,9 +95,9 @@ reweightedStep(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   a = (a + delta(2) * ud + delta(3) * vd).normalized();
   r += delta(4);
   // The step in radii (position, radius) and radians (tilt).
-  step = std::max({std::abs(delta(0)), std::abs(delta(1)), std::abs(delta(4))}) /
-             std::max(r, 1e-12) +
-         std::max(std::abs(delta(2)), std::abs(delta(3)));
+  step =
+    std::max({std::abs(delta(0)), std::abs(delta(1)), std::abs(delta(4))}) / std::max(r, 1e-12) +
+    std::max(std::abs(delta(2)), std::abs(delta(3)));
   return support;
 }
 
@@ -129,7 +129,7 @@ refineCylinderRobust(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& nor
     return false;
   const Eigen::Matrix3Xf pts = points(Eigen::all, reach);
   const Eigen::Matrix3Xf nrm =
-      normals.cols() == n ? Eigen::Matrix3Xf(normals(Eigen::all, reach)) : Eigen::Matrix3Xf();
+    normals.cols() == n ? Eigen::Matrix3Xf(normals(Eigen::all, reach)) : Eigen::Matrix3Xf();
   // Keep the point on the axis next to the supporting points (conditioning of the tilt).
   {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();

@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
-#include <cstdlib>
 
 namespace facyl {
 
@@ -48,9 +48,12 @@ finite(const pcl::PointXYZ& p)
 
 class UnionFind {
 public:
-  explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int
-  find(int a)
+  explicit UnionFind(std::size_t n)
+      : parent_(n)
+  {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  int find(int a)
   {
     while (parent_[static_cast<std::size_t>(a)] != a) {
       auto& p = parent_[static_cast<std::size_t>(a)];
@@ -59,8 +62,7 @@ public:
     }
     return a;
   }
-  void
-  unite(int a, int b)
+  void unite(int a, int b)
   {
     a = find(a), b = find(b);
     if (a != b)
@@ -77,8 +79,9 @@ class Grid {
 public:
   Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
        const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr)
-  : w_(static_cast<int>(cloud.width)), h_(static_cast<int>(cloud.height)),
-    slot_(cloud.size(), -1)
+      : w_(static_cast<int>(cloud.width))
+      , h_(static_cast<int>(cloud.height))
+      , slot_(cloud.size(), -1)
   {
     std::size_t valid = 0;
     for (const auto& q : cloud)
@@ -113,56 +116,47 @@ public:
         gap2_.push_back(gap * gap);
       }
   }
-  int
-  width() const
+  int width() const
   {
     return w_;
   }
-  int
-  height() const
+  int height() const
   {
     return h_;
   }
   /** Valid pixels. */
-  std::size_t
-  size() const
+  std::size_t size() const
   {
     return pixel_.size();
   }
-  std::size_t
-  pixel(int c) const
+  std::size_t pixel(int c) const
   {
     return pixel_[static_cast<std::size_t>(c)];
   }
   /** Compact number of pixel (u, v), or -1 (outside the image, or not valid). */
-  int
-  at(int u, int v) const
+  int at(int u, int v) const
   {
     if (u < 0 || v < 0 || u >= w_ || v >= h_)
       return -1;
     return slot_[static_cast<std::size_t>(v) * w_ + u];
   }
-  const Eigen::Vector3f&
-  point(int c) const
+  const Eigen::Vector3f& point(int c) const
   {
     return xyz_[static_cast<std::size_t>(c)];
   }
-  float
-  range(int c) const
+  float range(int c) const
   {
     return range_[static_cast<std::size_t>(c)];
   }
   /** Neighbours a and b are on one surface: no depth discontinuity. */
-  bool
-  linked(int a, int b) const
+  bool linked(int a, int b) const
   {
-    const float g2 = std::min(gap2_[static_cast<std::size_t>(a)], gap2_[static_cast<std::size_t>(b)]);
+    const float g2 =
+      std::min(gap2_[static_cast<std::size_t>(a)], gap2_[static_cast<std::size_t>(b)]);
     return (point(a) - point(b)).squaredNorm() < g2;
   }
   /** Calls f(b) for each valid 4-neighbour b of a, and g() for each other neighbour. */
-  template <typename F, typename G>
-  void
-  forNeighbours(int a, F f, G g) const
+  template <typename F, typename G> void forNeighbours(int a, F f, G g) const
   {
     const int u = u_[static_cast<std::size_t>(a)], v = v_[static_cast<std::size_t>(a)];
     for (const int b : {at(u + 1, v), at(u - 1, v), at(u, v + 1), at(u, v - 1)}) {
@@ -173,8 +167,7 @@ public:
     }
   }
   /** Image position of valid pixel c. */
-  void
-  position(int c, int& u, int& v) const
+  void position(int c, int& u, int& v) const
   {
     u = u_[static_cast<std::size_t>(c)];
     v = v_[static_cast<std::size_t>(c)];
@@ -294,8 +287,11 @@ components(const Grid& grid, Use use, std::vector<int>& label, int next)
 class Segments {
 public:
   Segments(const Grid& grid, std::vector<int> label, int count)
-  : grid_(grid), label_(std::move(label)), group_(static_cast<std::size_t>(count)),
-    size_(static_cast<std::size_t>(count), 0), boundary_(static_cast<std::size_t>(count), 0)
+      : grid_(grid)
+      , label_(std::move(label))
+      , group_(static_cast<std::size_t>(count))
+      , size_(static_cast<std::size_t>(count), 0)
+      , boundary_(static_cast<std::size_t>(count), 0)
   {
     std::iota(group_.begin(), group_.end(), 0);
     // The pairs of neighbours across segment borders, then summed per pair of segments.
@@ -325,8 +321,7 @@ public:
   }
 
   /** Fragments, then enclosed segments, join a neighbour, until nothing changes. */
-  void
-  mergeNeighbours(std::size_t min_fragment, float enclosed_share)
+  void mergeNeighbours(std::size_t min_fragment, float enclosed_share)
   {
     // Each pass joins every segment to its best neighbour at once; chains of fragments need a
     // pass per link. A noisy frame can shatter into thousands of fragments: after kMaxPasses
@@ -362,9 +357,8 @@ public:
   }
 
   /** Joins the parts of one surface on both sides of a nearer occluder. */
-  void
-  bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size_t min_part,
-                   const ObjectSegmentationParameters& p)
+  void bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size_t min_part,
+                        const ObjectSegmentationParameters& p)
   {
     std::map<int, std::vector<int>> pixels; // group -> its pixels
     for (int i = 0; i < static_cast<int>(grid_.size()); ++i)
@@ -392,8 +386,7 @@ public:
   }
 
   /** Point indices of every group, ascending. */
-  std::vector<pcl::Indices>
-  indices() const
+  std::vector<pcl::Indices> indices() const
   {
     std::vector<int> slot(group_.size(), -1);
     std::vector<pcl::Indices> out;
@@ -426,30 +419,26 @@ private:
     std::vector<GroupLink> links;
   };
 
-  static std::uint64_t
-  key(int a, int b)
+  static std::uint64_t key(int a, int b)
   {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
            static_cast<std::uint32_t>(b);
   }
-  int
-  find(int a)
+  int find(int a)
   {
     while (group_[static_cast<std::size_t>(a)] != a)
       a = group_[static_cast<std::size_t>(a)] =
         group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(a)])];
     return a;
   }
-  int
-  findConst(int a) const
+  int findConst(int a) const
   {
     while (group_[static_cast<std::size_t>(a)] != a)
       a = group_[static_cast<std::size_t>(a)];
     return a;
   }
 
-  GroupStats
-  groupStats()
+  GroupStats groupStats()
   {
     const std::size_t n = size_.size();
     GroupStats stats;
@@ -491,8 +480,7 @@ private:
   }
 
   /** Boundary pixels of a part (a 4-neighbour in another group or none), at most 100. */
-  std::vector<int>
-  border(const std::vector<int>& px, int g) const
+  std::vector<int> border(const std::vector<int>& px, int g) const
   {
     std::vector<int> out;
     for (const int i : px) {
@@ -513,9 +501,8 @@ private:
   }
 
   /** Plane (centroid, unit normal) of the points of \a px within \a radius of \a centre. */
-  bool
-  localPlane(const std::vector<int>& px, const Eigen::Vector3f& centre, float radius,
-             Eigen::Vector3f& centroid, Eigen::Vector3f& normal) const
+  bool localPlane(const std::vector<int>& px, const Eigen::Vector3f& centre, float radius,
+                  Eigen::Vector3f& centroid, Eigen::Vector3f& normal) const
   {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
@@ -540,11 +527,10 @@ private:
     return true;
   }
 
-  bool
-  sameSurfaceBehind(const std::vector<int>& pa, const std::vector<int>& pb,
-                    const std::vector<int>& ba, const std::vector<int>& bb, int g, int h,
-                    const std::vector<std::uint8_t>& has_depth,
-                    const ObjectSegmentationParameters& p) const
+  bool sameSurfaceBehind(const std::vector<int>& pa, const std::vector<int>& pb,
+                         const std::vector<int>& ba, const std::vector<int>& bb, int g, int h,
+                         const std::vector<std::uint8_t>& has_depth,
+                         const ObjectSegmentationParameters& p) const
   {
     // The closest border pixels of the two parts, in the image.
     int ia = -1, ib = -1;
@@ -574,8 +560,10 @@ private:
     std::size_t occluder = 0;
     for (int s = 1; s < steps; ++s) {
       const float t = static_cast<float>(s) / static_cast<float>(steps);
-      const int u = static_cast<int>(std::lround(static_cast<float>(ua) + t * static_cast<float>(ub - ua)));
-      const int v = static_cast<int>(std::lround(static_cast<float>(va) + t * static_cast<float>(vb - va)));
+      const int u =
+        static_cast<int>(std::lround(static_cast<float>(ua) + t * static_cast<float>(ub - ua)));
+      const int v =
+        static_cast<int>(std::lround(static_cast<float>(va) + t * static_cast<float>(vb - va)));
       const int c = grid_.at(u, v);
       if (c >= 0) {
         const int k = findConst(label_[static_cast<std::size_t>(c)]);
@@ -649,8 +637,8 @@ imageDownDirection(const pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Vec
     if (top < 0 || bottom <= top)
       continue;
     const auto ray = [&](int v) {
-      return Eigen::Vector3f((cloud.at(u, static_cast<std::uint32_t>(v)).getVector3fMap() -
-                              viewpoint).normalized());
+      return Eigen::Vector3f(
+        (cloud.at(u, static_cast<std::uint32_t>(v)).getVector3fMap() - viewpoint).normalized());
     };
     sum += ray(bottom) - ray(top);
   }
@@ -686,8 +674,8 @@ segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);
   // 1. Components without the crease pixels.
   std::vector<int> label(grid.size(), -1);
-  int count = components(grid, [&](int a) { return !crease[static_cast<std::size_t>(a)]; },
-                         label, 0);
+  int count = components(
+    grid, [&](int a) { return !crease[static_cast<std::size_t>(a)]; }, label, 0);
   // Crease pixels join the component that reaches them first (breadth first from all).
   std::vector<int> queue;
   queue.reserve(grid.size());
@@ -707,7 +695,8 @@ segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
       [] {});
   }
   // Crease pixels no component reached (thin parts) are components of their own.
-  count = components(grid, [](int) { return true; }, label, count);
+  count = components(
+    grid, [](int) { return true; }, label, count);
   // 2. Fragments and enclosed segments join their neighbour; 3. occluded parts are joined.
   Segments segments(grid, std::move(label), count);
   segments.mergeNeighbours(p.min_fragment, p.enclosed_share);

@@ -45,8 +45,8 @@ scoreSegments(const std::vector<int>& truth, const std::vector<pcl::PointIndices
         continue;
       const std::size_t inter = it->second;
       large_parts += 5 * inter >= points; // >= 20% of the object
-      const float iou = static_cast<float>(inter) /
-                        static_cast<float>(points + segment_size[s] - inter);
+      const float iou =
+        static_cast<float>(inter) / static_cast<float>(points + segment_size[s] - inter);
       if (inter > best_overlap) {
         best_overlap = inter;
         o.best_segment = static_cast<int>(s);

@@ -155,8 +155,8 @@ measureBand(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& samples,
     if (!member[i] || seen++ % stride != 0)
       continue;
     const auto c = static_cast<Eigen::Index>(i);
-    const Eigen::Vector3f p = samples.col(c).allFinite() ? Eigen::Vector3f(samples.col(c))
-                                                          : Eigen::Vector3f(cells.col(c));
+    const Eigen::Vector3f p =
+      samples.col(c).allFinite() ? Eigen::Vector3f(samples.col(c)) : Eigen::Vector3f(cells.col(c));
     ranges.push_back((p - viewpoint).norm());
     residuals.push_back(plane.head<3>().dot(p) + plane[3]);
   }
@@ -214,8 +214,8 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
   std::vector<float> range(n, 0.f);
   for (std::size_t i = 0; i < n; ++i) {
     const auto c = static_cast<Eigen::Index>(i);
-    usable[i] = !(excluded && (*excluded)[i]) && cells.col(c).allFinite() &&
-                normals.col(c).allFinite();
+    usable[i] =
+      !(excluded && (*excluded)[i]) && cells.col(c).allFinite() && normals.col(c).allFinite();
     if (usable[i])
       range[i] = (Eigen::Vector3f(cells.col(c)) - viewpoint).norm();
   }
@@ -268,7 +268,8 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
   region.band = band;
   region.max_angle = tolerance;
   region.member = members(band, 1);
-  region.members = static_cast<std::size_t>(std::count(region.member.begin(), region.member.end(), 1));
+  region.members =
+    static_cast<std::size_t>(std::count(region.member.begin(), region.member.end(), 1));
   return region.members >= 3;
 }
 
@@ -322,7 +323,8 @@ profileOf(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, Lower lo
   h.extent = box.diagonal().norm();
   const auto at = [&heights](double q) {
     const auto k = static_cast<std::size_t>(q * static_cast<double>(heights.size() - 1));
-    std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k), heights.end());
+    std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k),
+                     heights.end());
     return heights[k];
   };
   h.base = at(0.02);
@@ -337,7 +339,8 @@ HeightProfile
 heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, float min_height,
               float max_height)
 {
-  return profileOf(points, plane, [min_height](Eigen::Index) { return min_height; }, max_height);
+  return profileOf(
+    points, plane, [min_height](Eigen::Index) { return min_height; }, max_height);
 }
 
 HeightProfile

@@ -22,7 +22,8 @@ validate(const TabletopSegmentationParameters& p)
     why << "min_plane_points must be >= 3";
   else if (!(p.min_height < p.max_height) || !std::isfinite(p.min_height) ||
            !std::isfinite(p.max_height))
-    why << "height limits [" << p.min_height << ", " << p.max_height << "] must be finite, min < max";
+    why << "height limits [" << p.min_height << ", " << p.max_height
+        << "] must be finite, min < max";
   else if (!(p.cluster_tolerance > 0.f))
     why << "cluster tolerance " << p.cluster_tolerance << " must be > 0";
   else if (p.min_cluster_size < 1 || p.min_cluster_size > p.max_cluster_size)
@@ -51,5 +52,5 @@ validate(const TabletopSegmentationParameters& p)
 } // namespace facyl
 
 FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZ)
-FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGB)
-FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGBA)
+  FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGB)
+    FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGBA)

@@ -92,8 +92,8 @@ simulateCylinder(const CylinderSimulationParameters& params)
     const bool top = (i % 2) == 1;
     const float rho = r * std::sqrt(rng.uniform(0.f, 1.f));
     const float theta = 2.f * static_cast<float>(M_PI) * rng.uniform(0.f, 1.f);
-    const Eigen::Vector3f p = params.base + (top ? h : 0.f) * axis +
-                              rho * (std::cos(theta) * u + std::sin(theta) * v);
+    const Eigen::Vector3f p =
+      params.base + (top ? h : 0.f) * axis + rho * (std::cos(theta) * u + std::sin(theta) * v);
     out.cloud.push_back(makePoint(noisy(p), top ? axis : Eigen::Vector3f(-axis)));
     out.is_lid.push_back(1);
   }

@@ -143,8 +143,8 @@ acrossJump(const RayCastImage& image, int u, int v, float z, float edge_jump)
  * with probability flying_pixels, \a z moves to a random point between itself and the other
  * side. \return false if the pixel does not fly. */
 bool
-flyingDepth(const RayCastImage& image, int u, int v, const DepthSensorModel& sensor,
-            Random& rng, float& z)
+flyingDepth(const RayCastImage& image, int u, int v, const DepthSensorModel& sensor, Random& rng,
+            float& z)
 {
   if (!(sensor.flying_pixels > 0.f) || !rng.chance(sensor.flying_pixels))
     return false;
@@ -247,8 +247,8 @@ applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
       const SurfaceMaterial material = materialAt(image, idx);
       const float rho = diffuseReturn(material); // 1 on the reference material
       const float cos_incidence = image.incidence[idx];
-      if (!std::isfinite(z) || rho * cos_incidence < sensor.grazing_cos ||
-          drop < sensor.dropout || hole[idx])
+      if (!std::isfinite(z) || rho * cos_incidence < sensor.grazing_cos || drop < sensor.dropout ||
+          hole[idx])
         continue;
       if (!weak.empty() && weak[idx])
         continue;
@@ -264,9 +264,9 @@ applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
       }
       if (z < sensor.min_range || z > reach(sensor, rho))
         continue;
-      z += depthBias(sensor, z, radialPosition2(camera, static_cast<float>(u),
-                                                static_cast<float>(v)),
-                     cos_incidence);
+      z +=
+        depthBias(sensor, z, radialPosition2(camera, static_cast<float>(u), static_cast<float>(v)),
+                  cos_incidence);
       z += axialNoiseSigma(sensor, z, rho) * noise;
       if (sensor.disparity_step > 0.f) {
         const float disparity = sensor.baseline_focal / z;

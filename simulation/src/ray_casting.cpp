@@ -53,8 +53,8 @@ roots(float a, float b, float c, float& t0, float& t1)
 
 /** Lateral surface x^2 + y^2 = r^2 for z in [z0, z1]; normal outwards times \a side. */
 void
-lateral(Hit& best, const Eigen::Vector3f& o, const Eigen::Vector3f& d, float r, float z0,
-        float z1, float side)
+lateral(Hit& best, const Eigen::Vector3f& o, const Eigen::Vector3f& d, float r, float z0, float z1,
+        float side)
 {
   float t0, t1;
   if (!roots(d.x() * d.x() + d.y() * d.y(), 2.f * (o.x() * d.x() + o.y() * d.y()),
@@ -111,7 +111,8 @@ intersect(const SceneObject& obj, const Eigen::Vector3f& o, const Eigen::Vector3
       lateral(best, o, d, ri, obj.wall, h, -1.f);
       disc(best, o, d, obj.wall, 0.f, ri, 1.f);
       disc(best, o, d, h, ri, r, 1.f);
-    } else {
+    }
+    else {
       disc(best, o, d, h, 0.f, r, 1.f);
     }
     if (obj.handle) { // a chain of small spheres on a half circle beside the wall
@@ -184,7 +185,8 @@ intersect(const SceneObject& obj, const Eigen::Vector3f& o, const Eigen::Vector3
     disc(best, o, d, r, r - obj.wall, r, 1.f);
     break;
   }
-  default: break;
+  default:
+    break;
   }
   return best;
 }
@@ -223,9 +225,9 @@ paraboloid(Hit& best, const SceneObject& obj, float flat_top, const Eigen::Vecto
     if (!(t >= t_min - 1e-6) || !std::isfinite(t))
       continue;
     const Eigen::Vector3f p = o + static_cast<float>(t) * d;
-    const bool inside = box ? std::abs(p.x()) <= 0.5f * obj.size.x() &&
-                                std::abs(p.y()) <= 0.5f * obj.size.y()
-                            : p.x() * p.x() + p.y() * p.y() <= obj.radius * obj.radius;
+    const bool inside =
+      box ? std::abs(p.x()) <= 0.5f * obj.size.x() && std::abs(p.y()) <= 0.5f * obj.size.y()
+          : p.x() * p.x() + p.y() * p.y() <= obj.radius * obj.radius;
     if (inside)
       keep(best, static_cast<float>(t), o, d,
            Eigen::Vector3f(static_cast<float>(2.0 * k * p.x()), static_cast<float>(2.0 * k * p.y()),
@@ -274,21 +276,19 @@ albedo(const SceneObject& obj, const Eigen::Vector3f& p)
   return obj.colour[pick];
 }
 
-
 /** An object ready for ray casting: the eye in its frame and a bounding sphere. */
 struct Prepared {
   const SceneObject* object;
   std::uint16_t id;
   SceneClass pixel_class; ///< of its pixels
-  Eigen::Matrix3f r_lw; ///< world to local rotation
+  Eigen::Matrix3f r_lw;   ///< world to local rotation
   Eigen::Vector3f eye_local;
   Eigen::Vector3f centre; ///< world
   float bound;
 };
 
 Prepared
-prepare(const SceneObject& o, std::uint16_t id, SceneClass pixel_class,
-        const Eigen::Vector3f& eye)
+prepare(const SceneObject& o, std::uint16_t id, SceneClass pixel_class, const Eigen::Vector3f& eye)
 {
   Prepared p;
   p.object = &o;
@@ -300,7 +300,8 @@ prepare(const SceneObject& o, std::uint16_t id, SceneClass pixel_class,
   if (o.cls == SceneClass::Box) {
     extent_z = o.size.z();
     extent_r = 0.5f * std::hypot(o.size.x(), o.size.y());
-  } else if (o.cls == SceneClass::Sphere || o.cls == SceneClass::Bowl) {
+  }
+  else if (o.cls == SceneClass::Sphere || o.cls == SceneClass::Bowl) {
     extent_z = 2.f * o.radius;
   }
   if (o.top_sag > 0.f)
@@ -347,8 +348,7 @@ castBackground(const TabletopScene& scene, const Eigen::Vector3f& eye, const Eig
 
 void
 castObjects(const std::vector<Prepared>& prepared, const TabletopScene& scene,
-            const Eigen::Vector3f& eye, const Eigen::Vector3f& d, bool skip_transparent,
-            Surface& s)
+            const Eigen::Vector3f& eye, const Eigen::Vector3f& d, bool skip_transparent, Surface& s)
 {
   const float dd = d.squaredNorm();
   for (const Prepared& p : prepared) {
@@ -370,13 +370,13 @@ castObjects(const std::vector<Prepared>& prepared, const TabletopScene& scene,
     s.material = p.object->material;
     if (p.id == 1) { // the table: a checker of 10 cm cells on the top, plain legs
       const Eigen::Vector3f w = eye + hit.t * d;
-      const int cell = static_cast<int>(std::floor(w.x() / 0.1f)) +
-                       static_cast<int>(std::floor(w.y() / 0.1f));
-      const float top = p.object->top_sag != 0.f
-                          ? curvedTopHeight(*p.object, hit.local.x(), hit.local.y())
-                          : 0.f;
+      const int cell =
+        static_cast<int>(std::floor(w.x() / 0.1f)) + static_cast<int>(std::floor(w.y() / 0.1f));
+      const float top =
+        p.object->top_sag != 0.f ? curvedTopHeight(*p.object, hit.local.x(), hit.local.y()) : 0.f;
       s.albedo = w.z() - top > -0.005f ? scene.table_colour[cell & 1] : scene.table_colour[1];
-    } else {
+    }
+    else {
       s.albedo = albedo(*p.object, hit.local);
     }
   }
@@ -400,16 +400,16 @@ hasNonReferenceMaterials(const TabletopScene& scene)
 class RayCaster {
 public:
   RayCaster(const TabletopScene& scene, const CameraIntrinsics& camera)
-  : scene_(scene)
-  , camera_(camera)
-  , r_cw_(scene.camera_to_world.linear())
-  , eye_(scene.camera_to_world.translation())
+      : scene_(scene)
+      , camera_(camera)
+      , r_cw_(scene.camera_to_world.linear())
+      , eye_(scene.camera_to_world.translation())
   {
     for (const SceneObject& f : scene.furniture)
       prepared_.push_back(prepare(f, 1, SceneClass::Table, eye_));
     for (std::size_t i = 0; i < scene.objects.size(); ++i)
-      prepared_.push_back(prepare(scene.objects[i], static_cast<std::uint16_t>(i + 2),
-                                  scene.objects[i].cls, eye_));
+      prepared_.push_back(
+        prepare(scene.objects[i], static_cast<std::uint16_t>(i + 2), scene.objects[i].cls, eye_));
     for (std::size_t j = 0; j < scene.scenery.size(); ++j)
       for (const SceneObject& part : scene.scenery[j].parts)
         prepared_.push_back(prepare(part, static_cast<std::uint16_t>(kFirstSceneryId + j),
@@ -417,17 +417,14 @@ public:
   }
 
   /** The ray through pixel (u, v), in the world frame: t along it is the camera depth. */
-  Eigen::Vector3f
-  direction(int u, int v) const
+  Eigen::Vector3f direction(int u, int v) const
   {
-    const Eigen::Vector3f ray_c((u - camera_.cx) / camera_.fx, (v - camera_.cy) / camera_.fy,
-                                1.f);
+    const Eigen::Vector3f ray_c((u - camera_.cx) / camera_.fx, (v - camera_.cy) / camera_.fy, 1.f);
     return r_cw_ * ray_c;
   }
 
   /** The nearest surface along \a d; transparent objects are skipped if asked. */
-  Surface
-  cast(const Eigen::Vector3f& d, bool skip_transparent) const
+  Surface cast(const Eigen::Vector3f& d, bool skip_transparent) const
   {
     Surface s;
     castBackground(scene_, eye_, d, s);
@@ -437,8 +434,8 @@ public:
 
   /** Writes \a s, seen along \a d, into pixel \a idx of \a image: depth, incidence, shaded
    * colour, id, class and (when \a image has materials) material. */
-  void
-  record(const Surface& s, const Eigen::Vector3f& d, std::size_t idx, RayCastImage& image) const
+  void record(const Surface& s, const Eigen::Vector3f& d, std::size_t idx,
+              RayCastImage& image) const
   {
     image.id[idx] = s.id;
     image.cls[idx] = s.cls;
@@ -548,8 +545,7 @@ seeThroughTransparent(RayCastImage& image, const RayCastImage& behind,
     if (!(tau > 0.f))
       continue;
     const bool has_behind = std::isfinite(behind.depth[i]);
-    const Eigen::Vector3f back =
-      has_behind ? behind.colour[i] : Eigen::Vector3f::Constant(0.5f);
+    const Eigen::Vector3f back = has_behind ? behind.colour[i] : Eigen::Vector3f::Constant(0.5f);
     image.colour[i] = (1.f - tau) * image.colour[i] + tau * 0.9f * back; // a slight tint
     if (!has_behind || !rng.chance(tau * sensor.see_through))
       continue; // the weak front return (diffuseReturn counts the transparency)

@@ -98,7 +98,8 @@ skeleton(const SceneObject& o)
     circle(o.radius, o.radius);
     s.emplace_back(0.f, 0.f, 0.f);
     break;
-  default: break;
+  default:
+    break;
   }
   return s;
 }
@@ -227,7 +228,8 @@ setPose(SceneObject& o, const Eigen::Vector2f& centre, float z, float yaw)
     o.pose.linear() = frameWithZ(axis, 0.f);
     o.pose.translation() =
       Eigen::Vector3f(centre.x(), centre.y(), z + o.radius) - 0.5f * o.height * axis;
-  } else {
+  }
+  else {
     o.pose.linear() = frameWithZ(Eigen::Vector3f::UnitZ(), yaw);
     o.pose.translation() = Eigen::Vector3f(centre.x(), centre.y(), z);
   }
@@ -250,19 +252,19 @@ flatTop(const SceneObject& o)
 class Layout {
 public:
   Layout(const TabletopScene& scene, const Eigen::Vector2f& half_area)
-  : scene_(scene), half_area_(half_area)
-  {}
+      : scene_(scene)
+      , half_area_(half_area)
+  {
+  }
 
-  const std::vector<SceneObject>&
-  objects() const
+  const std::vector<SceneObject>& objects() const
   {
     return objects_;
   }
 
   /** True if \a f lies on the table and keeps \a margin from every placed object except
    * those in \a partners (which it may touch). */
-  bool
-  fits(const Footprint& f, float margin, const std::vector<int>& partners) const
+  bool fits(const Footprint& f, float margin, const std::vector<int>& partners) const
   {
     for (const auto& p : f.hull)
       if (!onTableTop(p))
@@ -279,15 +281,13 @@ public:
   }
 
   /** A point of the objects' area on the table. */
-  Eigen::Vector2f
-  randomSpot(Random& rng) const
+  Eigen::Vector2f randomSpot(Random& rng) const
   {
     return {rng.uniform(-half_area_.x(), half_area_.x()),
             rng.uniform(-half_area_.y(), half_area_.y())};
   }
 
-  void
-  add(SceneObject o)
+  void add(SceneObject o)
   {
     const int index = static_cast<int>(objects_.size());
     for (const int j : o.touches)
@@ -296,15 +296,13 @@ public:
     objects_.push_back(std::move(o));
   }
 
-  const Footprint&
-  footprint(std::size_t i) const
+  const Footprint& footprint(std::size_t i) const
   {
     return footprints_[i];
   }
 
 private:
-  bool
-  onTableTop(const Eigen::Vector2f& p) const
+  bool onTableTop(const Eigen::Vector2f& p) const
   {
     constexpr float inset = 0.005f;
     if (scene_.table_shape == TableShape::Round)
@@ -330,7 +328,8 @@ pickOne(Random& rng, std::size_t n, Eligible eligible)
       candidates.push_back(static_cast<int>(i));
   if (candidates.empty())
     return -1;
-  return candidates[static_cast<std::size_t>(rng.integer(0, static_cast<int>(candidates.size()) - 1))];
+  return candidates[static_cast<std::size_t>(
+    rng.integer(0, static_cast<int>(candidates.size()) - 1))];
 }
 
 constexpr float kApart = 0.02f;   ///< gap between objects that do not touch (m)
@@ -348,9 +347,8 @@ bool
 placeTouching(SceneObject& o, const Layout& layout, Random& rng)
 {
   const auto& placed = layout.objects();
-  const int b = pickOne(rng, placed.size(), [&](std::size_t i) {
-    return placed[i].support < 0 && !placed[i].leaning;
-  });
+  const int b = pickOne(rng, placed.size(),
+                        [&](std::size_t i) { return placed[i].support < 0 && !placed[i].leaning; });
   if (b < 0)
     return false;
   const float yaw = rng.uniform(-kPi, kPi), phi = rng.uniform(-kPi, kPi);
@@ -401,7 +399,8 @@ placeStacked(SceneObject& o, const Layout& layout, Random& rng)
     const Eigen::Vector2f local(rng.uniform(-0.3f, 0.3f) * base.size.x(),
                                 rng.uniform(-0.3f, 0.3f) * base.size.y());
     centre += base.pose.linear().topLeftCorner<2, 2>() * local;
-  } else {
+  }
+  else {
     const float slack = std::max(0.f, base.radius - 0.8f * o.radius);
     const float t = rng.uniform(-kPi, kPi), r = rng.uniform(0.f, 0.5f) * slack;
     centre += r * Eigen::Vector2f(std::cos(t), std::sin(t));
@@ -498,7 +497,8 @@ drawTable(const TabletopSceneParameters& params, Random& rng, TabletopScene& sce
     top.cls = SceneClass::Cylinder; // shape only: the pixels are the table's
     top.radius = scene.table_radius;
     top.height = kSlab;
-  } else {
+  }
+  else {
     top.cls = SceneClass::Box;
     top.size = Eigen::Vector3f(scene.table_width, scene.table_depth, kSlab);
   }
@@ -513,7 +513,8 @@ drawTable(const TabletopSceneParameters& params, Random& rng, TabletopScene& sce
       pedestal.height = leg_height;
       pedestal.pose.translation() = Eigen::Vector3f(0.f, 0.f, -scene.table_height);
       scene.furniture.push_back(pedestal);
-    } else {
+    }
+    else {
       for (int k = 0; k < 4; ++k) {
         SceneObject leg;
         leg.cls = SceneClass::Box;
@@ -580,9 +581,9 @@ generateTabletopScene(const TabletopSceneParameters& params)
           : Eigen::Vector2f(std::min(0.36f, 0.5f * scene.table_width - 0.1f),
                             std::min(0.24f, 0.5f * scene.table_depth - 0.1f));
   Layout layout(scene, half_area);
-  const std::size_t count = params.min_objects + static_cast<std::size_t>(rng.integer(
-                                                   0, static_cast<int>(params.max_objects -
-                                                                       params.min_objects)));
+  const std::size_t count =
+    params.min_objects + static_cast<std::size_t>(rng.integer(
+                           0, static_cast<int>(params.max_objects - params.min_objects)));
   for (std::size_t attempt = 0; layout.objects().size() < count && attempt < 60 * count + 20;
        ++attempt) {
     const double mode = rng.unit();

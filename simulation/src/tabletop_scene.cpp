@@ -16,14 +16,22 @@ std::string
 toString(SceneClass c)
 {
   switch (c) {
-  case SceneClass::Background: return "background";
-  case SceneClass::Table: return "table";
-  case SceneClass::Cylinder: return "cylinder";
-  case SceneClass::Box: return "box";
-  case SceneClass::Sphere: return "sphere";
-  case SceneClass::Cone: return "cone";
-  case SceneClass::Bowl: return "bowl";
-  case SceneClass::Scenery: return "scenery";
+  case SceneClass::Background:
+    return "background";
+  case SceneClass::Table:
+    return "table";
+  case SceneClass::Cylinder:
+    return "cylinder";
+  case SceneClass::Box:
+    return "box";
+  case SceneClass::Sphere:
+    return "sphere";
+  case SceneClass::Cone:
+    return "cone";
+  case SceneClass::Bowl:
+    return "bowl";
+  case SceneClass::Scenery:
+    return "scenery";
   }
   return "unknown";
 }
@@ -177,8 +185,8 @@ namespace {
 
 /** renderTabletopScene with a sensor that is not drawn. */
 RenderedScene
-render(const TabletopScene& scene, const CameraIntrinsics& camera,
-       const DepthSensorModel& sensor, std::uint64_t seed)
+render(const TabletopScene& scene, const CameraIntrinsics& camera, const DepthSensorModel& sensor,
+       std::uint64_t seed)
 {
   TabletopSceneParameters check;
   check.camera = camera;
@@ -285,15 +293,13 @@ drawnSensorJson(const RenderedScene& r)
     << ",\"edge_jump\":" << m.edge_jump << ",\"grazing_cos\":" << m.grazing_cos
     << ",\"dropout\":" << m.dropout << ",\"hole_rate\":" << m.hole_rate
     << ",\"hole_radius\":" << m.hole_radius << ",\"edge_fattening\":" << m.edge_fattening
-    << ",\"flying_pixels\":" << m.flying_pixels << ",\"colour_shift\":[" << m.colour_shift_u
-    << "," << m.colour_shift_v << "],\"min_range\":" << m.min_range
-    << ",\"max_range\":" << m.max_range << ",\"colour_noise\":" << m.colour_noise
-    << ",\"depth_scale_error\":" << m.depth_scale_error
+    << ",\"flying_pixels\":" << m.flying_pixels << ",\"colour_shift\":[" << m.colour_shift_u << ","
+    << m.colour_shift_v << "],\"min_range\":" << m.min_range << ",\"max_range\":" << m.max_range
+    << ",\"colour_noise\":" << m.colour_noise << ",\"depth_scale_error\":" << m.depth_scale_error
     << ",\"radial_depth_bias\":" << m.radial_depth_bias
     << ",\"incidence_bias\":" << m.incidence_bias
     << ",\"weak_return_dropout\":" << m.weak_return_dropout
-    << ",\"highlight_width\":" << m.highlight_width << ",\"see_through\":" << m.see_through
-    << "}";
+    << ",\"highlight_width\":" << m.highlight_width << ",\"see_through\":" << m.see_through << "}";
   return s.str();
 }
 } // namespace
@@ -350,11 +356,13 @@ groundTruthJson(const RenderedScene& r)
       s << ",\"radius\":" << o.radius;
     if (o.cls == SceneClass::Cylinder) {
       const CylinderTruth ct = cylinderTruth(r.scene, o);
-      s << ",\"pose\":\"" << (o.lying ? "lying" : "upright") << "\",\"open_top\":"
-        << (o.open_top ? "true" : "false") << ",\"handle\":" << (o.handle ? "true" : "false")
+      s << ",\"pose\":\"" << (o.lying ? "lying" : "upright")
+        << "\",\"open_top\":" << (o.open_top ? "true" : "false")
+        << ",\"handle\":" << (o.handle ? "true" : "false")
         << ",\"cylinder\":{\"point_on_axis\":" << vec(ct.base) << ",\"axis\":" << vec(ct.axis)
         << ",\"radius\":" << ct.radius << ",\"height\":" << ct.height << "}";
-    } else if (o.cls == SceneClass::Cone) {
+    }
+    else if (o.cls == SceneClass::Cone) {
       s << ",\"height\":" << o.height;
     }
     s << materialJson("material", o.material) << "}";

@@ -58,8 +58,8 @@ changeableObject(const TabletopScene& scene, Random& rng)
     for (const auto& o : scene.objects) {
       if (o.support == static_cast<int>(k))
         held = true;
-      if (o.leaning && std::find(o.touches.begin(), o.touches.end(), static_cast<int>(k)) !=
-                         o.touches.end())
+      if (o.leaning &&
+          std::find(o.touches.begin(), o.touches.end(), static_cast<int>(k)) != o.touches.end())
         held = true;
     }
     if (held)
@@ -80,9 +80,12 @@ std::string
 toString(TabletopSequenceParameters::Change c)
 {
   switch (c) {
-  case TabletopSequenceParameters::Change::Remove: return "remove";
-  case TabletopSequenceParameters::Change::Add: return "add";
-  default: return "none";
+  case TabletopSequenceParameters::Change::Remove:
+    return "remove";
+  case TabletopSequenceParameters::Change::Add:
+    return "add";
+  default:
+    return "none";
   }
 }
 
@@ -202,16 +205,16 @@ generateTabletopSequence(const TabletopSceneParameters& scene_params,
   for (std::size_t k = 0; k < params.frames; ++k) {
     const float s = static_cast<float>(k) / static_cast<float>(params.frames - 1);
     const float az = azimuth + direction * params.orbit * s;
-    const float el = std::min(
-      1.45f, std::max(0.26f, elevation + params.elevation_swing *
-                                           (std::sin(kTwoPi * s + phase_elevation) -
-                                            std::sin(phase_elevation))));
+    const float el =
+      std::min(1.45f, std::max(0.26f, elevation + params.elevation_swing *
+                                                    (std::sin(kTwoPi * s + phase_elevation) -
+                                                     std::sin(phase_elevation))));
     float d = distance * (1.f + params.distance_swing * (std::sin(kTwoPi * s + phase_distance) -
                                                          std::sin(phase_distance)));
     d = std::max(d, (tallest - target.z() + scene_params.sensor.min_range + 0.05f) / std::sin(el));
     const Eigen::Vector3f e =
-      target + d * Eigen::Vector3f(std::sin(az) * std::cos(el), -std::cos(az) * std::cos(el),
-                                   std::sin(el));
+      target +
+      d * Eigen::Vector3f(std::sin(az) * std::cos(el), -std::cos(az) * std::cos(el), std::sin(el));
     Eigen::Isometry3f pose = Eigen::Isometry3f::Identity();
     pose.linear() = lookAt(e, target) * roll;
     pose.translation() = e;

@@ -1,10 +1,11 @@
 // The README's example: fit a cylinder to a cloud with facyl.
-#include <facyl/features/normal_curvature_estimation.h>
-#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <cmath>
 #include <cstdio>
+#include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 
-int main()
+int
+main()
 {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   for (int i = 0; i < 2000; ++i) // a can: radius 3 cm, axis along z

@@ -9,7 +9,8 @@
 #include <cmath>
 #include <cstdio>
 
-int main()
+int
+main()
 {
   pcl::PointCloud<pcl::PointXYZI>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZI>);
   for (int i = 0; i < 2000; ++i) { // a can: radius 3 cm, axis along z

@@ -101,13 +101,20 @@ std::string
 toString(TrackStatus s)
 {
   switch (s) {
-  case TrackStatus::Seen: return "seen";
-  case TrackStatus::Missed: return "missed";
-  case TrackStatus::Occluded: return "occluded";
-  case TrackStatus::Merged: return "merged";
-  case TrackStatus::SeenThrough: return "seen_through";
-  case TrackStatus::OutOfView: return "out_of_view";
-  case TrackStatus::NotUpdated: return "not_updated";
+  case TrackStatus::Seen:
+    return "seen";
+  case TrackStatus::Missed:
+    return "missed";
+  case TrackStatus::Occluded:
+    return "occluded";
+  case TrackStatus::Merged:
+    return "merged";
+  case TrackStatus::SeenThrough:
+    return "seen_through";
+  case TrackStatus::OutOfView:
+    return "out_of_view";
+  case TrackStatus::NotUpdated:
+    return "not_updated";
   }
   return "unknown";
 }
@@ -116,10 +123,14 @@ std::string
 toString(TrackAssignment::Role r)
 {
   switch (r) {
-  case TrackAssignment::Role::Ignored: return "ignored";
-  case TrackAssignment::Role::Matched: return "matched";
-  case TrackAssignment::Role::Started: return "started";
-  case TrackAssignment::Role::Fragment: return "fragment";
+  case TrackAssignment::Role::Ignored:
+    return "ignored";
+  case TrackAssignment::Role::Matched:
+    return "matched";
+  case TrackAssignment::Role::Started:
+    return "started";
+  case TrackAssignment::Role::Fragment:
+    return "fragment";
   }
   return "unknown";
 }
@@ -196,10 +207,10 @@ CylinderTracker::cylinderInFrame(const CylinderTrack& t) const
 
 struct CylinderTracker::Observation {
   bool valid{false};
-  AssociationGeometry geometry; ///< world
+  AssociationGeometry geometry;                                                ///< world
   Eigen::Vector3f base{Eigen::Vector3f::Zero()}, top{Eigen::Vector3f::Zero()}; ///< world
-  float p{0.5f};       ///< evidence that it is a cylinder
-  float quality{1.f};  ///< points x angular coverage of the fit (cylinders)
+  float p{0.5f};      ///< evidence that it is a cylinder
+  float quality{1.f}; ///< points x angular coverage of the fit (cylinders)
   int support{-1};
   std::size_t points{0};
 };
@@ -321,14 +332,16 @@ CylinderTracker::correct(CylinderTrack& t, const Observation& o, float weight)
       t.lo = -0.5f * g.height;
       t.hi = 0.5f * g.height;
       t.var_extent = square(params_.measurement_extent);
-      t.fits.assign(1, CylinderTrack::Fit{t.axis, t.centre, t.radius, o.quality * o.quality * weight});
+      t.fits.assign(1,
+                    CylinderTrack::Fit{t.axis, t.centre, t.radius, o.quality * o.quality * weight});
     }
     else {
       // Observations count by what the frame saw of the object (reference_quality).
       const float scale =
         std::clamp(params_.reference_quality / std::max(o.quality, 1e-3f), 0.25f, 4.f) / weight;
       // The history: the axis most fits agree with, the line and radius they give.
-      t.fits.push_back(CylinderTrack::Fit{g.axis, g.centre, g.radius, o.quality * o.quality * weight});
+      t.fits.push_back(
+        CylinderTrack::Fit{g.axis, g.centre, g.radius, o.quality * o.quality * weight});
       if (t.fits.size() > static_cast<std::size_t>(params_.history))
         t.fits.erase(t.fits.begin(), t.fits.end() - params_.history);
       std::vector<Eigen::Vector3f> axes;
@@ -409,7 +422,8 @@ CylinderTracker::viewStatus(const CylinderTrack& t, const TrackerView& view,
   if (!(c.z() > 0.05f))
     return TrackStatus::OutOfView;
   const auto inImage = [&cam](const Eigen::Vector2f& uv) {
-    return uv.x() >= 0.f && uv.y() >= 0.f && uv.x() <= cam.width - 1.f && uv.y() <= cam.height - 1.f;
+    return uv.x() >= 0.f && uv.y() >= 0.f && uv.x() <= cam.width - 1.f &&
+           uv.y() <= cam.height - 1.f;
   };
   const Eigen::Vector2f uv = cam.project(c);
   if (!inImage(uv))
@@ -436,17 +450,18 @@ CylinderTracker::viewStatus(const CylinderTrack& t, const TrackerView& view,
       towards.normalize();
       const Eigen::Vector3f across = a.cross(towards);
       for (const float s : {-0.5f, 0.f, 0.5f})
-        probes.push_back({q + across * (s * t.radius) - towards * (t.radius * std::sqrt(1.f - s * s)),
-                          tolerance, tolerance});
+        probes.push_back(
+          {q + across * (s * t.radius) - towards * (t.radius * std::sqrt(1.f - s * s)), tolerance,
+           tolerance});
     }
   }
   else {
     // The centroid of the visible points lies behind the visible surface, by up to the
     // object's depth: nearer surfaces count only well in front of it.
     const float d = 0.02f * c.z();
-    for (const Eigen::Vector3f& o : {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(d, 0, 0),
-                                     Eigen::Vector3f(-d, 0, 0), Eigen::Vector3f(0, d, 0),
-                                     Eigen::Vector3f(0, -d, 0)})
+    for (const Eigen::Vector3f& o :
+         {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(d, 0, 0), Eigen::Vector3f(-d, 0, 0),
+          Eigen::Vector3f(0, d, 0), Eigen::Vector3f(0, -d, 0)})
       probes.push_back({c + o, tolerance + 0.08f, tolerance + 0.03f});
   }
   int finite = 0, nearer = 0, farther = 0;
@@ -456,7 +471,8 @@ CylinderTracker::viewStatus(const CylinderTrack& t, const TrackerView& view,
     const Eigen::Vector2f q = cam.project(probe.p);
     if (!inImage(q))
       continue;
-    const float d = view.depth(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())));
+    const float d =
+      view.depth(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())));
     if (!std::isfinite(d))
       continue;
     ++finite;
@@ -518,25 +534,25 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
     return on[static_cast<std::size_t>(a)] > on[static_cast<std::size_t>(b)];
   });
   preference.insert(preference.end(), others.begin(), others.end());
-  preference.erase(std::remove_if(preference.begin(), preference.end(),
-                                  [&](int k) {
-                                    return !supports[static_cast<std::size_t>(k)].frame.matrix().allFinite();
-                                  }),
-                   preference.end());
+  preference.erase(
+    std::remove_if(
+      preference.begin(), preference.end(),
+      [&](int k) { return !supports[static_cast<std::size_t>(k)].frame.matrix().allFinite(); }),
+    preference.end());
   const bool continuing = has_pose_ && world_on_support_;
   // The camera keeps its motion between two frames (constant velocity) when the last two
   // frames were anchored one after the other; else it stays where it was.
   const Eigen::Affine3f predicted =
-    has_velocity_ ? Eigen::Affine3f(frame_to_world_ * (previous_frame_to_world_.inverse() * frame_to_world_))
-                  : frame_to_world_;
+    has_velocity_
+      ? Eigen::Affine3f(frame_to_world_ * (previous_frame_to_world_.inverse() * frame_to_world_))
+      : frame_to_world_;
   const Eigen::Affine3f last_pose = frame_to_world_;
   const bool last_anchored = info_.anchored && !info_.skipped;
   const auto continues = [&](int k) {
     const Eigen::Affine3f m = predicted * supports[static_cast<std::size_t>(k)].frame;
     const float cos_angle = std::min(1.f, std::abs(m.linear().col(2).normalized().z()));
     return std::acos(cos_angle) <= params_.max_plane_angle &&
-           std::abs(m.translation().z()) <= params_.max_plane_offset &&
-           m.linear().col(2).z() > 0.f;
+           std::abs(m.translation().z()) <= params_.max_plane_offset && m.linear().col(2).z() > 0.f;
   };
   int anchor = -1;
   bool plane_jump = false;
@@ -691,13 +707,14 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
           continue;
         ++confirmed;
         int inside = 0;
-        const TrackStatus s = viewStatus(t, TrackerView{view.camera, view.sensor_pose, {}}, {}, inside);
+        const TrackStatus s =
+          viewStatus(t, TrackerView{view.camera, view.sensor_pose, {}}, {}, inside);
         expected += s != TrackStatus::OutOfView;
       }
       expected = std::min(expected, seen);
-      const bool no_overlap =
-        params_.min_overlap > 0.f && expected >= 3 &&
-        static_cast<float>(reg.matched_objects) < params_.min_overlap * static_cast<float>(expected);
+      const bool no_overlap = params_.min_overlap > 0.f && expected >= 3 &&
+                              static_cast<float>(reg.matched_objects) <
+                                params_.min_overlap * static_cast<float>(expected);
       if (confirmed > 0 && ((plane_jump && reg.matched_objects < 2) || no_overlap)) {
         endTracks();
         new_scene = true;
@@ -755,11 +772,13 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       loose.sigma_centroid *= 2.f;
       loose.sigma_radius *= 2.f;
       loose.sigma_axis *= 2.f;
-      Eigen::MatrixXf c2(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(cols.size()));
+      Eigen::MatrixXf c2(static_cast<Eigen::Index>(rows.size()),
+                         static_cast<Eigen::Index>(cols.size()));
       for (std::size_t a = 0; a < rows.size(); ++a)
         for (std::size_t b = 0; b < cols.size(); ++b)
-          c2(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = associationCost(
-            tg[static_cast<std::size_t>(cols[b])], obs[static_cast<std::size_t>(rows[a])].geometry, loose);
+          c2(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+            associationCost(tg[static_cast<std::size_t>(cols[b])],
+                            obs[static_cast<std::size_t>(rows[a])].geometry, loose);
       const std::vector<int> second = assignMinimumCost(c2, params_.association.gate);
       for (std::size_t a = 0; a < rows.size(); ++a)
         if (second[a] >= 0)
@@ -803,14 +822,15 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
         const Eigen::Vector3f d = o.geometry.centroid - t.centre;
         const float along = d.dot(t.axis);
         const float across = (d - along * t.axis).norm();
-        if (across <= t.radius + params_.fragment_margin && along >= t.lo - params_.fragment_margin &&
-            along <= t.hi + params_.fragment_margin)
+        if (across <= t.radius + params_.fragment_margin &&
+            along >= t.lo - params_.fragment_margin && along <= t.hi + params_.fragment_margin)
           gain = 1.f;
       }
       if (gain == 0.f) { // the two pieces together are nearer the track than its match alone
         const float wi = static_cast<float>(o.points), wj = static_cast<float>(mo.points);
         if (wi + wj > 0.f) {
-          const Eigen::Vector3f merged = (wi * o.geometry.centroid + wj * mo.geometry.centroid) / (wi + wj);
+          const Eigen::Vector3f merged =
+            (wi * o.geometry.centroid + wj * mo.geometry.centroid) / (wi + wj);
           const float before = (mo.geometry.centroid - t.centroid).norm();
           const float after = (merged - t.centroid).norm();
           if (after + 0.005f < before &&
@@ -854,8 +874,12 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       continue;
     }
     switch (t.status) {
-    case TrackStatus::OutOfView: ++t.out_of_view; break;
-    case TrackStatus::Occluded: ++t.occluded; break;
+    case TrackStatus::OutOfView:
+      ++t.out_of_view;
+      break;
+    case TrackStatus::Occluded:
+      ++t.occluded;
+      break;
     case TrackStatus::Merged: {
       auto& a = assignments_[static_cast<std::size_t>(inside)];
       if (a.role == TrackAssignment::Role::Started && t.seen_through == 0) {
@@ -887,7 +911,9 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       t.misses += params_.see_through_misses;
       ++t.seen_through;
       break;
-    default: t.misses += 1; break;
+    default:
+      t.misses += 1;
+      break;
     }
   }
   // Two tracks of one object (a new one started while the old one was merged into another
@@ -898,7 +924,8 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
       auto& older = tracks_[i];
       auto& younger = tracks_[j];
       if (i == j || older.id >= younger.id || younger.misses > 1000 || older.misses > 1000 ||
-          !younger.confirmed || (older.status == TrackStatus::Seen && younger.status == TrackStatus::Seen))
+          !younger.confirmed ||
+          (older.status == TrackStatus::Seen && younger.status == TrackStatus::Seen))
         continue;
       const AssociationGeometry a = geometryOf(older), b = geometryOf(younger);
       if (associationCost(a, b, params_.association) >= 1.f)
@@ -952,6 +979,5 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
 
 } // namespace facyl
 
-FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZ)
-FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGB)
-FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZ) FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGB)
+  FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGBA)

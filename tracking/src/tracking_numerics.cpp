@@ -104,16 +104,15 @@ struct Landmarks {
   const Eigen::Matrix2Xf& track_axes;
 
   /** Both ends of candidate \a k have an axis: they agree along a line. */
-  bool
-  isLine(const RegistrationCandidate& k) const
+  bool isLine(const RegistrationCandidate& k) const
   {
     return object_axes.cols() > k.object && track_axes.cols() > k.track &&
-           object_axes.col(k.object).squaredNorm() > 0.5f && track_axes.col(k.track).squaredNorm() > 0.5f;
+           object_axes.col(k.object).squaredNorm() > 0.5f &&
+           track_axes.col(k.track).squaredNorm() > 0.5f;
   }
   /** Residual of \a k under \a t: the distance of the points, or for a line the distance
    * across the track's axis and the angle between the axes (times kAxisArm). */
-  float
-  residual(const RegistrationCandidate& k, const PlanarRigid& t) const
+  float residual(const RegistrationCandidate& k, const PlanarRigid& t) const
   {
     const Eigen::Vector2f d = t.apply(objects.col(k.object)) - tracks.col(k.track);
     if (!isLine(k))
@@ -128,10 +127,9 @@ struct Landmarks {
   }
   /** The point pairs \a k gives a Procrustes fit at \a t, with weight \a w: the points, or for
    * a line a segment along each axis, the track's centred where the object's lies across it. */
-  void
-  pairs(const RegistrationCandidate& k, const PlanarRigid& t, float w,
-        std::vector<Eigen::Vector2f>& from, std::vector<Eigen::Vector2f>& to,
-        std::vector<float>& weights) const
+  void pairs(const RegistrationCandidate& k, const PlanarRigid& t, float w,
+             std::vector<Eigen::Vector2f>& from, std::vector<Eigen::Vector2f>& to,
+             std::vector<float>& weights) const
   {
     const Eigen::Vector2f o = objects.col(k.object);
     if (!isLine(k)) {
@@ -323,7 +321,8 @@ registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
         if (closest[i] >= 0) {
           const auto& k = near[static_cast<std::size_t>(closest[i])];
           l.pairs(k, local,
-                  k.weight / (k.tolerance * k.tolerance) * huberWeight(residual[i], k.tolerance, 1.f),
+                  k.weight / (k.tolerance * k.tolerance) *
+                    huberWeight(residual[i], k.tolerance, 1.f),
                   from, to, w);
         }
       if (from.empty())
@@ -435,7 +434,8 @@ assignMinimumCost(const Eigen::MatrixXf& cost, float gate)
     return std::isfinite(c) && c <= gate ? static_cast<double>(c) : big;
   };
   const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> u(static_cast<std::size_t>(n + 1), 0.0), v(static_cast<std::size_t>(m + 1), 0.0);
+  std::vector<double> u(static_cast<std::size_t>(n + 1), 0.0),
+    v(static_cast<std::size_t>(m + 1), 0.0);
   std::vector<int> p(static_cast<std::size_t>(m + 1), 0), way(static_cast<std::size_t>(m + 1), 0);
   for (int i = 1; i <= n; ++i) {
     p[0] = i;
@@ -449,8 +449,8 @@ assignMinimumCost(const Eigen::MatrixXf& cost, float gate)
       int j1 = 0;
       for (int j = 1; j <= m; ++j)
         if (!used[static_cast<std::size_t>(j)]) {
-          const double cur = at(i0 - 1, j - 1) - u[static_cast<std::size_t>(i0)] -
-                             v[static_cast<std::size_t>(j)];
+          const double cur =
+            at(i0 - 1, j - 1) - u[static_cast<std::size_t>(i0)] - v[static_cast<std::size_t>(j)];
           if (cur < minv[static_cast<std::size_t>(j)]) {
             minv[static_cast<std::size_t>(j)] = cur;
             way[static_cast<std::size_t>(j)] = j0;
@@ -567,7 +567,8 @@ median(std::vector<float> values)
   if (values.size() % 2)
     return values[h];
   const float upper = values[h];
-  return 0.5f * (upper + *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(h)));
+  return 0.5f * (upper + *std::max_element(values.begin(),
+                                           values.begin() + static_cast<std::ptrdiff_t>(h)));
 }
 
 float

@@ -59,8 +59,8 @@ estimateNormal(std::size_t count, PointAt point_at, Eigen::Vector3f& normal,
   const Eigen::Vector3f mean = sum * inv;
   Eigen::Matrix3f cov;
   cov << xx * inv, xy * inv, xz * inv, //
-      xy * inv, yy * inv, yz * inv,    //
-      xz * inv, yz * inv, zz * inv;
+    xy * inv, yy * inv, yz * inv,      //
+    xz * inv, yz * inv, zz * inv;
   cov -= mean * mean.transpose();
   const float scale = cov.cwiseAbs().maxCoeff();
   if (!(scale > 0.f) || !std::isfinite(scale))
@@ -88,8 +88,8 @@ estimateNormal(std::size_t count, PointAt point_at, Eigen::Vector3f& normal,
  */
 template <typename NormalAt>
 bool
-principalCurvaturesFromNormals(const Eigen::Vector3f& normal, std::size_t count,
-                               NormalAt normal_at, PrincipalCurvatures& out)
+principalCurvaturesFromNormals(const Eigen::Vector3f& normal, std::size_t count, NormalAt normal_at,
+                               PrincipalCurvatures& out)
 {
   const Eigen::Vector3f t1 = normal.unitOrthogonal();
   const Eigen::Vector3f t2 = normal.cross(t1);

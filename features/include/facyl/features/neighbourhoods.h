@@ -18,21 +18,17 @@ struct Neighbourhoods {
   std::vector<int> indices;
 
   /** \brief Number of queries. */
-  std::size_t
-  size() const
+  std::size_t size() const
   {
     return offsets.size() - 1;
   }
   /** \brief Number of neighbours of query \a i. */
-  std::size_t
-  count(std::size_t i) const
+  std::size_t count(std::size_t i) const
   {
     return offsets[i + 1] - offsets[i];
   }
   /** \brief Compressed rows from one list of neighbour indices per query. */
-  template <typename List>
-  static Neighbourhoods
-  fromLists(const std::vector<List>& lists)
+  template <typename List> static Neighbourhoods fromLists(const std::vector<List>& lists)
   {
     Neighbourhoods out;
     out.offsets.assign(lists.size() + 1, 0);
@@ -44,8 +40,7 @@ struct Neighbourhoods {
     return out;
   }
   /** \brief Pointer to the first neighbour of query \a i. */
-  const int*
-  begin(std::size_t i) const
+  const int* begin(std::size_t i) const
   {
     return indices.data() + offsets[i];
   }
@@ -64,18 +59,15 @@ public:
   explicit NeighbourSearch(const Eigen::Matrix3Xf& surface);
   ~NeighbourSearch();
   NeighbourSearch(const NeighbourSearch&) = delete;
-  NeighbourSearch&
-  operator=(const NeighbourSearch&) = delete;
+  NeighbourSearch& operator=(const NeighbourSearch&) = delete;
 
   /** \brief The k nearest surface points of every query column, nearest first.
    * \throws std::invalid_argument if k < 1. */
-  Neighbourhoods
-  nearest(const Eigen::Matrix3Xf& queries, int k, int threads = 0) const;
+  Neighbourhoods nearest(const Eigen::Matrix3Xf& queries, int k, int threads = 0) const;
 
   /** \brief Every surface point within \a radius of each query column, nearest first.
    * \throws std::invalid_argument if radius is not positive and finite. */
-  Neighbourhoods
-  within(const Eigen::Matrix3Xf& queries, float radius, int threads = 0) const;
+  Neighbourhoods within(const Eigen::Matrix3Xf& queries, float radius, int threads = 0) const;
 
 private:
   struct Impl;

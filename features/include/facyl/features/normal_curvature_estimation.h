@@ -44,71 +44,65 @@ public:
   using PointCloudOut = typename pcl::Feature<PointInT, PointOutT>::PointCloudOut;
   using NormalCloudConstPtr = pcl::PointCloud<pcl::Normal>::ConstPtr;
 
-  NormalCurvatureEstimation() { this->feature_name_ = "NormalCurvatureEstimation"; }
+  NormalCurvatureEstimation()
+  {
+    this->feature_name_ = "NormalCurvatureEstimation";
+  }
 
   /** \brief Point towards which the normals are flipped (default: the input cloud's
    * sensor_origin_, as in pcl::NormalEstimation; the origin for a cloud without a pose). */
-  void
-  setViewPoint(float vpx, float vpy, float vpz)
+  void setViewPoint(float vpx, float vpy, float vpz)
   {
     view_point_ = Eigen::Vector3f(vpx, vpy, vpz);
     use_sensor_origin_ = false;
   }
   /** \brief The view point set with setViewPoint, or the input's sensor origin. */
-  Eigen::Vector3f
-  getViewPoint() const
+  Eigen::Vector3f getViewPoint() const
   {
-    return use_sensor_origin_ && this->input_ ? Eigen::Vector3f(this->input_->sensor_origin_.template head<3>())
-                                              : view_point_;
+    return use_sensor_origin_ && this->input_
+             ? Eigen::Vector3f(this->input_->sensor_origin_.template head<3>())
+             : view_point_;
   }
   /** \brief Flip the normals towards the input's sensor_origin_ again (the default). */
-  void
-  useSensorOriginAsViewPoint()
+  void useSensorOriginAsViewPoint()
   {
     use_sensor_origin_ = true;
   }
 
   /** \brief Known normals, one per point of the search surface (the input when no surface was
    * set). Only the curvatures are then estimated. Pass nullptr to estimate normals again. */
-  void
-  setInputNormals(const NormalCloudConstPtr& normals)
+  void setInputNormals(const NormalCloudConstPtr& normals)
   {
     input_normals_ = normals;
   }
   /** \brief The normals given with setInputNormals, or nullptr. */
-  NormalCloudConstPtr
-  getInputNormals() const
+  NormalCloudConstPtr getInputNormals() const
   {
     return input_normals_;
   }
 
   /** \brief Number of threads; 0 (default): the hardware's concurrency. Inputs of at most 256
    * points (one block) run on the calling thread alone. */
-  void
-  setNumberOfThreads(unsigned int threads)
+  void setNumberOfThreads(unsigned int threads)
   {
     threads_ = threads;
   }
   /** \brief Number of threads (0: the hardware's concurrency). */
-  unsigned int
-  getNumberOfThreads() const
+  unsigned int getNumberOfThreads() const
   {
     return threads_;
   }
 
 protected:
-  bool
-  initCompute() override;
+  bool initCompute() override;
 
 private:
-  void
-  computeFeature(PointCloudOut& output) override;
+  void computeFeature(PointCloudOut& output) override;
 
   /** Neighbour lists of surface_queries (indices into the input if queries_are_input, else
    * into the surface), from the PCL search method or the internal kd-tree. */
-  Neighbourhoods
-  neighbourhoods(const std::vector<int>& surface_queries, bool queries_are_input,
-                 int threads) const;
+  Neighbourhoods neighbourhoods(const std::vector<int>& surface_queries, bool queries_are_input,
+                                int threads) const;
 
   Eigen::Vector3f view_point_{Eigen::Vector3f::Zero()};
   bool use_sensor_origin_{true};

@@ -25,8 +25,10 @@ parallelWorkers(std::size_t n, int threads, std::size_t grain)
 {
   int t = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
   t = std::max(t, 1);
-  const std::size_t blocks = (n + std::max<std::size_t>(grain, 1) - 1) / std::max<std::size_t>(grain, 1);
-  return static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(blocks, static_cast<std::size_t>(t))));
+  const std::size_t blocks =
+    (n + std::max<std::size_t>(grain, 1) - 1) / std::max<std::size_t>(grain, 1);
+  return static_cast<int>(
+    std::max<std::size_t>(1, std::min<std::size_t>(blocks, static_cast<std::size_t>(t))));
 }
 
 /** \brief Calls \a body(begin, end) on blocks of at most \a grain items covering [0, n), on

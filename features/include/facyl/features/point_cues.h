@@ -29,17 +29,16 @@ struct PointCues {
  *        product is negative), or an empty matrix.
  * \throws std::invalid_argument if \a radius is not positive and finite or
  *         \a max_neighbours < 3. */
-PointCues
-estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbours,
-                  const Eigen::Matrix3Xf& reference);
+PointCues estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbours,
+                            const Eigen::Matrix3Xf& reference);
 
 /** \brief The points' own noise, whatever shape they lie on: the median over \a samples
  * evenly spread columns of sqrt(lambda_0 k / (k - 3)) of their \a k nearest neighbours (the
  * spread along the local normal of a patch small enough to be flat; k - 3 degrees of freedom
- * are left once the plane is fitted). Gaussian noise of sigma gives about sigma; a smooth surface without noise about 0 (a box's faces, a cylinder much wider than the
- * patch), whatever a model fitted to the whole makes of it. 0 when no neighbourhood is usable.
- * \throws std::invalid_argument if k < 3. */
-float
-estimateLocalNoise(const Eigen::Matrix3Xf& points, int k, int samples);
+ * are left once the plane is fitted). Gaussian noise of sigma gives about sigma; a smooth surface
+ * without noise about 0 (a box's faces, a cylinder much wider than the patch), whatever a model
+ * fitted to the whole makes of it. 0 when no neighbourhood is usable. \throws std::invalid_argument
+ * if k < 3. */
+float estimateLocalNoise(const Eigen::Matrix3Xf& points, int k, int samples);
 
 } // namespace facyl

@@ -34,8 +34,13 @@ struct EIGEN_ALIGN16 NormalCurvature {
   float pc2{0.f};
 
   NormalCurvature()
-  : normal_x(0.f), normal_y(0.f), normal_z(0.f), principal_curvature_x(0.f)
-  , principal_curvature_y(0.f), principal_curvature_z(0.f), curvature(0.f)
+      : normal_x(0.f)
+      , normal_y(0.f)
+      , normal_z(0.f)
+      , principal_curvature_x(0.f)
+      , principal_curvature_y(0.f)
+      , principal_curvature_z(0.f)
+      , curvature(0.f)
   {
     data_n[3] = 0.f;
   }

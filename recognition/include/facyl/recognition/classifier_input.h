@@ -25,14 +25,11 @@ enum class ClassifierChannels {
 };
 
 /** \brief "rgb", "depth" or "depthrgb". */
-std::string
-toString(ClassifierChannels channels);
+std::string toString(ClassifierChannels channels);
 /** \brief Parses "rgb", "depth" or "depthrgb". \return false for anything else. */
-bool
-parseClassifierChannels(const std::string& text, ClassifierChannels& channels);
+bool parseClassifierChannels(const std::string& text, ClassifierChannels& channels);
 /** \brief 3 for Rgb, 2 for Depth, 5 for DepthRgb. */
-int
-channelCount(ClassifierChannels channels);
+int channelCount(ClassifierChannels channels);
 
 /** \brief How a view becomes the network's input image. */
 struct ClassifierInputSpec {
@@ -52,24 +49,22 @@ struct ClassifierInputSpec {
  *   images into it).
  * \return an empty vector when the view has no box, or (Rgb, DepthRgb) no crop, or (Depth,
  * DepthRgb) no pixels. */
-std::vector<std::uint8_t>
-classifierImage(const ObjectView& view, const ClassifierInputSpec& spec);
+std::vector<std::uint8_t> classifierImage(const ObjectView& view, const ClassifierInputSpec& spec);
 
 /** \brief The view of the points \a indices of \a cloud: box, points, pixels and (for point
  * types with colour) the RGB crop of the box. Organized clouds: pixels from the indices; else
  * projected with \a camera when it is valid (no pixels, box or crop otherwise). */
 template <typename PointT>
-ObjectView
-objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-           const PinholeCamera& camera);
+ObjectView objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+                      const PinholeCamera& camera);
 
 /** \brief Sets \a view's box from its pixels (-1: unknown) and, for point types with colour,
  * its RGB crop: the box's pixels of an organized \a cloud, else the points \a indices drawn at
  * their pixels (black elsewhere). For views whose pixels come from elsewhere (a file's
  * image coordinates). */
 template <typename PointT>
-void
-viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices);
+void viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud,
+                    const pcl::Indices& indices);
 
 /** \brief The view of the points \a indices of \a cloud by a virtual pinhole camera at \a
  * viewpoint looking at their centroid (its x axis along the cloud's x as far as possible):
@@ -78,21 +73,18 @@ viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl
  * sensor's image of it is), clamped to [50, 2000] pixels. points are in that camera's frame;
  * box and crop as in objectView. An empty view (no box) when no point is in front. */
 template <typename PointT>
-ObjectView
-lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-                 const Eigen::Vector3f& viewpoint);
+ObjectView lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+                            const Eigen::Vector3f& viewpoint);
 
 } // namespace facyl
 
-#define FACYL_INSTANTIATE_objectView(T)                                                    \
-  template facyl::ObjectView facyl::objectView<T>(const pcl::PointCloud<T>&,                \
-                                                  const pcl::Indices&,                      \
-                                                  const facyl::PinholeCamera&);             \
-  template void facyl::viewBoxAndCrop<T>(facyl::ObjectView&, const pcl::PointCloud<T>&,     \
-                                         const pcl::Indices&);                              \
-  template facyl::ObjectView facyl::lookAtObjectView<T>(const pcl::PointCloud<T>&,          \
-                                                        const pcl::Indices&,                \
-                                                        const Eigen::Vector3f&);
+#define FACYL_INSTANTIATE_objectView(T)                                                            \
+  template facyl::ObjectView facyl::objectView<T>(const pcl::PointCloud<T>&, const pcl::Indices&,  \
+                                                  const facyl::PinholeCamera&);                    \
+  template void facyl::viewBoxAndCrop<T>(facyl::ObjectView&, const pcl::PointCloud<T>&,            \
+                                         const pcl::Indices&);                                     \
+  template facyl::ObjectView facyl::lookAtObjectView<T>(                                           \
+    const pcl::PointCloud<T>&, const pcl::Indices&, const Eigen::Vector3f&);
 
 #ifdef PCL_NO_PRECOMPILE
 #include <facyl/recognition/impl/classifier_input.hpp>

@@ -39,8 +39,7 @@ struct ClassifierModelInfo {
 
 /** \brief Parses \a text (the file's contents) into \a info. \return an empty string, or what
  * is wrong (naming the line). */
-std::string
-parseClassifierModelInfo(const std::string& text, ClassifierModelInfo& info);
+std::string parseClassifierModelInfo(const std::string& text, ClassifierModelInfo& info);
 
 /** \brief The CNN shape classifier (implements ShapeClassifier), run by OpenCV's DNN module.
  *
@@ -62,57 +61,45 @@ public:
   CylinderClassifier();
   ~CylinderClassifier() override;
   CylinderClassifier(const CylinderClassifier&) = delete;
-  CylinderClassifier&
-  operator=(const CylinderClassifier&) = delete;
+  CylinderClassifier& operator=(const CylinderClassifier&) = delete;
 
   /** \brief Loads an ONNX network \a onnx_path and its description (the same path with the
    * extension .cfg). Checks both: the file exists and parses, the network takes the described
    * input and gives 1 (sigmoid) or 2 (softmax) outputs per view.
    * \throws std::runtime_error naming the file and what is wrong; the classifier is then
    * unloaded. */
-  void
-  load(const std::string& onnx_path);
+  void load(const std::string& onnx_path);
   /** \brief Loads a Caffe network (\a prototxt, \a caffemodel) described by \a cfg_path.
    * \throws std::runtime_error as load. */
-  void
-  loadCaffe(const std::string& prototxt, const std::string& caffemodel,
-            const std::string& cfg_path);
+  void loadCaffe(const std::string& prototxt, const std::string& caffemodel,
+                 const std::string& cfg_path);
   /** \brief True after a successful load. */
-  bool
-  loaded() const;
-  const ClassifierModelInfo&
-  getModelInfo() const
+  bool loaded() const;
+  const ClassifierModelInfo& getModelInfo() const
   {
     return info_;
   }
   /** \brief The model shipped with facyl (installed with the headers' share directory, or the
    * source tree's recognition/models when run from the build tree); empty if not found. */
-  static std::string
-  defaultModelPath();
+  static std::string defaultModelPath();
 
   /** \brief NaN when the view gives no input image (no box, crop or pixels).
    * \throws std::logic_error when no model is loaded. */
-  float
-  cylinderProbability(const ObjectView& view) override;
+  float cylinderProbability(const ObjectView& view) override;
   /** \brief One batch for all views; NaN for those without an input image. */
-  std::vector<float>
-  cylinderProbabilities(const std::vector<ObjectView>& views) override;
+  std::vector<float> cylinderProbabilities(const std::vector<ObjectView>& views) override;
   /** \brief fusedProbability with the model's fusion weights; \a p_network when the model has
    * none or \a p_network is NaN. */
-  float
-  fuse(float p_network, const CylinderEvidence& evidence,
-       const CylinderDecision& decision) const override;
+  float fuse(float p_network, const CylinderEvidence& evidence,
+             const CylinderDecision& decision) const override;
   /** \brief Network outputs for ready-made input images (channels x size x size bytes each,
    * see classifierImage); for tests and training checks. */
-  std::vector<float>
-  probabilitiesOfImages(const std::vector<std::vector<std::uint8_t>>& images);
-  std::string
-  name() const override;
+  std::vector<float> probabilitiesOfImages(const std::vector<std::vector<std::uint8_t>>& images);
+  std::string name() const override;
 
 private:
   struct Network;
-  void
-  check(const std::string& what);
+  void check(const std::string& what);
   std::unique_ptr<Network> net_;
   ClassifierModelInfo info_;
   std::string name_;

@@ -26,7 +26,7 @@ struct CylinderDecision {
   /** The fit score: the paper's inlier ratio (eq. 4), or the surface ratio, which also counts
    * the points on the fitted cylinder's end caps and inner wall as explained. */
   enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
-  float min_score{0.5f};            ///< score at least this, in [0, 1]
+  float min_score{0.5f}; ///< score at least this, in [0, 1]
   /** With a classifier: p_cylinder at least this, in [0, 1]. 0.5: p_cylinder is a calibrated
    * probability (the fusion is a logistic regression), so 0.5 calls an object a cylinder when
    * that is the likelier answer; on simulated clutter the F1 is flat from 0.3 to 0.6 and 0.5
@@ -49,12 +49,11 @@ struct CylinderDecision {
 };
 
 /** \brief Checks \a decision. \return an empty string, or what is wrong. */
-std::string
-validate(const CylinderDecision& decision);
+std::string validate(const CylinderDecision& decision);
 
 /** \brief What the decision looks at for one object. */
 struct CylinderEvidence {
-  bool fitted{false};      ///< a cylinder was fitted
+  bool fitted{false}; ///< a cylinder was fitted
   /** The probability that the object is a cylinder: with a classifier, its network's output
    * for the object's view fused with this evidence (ShapeClassifier::fuse; the network's alone
    * when the object was not fitted); NaN without a classifier. */
@@ -77,24 +76,20 @@ struct CylinderEvidence {
   float taper{std::numeric_limits<float>::quiet_NaN()};
 
   /** \brief The score \a decision uses. */
-  float
-  score(const CylinderDecision& decision) const
+  float score(const CylinderDecision& decision) const
   {
-    return decision.score == CylinderDecision::Score::SurfaceRatio ? surface_ratio
-                                                                   : inlier_ratio;
+    return decision.score == CylinderDecision::Score::SurfaceRatio ? surface_ratio : inlier_ratio;
   }
 };
 
 /** \brief The decision: fitted, p_cylinder >= min_probability when known, score >= min_score,
  * curvature ratio <= max_curvature_ratio (when known), angular coverage >=
  * min_angular_coverage, arc gap <= max_arc_gap and taper <= max_taper (both when known). */
-bool
-acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
+bool acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
 /** \brief The decision without its probability test: what acceptCylinder says when
  * p_cylinder is unknown. */
-bool
-acceptGeometry(const CylinderEvidence& evidence, const CylinderDecision& decision);
+bool acceptGeometry(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
 /** \brief Number of features of the fusion model (see fusionFeatures). */
 constexpr std::size_t kFusionFeatures = 9;
@@ -104,57 +99,52 @@ constexpr std::size_t kFusionFeatures = 9;
  * 1 - 1e-4]), surface ratio, inlier ratio, curvature ratio (1 when unknown), angular coverage,
  * taper clamped to [0, 1] (0 when unknown), arc gap (0 when unknown), and 1 when
  * acceptGeometry(evidence, decision) holds, else 0. */
-std::array<float, kFusionFeatures>
-fusionFeatures(float p_network, const CylinderEvidence& evidence, const CylinderDecision& decision);
+std::array<float, kFusionFeatures> fusionFeatures(float p_network, const CylinderEvidence& evidence,
+                                                  const CylinderDecision& decision);
 
 /** \brief 1 / (1 + exp(-w . fusionFeatures(...))). */
-float
-fusedProbability(const std::array<float, kFusionFeatures>& weights, float p_network,
-                 const CylinderEvidence& evidence, const CylinderDecision& decision);
+float fusedProbability(const std::array<float, kFusionFeatures>& weights, float p_network,
+                       const CylinderEvidence& evidence, const CylinderDecision& decision);
 
 /** \brief Median |k_min| / median |k_max| of \a cues over \a inliers (indices into cues):
  * 0 on an ideal cylinder, 1 on a sphere. NaN when no inlier has finite curvatures; 1 when the
  * median |k_max| is 0. */
-float
-curvatureRatio(const pcl::PointCloud<NormalCurvature>& cues, const pcl::Indices& inliers);
+float curvatureRatio(const pcl::PointCloud<NormalCurvature>& cues, const pcl::Indices& inliers);
 
 /** \brief True if \a p (unit normal \a n) lies on an end cap of \a model: within
  * max(\a distance, 0.1 x radius) of the plane through model.base or model.top normal to the
  * axis (lids sit a little below a can's rim), at most radius + \a distance from the axis,
  * with a normal within acos(\a cos_max) of the axis. */
-bool
-onCap(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
-      float distance, float cos_max);
+bool onCap(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+           float distance, float cos_max);
 
 /** \brief True if \a p (unit normal \a n) lies on the inner wall of \a model seen as an open
  * container (a cup's inside, seen through its opening): between inner_ratio x radius and the
  * radius from the axis, within the axial extent, with a normal within acos(\a cos_max) of
  * pointing at the axis. */
-bool
-onInnerWall(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
-            float cos_max, float inner_ratio);
+bool onInnerWall(const CylinderModel& model, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                 float cos_max, float inner_ratio);
 
 /** \brief Number of \a points (3 x n, unit \a normals alongside) on an end cap of \a model
  * (onCap with cos(max_angle)). Points listed in model.inliers (column indices, ascending) are
  * not counted. */
-std::size_t
-countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-               const Eigen::Matrix3Xf& normals, float distance, float max_angle);
+std::size_t countCapPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                           const Eigen::Matrix3Xf& normals, float distance, float max_angle);
 
 /** \brief Number of \a points (with unit \a normals) on the inner wall of \a model
  * (onInnerWall with cos(max_angle)). Points in model.inliers are not counted. */
-std::size_t
-countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-                     const Eigen::Matrix3Xf& normals, float max_angle, float inner_ratio);
+std::size_t countInnerWallPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                                 const Eigen::Matrix3Xf& normals, float max_angle,
+                                 float inner_ratio);
 
 /** \brief Which points a cylinder explains, for handing a cylinder found in a larger cluster
  * its own points. */
 struct ExplainSettings {
-  float distance{0.005f};  ///< lateral: |distance to the surface| at most this; caps: 2x
-  float max_angle{0.6f};   ///< rad: normal vs the surface's normal (lateral, caps)
-  bool outward{true};      ///< lateral normals must point away from the axis
-  bool inner_wall{true};   ///< count the inner wall of an open container
-  float inner_ratio{0.8f}; ///< see onInnerWall
+  float distance{0.005f};    ///< lateral: |distance to the surface| at most this; caps: 2x
+  float max_angle{0.6f};     ///< rad: normal vs the surface's normal (lateral, caps)
+  bool outward{true};        ///< lateral normals must point away from the axis
+  bool inner_wall{true};     ///< count the inner wall of an open container
+  float inner_ratio{0.8f};   ///< see onInnerWall
   float axial_margin{0.01f}; ///< lateral points may lie this far beyond base and top
 };
 
@@ -165,9 +155,9 @@ enum class Explained : std::uint8_t { No = 0, Lateral, Cap, InnerWall };
  * extent grown by the margin), on an end cap, on its inner wall, or none of them.
  * \param normals unit normals alongside the points, or an empty matrix: every point is then
  *        judged by its position alone. */
-std::vector<Explained>
-explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-                const Eigen::Matrix3Xf& normals, const ExplainSettings& settings);
+std::vector<Explained> explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                                       const Eigen::Matrix3Xf& normals,
+                                       const ExplainSettings& settings);
 
 /** \brief How the radius of the side surface around \a model changes along its axis:
  * |slope| of a robust line fit of the distance to the axis against the position along it, over
@@ -177,9 +167,8 @@ explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
  * About 0 on a cylinder, tan(half-angle) on a cone seen along enough of its height. NaN with
  * fewer than 20 such points or no axial spread.
  * \param normals unit normals alongside the points */
-float
-taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-               const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive);
+float taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                     const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive);
 
 /** \brief How a part of a cluster meets the rest: over the pairs (a point of the part, a
  * point of the rest) closer than \a distance, the share that is clearly convex, by the
@@ -188,40 +177,39 @@ taperAlongAxis(const CylinderModel& model, const Eigen::Matrix3Xf& points,
  * continue into the rest convexly (a box edge into its faces). NaN when no pair is that
  * close.
  * \param part,rest column indices into \a points (unit \a normals alongside) */
-float
-convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-                    const std::vector<Eigen::Index>& part, const std::vector<Eigen::Index>& rest,
-                    float distance, float tolerance);
+float convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                          const std::vector<Eigen::Index>& part,
+                          const std::vector<Eigen::Index>& rest, float distance, float tolerance);
 
 /** \brief Largest empty arc inside the span of \a points (3 x n) around \a model's axis, as a
  * share of the circumference, on 36 sectors (a sector holds at least 2 points to count): 0
  * for a contiguous arc, larger where the points sit at two separate angles. 0 for fewer than
  * 2 occupied sectors. */
-float
-arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points);
+float arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points);
 
 /** \brief Evidence for a cylinder found inside a larger cluster, judged on the points around
  * it: its region holds the columns of \a points flagged in \a alive (all when empty) within
  * radius + max(radial_margin x radius, margin) + 2 x distance of the axis and within
- * max(axial_margin x radius, margin) beyond base and top. surface_ratio is the share of the region it explains, inlier_ratio the
- * share on its lateral surface; angular_coverage is the model's, curvature_ratio is left NaN
- * (the caller knows the curvatures). A sphere's band or a cone's, fitted by a cylinder, leaves
- * the rest of the sphere or cone inside the region unexplained; so does a thin cylinder fitted
- * to the edge of a box, with the faces beyond the edge (hence the absolute margin). Points
- * whose normal lies along the axis (the box a can stands on) are left out of the region.
- * \param[out] explained when given, the explanation of every column (alive or not). */
-CylinderEvidence
-localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-              const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive,
-              const ExplainSettings& settings, float radial_margin, float axial_margin,
-              float margin, std::vector<Explained>* explained = nullptr);
+ * max(axial_margin x radius, margin) beyond base and top. surface_ratio is the share of the region
+ * it explains, inlier_ratio the share on its lateral surface; angular_coverage is the model's,
+ * curvature_ratio is left NaN (the caller knows the curvatures). A sphere's band or a cone's,
+ * fitted by a cylinder, leaves the rest of the sphere or cone inside the region unexplained; so
+ * does a thin cylinder fitted to the edge of a box, with the faces beyond the edge (hence the
+ * absolute margin). Points whose normal lies along the axis (the box a can stands on) are left out
+ * of the region. \param[out] explained when given, the explanation of every column (alive or not).
+ */
+CylinderEvidence localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                               const Eigen::Matrix3Xf& normals,
+                               const std::vector<std::uint8_t>& alive,
+                               const ExplainSettings& settings, float radial_margin,
+                               float axial_margin, float margin,
+                               std::vector<Explained>* explained = nullptr);
 
 /** \brief Share of \a points (3 x n) inside the volume of \a model: within \a radial_factor x
  * radius of its axis and between base and top grown by \a axial_margin (m). The inside of an
  * open container (a cup, a bowl) seen through its opening lies inside the cylinder fitted to
  * its outer wall; an object behind or beside it does not. 0 for no points. */
-float
-shareInside(const CylinderModel& model, const Eigen::Matrix3Xf& points, float radial_factor,
-            float axial_margin);
+float shareInside(const CylinderModel& model, const Eigen::Matrix3Xf& points, float radial_factor,
+                  float axial_margin);
 
 } // namespace facyl

@@ -20,8 +20,7 @@ struct RgbImage {
   int width{0};
   int height{0};
   std::vector<std::uint8_t> data; ///< width * height * 3
-  bool
-  empty() const
+  bool empty() const
   {
     return width <= 0 || height <= 0 || data.size() != static_cast<std::size_t>(width) * height * 3;
   }
@@ -31,9 +30,9 @@ struct RgbImage {
  * for unorganized clouds, the points drawn at their projections), its points and the pixel
  * each point was seen at (see objectView). */
 struct ObjectView {
-  RgbImage crop;            ///< the pixels of box; empty when the cloud has no colour
+  RgbImage crop;                ///< the pixels of box; empty when the cloud has no colour
   PixelBox box{-1, -1, -1, -1}; ///< in the full image; all -1 when unknown
-  Eigen::Matrix3Xf points;  ///< camera frame
+  Eigen::Matrix3Xf points;      ///< camera frame
   /** Pixel (u, v) of each point in the full image; empty or -1 where unknown. */
   Eigen::Matrix2Xi pixels;
 };
@@ -47,12 +46,10 @@ public:
   virtual ~ShapeClassifier() = default;
   /** \brief Probability in [0, 1] that \a view shows a cylinder; NaN when it cannot tell (the
    * object is then fitted as if there were no classifier). */
-  virtual float
-  cylinderProbability(const ObjectView& view) = 0;
+  virtual float cylinderProbability(const ObjectView& view) = 0;
   /** \brief cylinderProbability of every view, in order; implementations may run them as one
    * batch (the default calls cylinderProbability for each). */
-  virtual std::vector<float>
-  cylinderProbabilities(const std::vector<ObjectView>& views)
+  virtual std::vector<float> cylinderProbabilities(const std::vector<ObjectView>& views)
   {
     std::vector<float> p;
     p.reserve(views.size());
@@ -64,16 +61,15 @@ public:
    * \a p_network for its view and the fit's \a evidence under \a decision (see
    * fusionFeatures). The default returns \a p_network; a classifier with a calibrated fusion
    * model overrides it. */
-  virtual float
-  fuse(float p_network, const CylinderEvidence& evidence, const CylinderDecision& decision) const
+  virtual float fuse(float p_network, const CylinderEvidence& evidence,
+                     const CylinderDecision& decision) const
   {
     (void)evidence;
     (void)decision;
     return p_network;
   }
   /** \brief A short name for reports. */
-  virtual std::string
-  name() const = 0;
+  virtual std::string name() const = 0;
 };
 
 } // namespace facyl

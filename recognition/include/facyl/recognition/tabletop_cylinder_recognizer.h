@@ -4,12 +4,12 @@
 #pragma once
 
 #include <facyl/features/normal_curvature_estimation.h>
-#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/recognition/classifier_input.h>
+#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/recognition/shape_classifier.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
-#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/sample_consensus_alt/cylinder_model.h>
+#include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/sample_consensus_alt/orientation_accumulator.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 
@@ -50,7 +50,7 @@ struct TabletopRecognizerParameters {
   /** The fit's settings, the orientation prior (in the table frame), N_d and the seed
    * included. */
   HoughCylinderParameters hough{tabletopHoughDefaults()};
-  CylinderDecision decision;      ///< what makes a fitted object a cylinder
+  CylinderDecision decision; ///< what makes a fitted object a cylinder
   /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
    * a lying (Horizontal) prior in the table frame, then (objects on a support) with the axis
    * fixed along the support's normal, and keep the best. */
@@ -73,22 +73,22 @@ struct TabletopRecognizerParameters {
    * pixels at a 525 px focal length), so normals and curvatures are estimated at the same
    * angular scale near and far; 0: every pixel. In [0, 0.1]. */
   float fit_point_angle{0.006f};
-  std::size_t max_fit_points{1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
+  std::size_t max_fit_points{
+    1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
   /** With a classifier: clusters whose network probability is below this are not fitted
    * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
   float reject_below{0.1f};
-  int neighbours{16};             ///< k of the normal/curvature estimation, in [5, 200]
+  int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const TabletopRecognizerParameters& params);
+std::string validate(const TabletopRecognizerParameters& params);
 
 /** \brief One object on the table and what was decided about it. */
 struct RecognizedObject {
-  TabletopCluster cluster;  ///< the object's points, pixel box and centroid
+  TabletopCluster cluster;   ///< the object's points, pixel box and centroid
   CylinderEvidence evidence; ///< what the decision looked at
-  bool is_cylinder{false};  ///< the decision (acceptCylinder)
+  bool is_cylinder{false};   ///< the decision (acceptCylinder)
   /** The fitted cylinder (valid when evidence.fitted); its inliers index the input cloud and
    * come from the subsample that was fitted. */
   CylinderModel cylinder;
@@ -118,8 +118,7 @@ struct RecognitionTiming {
  * recognize() return false with no objects. recognize() is not reentrant on one object;
  * distinct objects may run concurrently.
  */
-template <typename PointT>
-class TabletopCylinderRecognizer : public pcl::PCLBase<PointT> {
+template <typename PointT> class TabletopCylinderRecognizer : public pcl::PCLBase<PointT> {
 public:
   using Ptr = std::shared_ptr<TabletopCylinderRecognizer<PointT>>;
   using ConstPtr = std::shared_ptr<const TabletopCylinderRecognizer<PointT>>;
@@ -129,74 +128,62 @@ public:
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
 
   /** \brief All settings. */
-  void
-  setParameters(const TabletopRecognizerParameters& params)
+  void setParameters(const TabletopRecognizerParameters& params)
   {
     params_ = params;
     configured_ = false;
   }
-  const TabletopRecognizerParameters&
-  getParameters() const
+  const TabletopRecognizerParameters& getParameters() const
   {
     return params_;
   }
   /** \brief Optional classifier; nullptr (default): every cluster is fitted. */
-  void
-  setClassifier(const ShapeClassifier::Ptr& classifier)
+  void setClassifier(const ShapeClassifier::Ptr& classifier)
   {
     classifier_ = classifier;
   }
-  ShapeClassifier::Ptr
-  getClassifier() const
+  ShapeClassifier::Ptr getClassifier() const
   {
     return classifier_;
   }
   /** \brief Camera for boxes and crops of unorganized clouds. */
-  void
-  setCamera(const PinholeCamera& camera)
+  void setCamera(const PinholeCamera& camera)
   {
     camera_ = camera;
   }
   /** \brief Gravity's opposite in the cloud's frame (see TabletopSegmentation::setUpDirection);
    * zero (default): unknown. */
-  void
-  setUpDirection(const Eigen::Vector3f& up)
+  void setUpDirection(const Eigen::Vector3f& up)
   {
     up_ = up;
   }
 
   /** \brief Runs the pipeline. \return false on error (see the class description). */
-  bool
-  recognize(std::vector<RecognizedObject>& objects);
+  bool recognize(std::vector<RecognizedObject>& objects);
 
   /** \brief Table plane of the last run (unit normal towards the sensor). */
-  const pcl::ModelCoefficients&
-  getTableCoefficients() const
+  const pcl::ModelCoefficients& getTableCoefficients() const
   {
     return segmentation_.getTableCoefficients();
   }
   /** \brief Supports of the last run (RecognizedObject::cluster.support indexes them). */
-  const std::vector<SupportPlane>&
-  getSupports() const
+  const std::vector<SupportPlane>& getSupports() const
   {
     return segmentation_.getSupports();
   }
   /** \brief False when no object stood on any plane in the last run: the "table" is then the
    * largest plane. */
-  bool
-  tableFound() const
+  bool tableFound() const
   {
     return segmentation_.tableFound();
   }
   /** \brief Table frame of the last run (z up). */
-  const Eigen::Affine3f&
-  getTableFrame() const
+  const Eigen::Affine3f& getTableFrame() const
   {
     return segmentation_.getTableFrame();
   }
   /** \brief Stage timing of the last run. */
-  const RecognitionTiming&
-  getTiming() const
+  const RecognitionTiming& getTiming() const
   {
     return timing_;
   }
@@ -208,58 +195,43 @@ private:
   struct Fit;
 
   /** recognize() on a cloud in the sensor's frame (identity sensor pose); \a t0: its start. */
-  bool
-  recognizeInSensorFrame(std::vector<RecognizedObject>& objects,
-                         std::chrono::steady_clock::time_point t0);
+  bool recognizeInSensorFrame(std::vector<RecognizedObject>& objects,
+                              std::chrono::steady_clock::time_point t0);
   /** Builds the cue estimation and the estimators (one per prior of the retries). */
-  void
-  configure();
+  void configure();
   /** What the classifier sees of the points \a indices: the image's pixels, or (an unorganized
    * cloud without a camera) a virtual camera's at the sensor origin (lookAtObjectView). */
-  ObjectView
-  viewOf(const pcl::Indices& indices) const;
+  ObjectView viewOf(const pcl::Indices& indices) const;
   /** The classifier's network probability of each cluster (one batch); NaN without one. */
-  std::vector<float>
-  classifyClusters(const std::vector<TabletopCluster>& clusters);
+  std::vector<float> classifyClusters(const std::vector<TabletopCluster>& clusters);
   /** The objects [first, end) made of one cluster of network probability \a p_cluster: their
    * p_network (split parts: of their own view), p_cylinder (fused) and the decision. */
-  void
-  applyClassifier(std::vector<RecognizedObject>& objects, std::size_t first, float p_cluster);
+  void applyClassifier(std::vector<RecognizedObject>& objects, std::size_t first, float p_cluster);
   /** Sets the estimators' prior frame to that of support \a support (-1: none). */
-  void
-  usePriorFrameOf(int support);
+  void usePriorFrameOf(int support);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
    * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
    * that one, which keeps its fit and is classified again as a whole. */
-  void
-  joinContainerInsides(std::vector<RecognizedObject>& objects);
+  void joinContainerInsides(std::vector<RecognizedObject>& objects);
   /** Subsamples \a cluster and estimates normals and curvatures. */
-  FitInput
-  prepareFit(const TabletopCluster& cluster);
+  FitInput prepareFit(const TabletopCluster& cluster);
   /** Fits the points of \a input flagged in \a alive (all when empty) with the configured
    * prior, then (when not accepted) the retries. The evidence is relative to those points. */
-  Fit
-  fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
-  Fit
-  fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
+  Fit fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
+  Fit fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
   /** Classifies, fits and decides one cluster: one object, or several (recovery). */
-  void
-  recognizeCluster(TabletopCluster cluster, float p_network,
-                   std::vector<RecognizedObject>& objects);
+  void recognizeCluster(TabletopCluster cluster, float p_network,
+                        std::vector<RecognizedObject>& objects);
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
-  std::vector<Fit>
-  extractCylinders(const FitInput& input, Fit first);
+  std::vector<Fit> extractCylinders(const FitInput& input, Fit first);
   /** Least squares of \a model on the cluster's points (\a indices) near its surface. */
-  void
-  refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
+  void refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
-  ExplainSettings
-  explainSettings(const CylinderModel& model) const;
+  ExplainSettings explainSettings(const CylinderModel& model) const;
   /** The cluster split into one object per cylinder and the rest. */
-  void
-  splitCluster(const RecognizedObject& whole, const FitInput& input,
-               const std::vector<Fit>& parts, std::vector<RecognizedObject>& objects) const;
+  void splitCluster(const RecognizedObject& whole, const FitInput& input,
+                    const std::vector<Fit>& parts, std::vector<RecognizedObject>& objects) const;
 
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;
@@ -279,22 +251,20 @@ private:
  * support's normal; without a support, an upright camera's up: against the image rows); when
  * the axis lies across \a up (within about 6 degrees of perpendicular: a lying can), it points
  * to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
-void
-orientCylinder(CylinderModel& model, const Eigen::Vector3f& up, const Eigen::Vector3f& viewpoint);
+void orientCylinder(CylinderModel& model, const Eigen::Vector3f& up,
+                    const Eigen::Vector3f& viewpoint);
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */
-pcl::Indices
-evenSubsample(const pcl::Indices& indices, std::size_t max_count);
+pcl::Indices evenSubsample(const pcl::Indices& indices, std::size_t max_count);
 
 /** \brief The \a indices of an organized cloud \a width pixels wide whose column and row are
  * both multiples of \a stride (>= 1). */
-pcl::Indices
-pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride);
+pcl::Indices pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride);
 
 } // namespace facyl
 
-#define FACYL_INSTANTIATE_TabletopCylinderRecognizer(T)                                     \
+#define FACYL_INSTANTIATE_TabletopCylinderRecognizer(T)                                            \
   template class facyl::TabletopCylinderRecognizer<T>;
 
 #ifdef PCL_NO_PRECOMPILE

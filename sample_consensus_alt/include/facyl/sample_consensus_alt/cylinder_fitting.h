@@ -28,11 +28,9 @@ enum class VotingMode {
 };
 
 /** \brief Parses "rabbani", "soft-normal", "soft-curvature". */
-bool
-parseVotingMode(const std::string& name, VotingMode& mode);
+bool parseVotingMode(const std::string& name, VotingMode& mode);
 /** \brief The name parseVotingMode accepts. */
-std::string
-toString(VotingMode mode);
+std::string toString(VotingMode mode);
 
 /** \brief Per-point voting cues in structure-of-arrays form (the hot loop is vectorised over
  * points). c_* are only read by VotingMode::SoftCurvature. */
@@ -41,13 +39,11 @@ struct VotingCues {
   Eigen::ArrayXf cx, cy, cz; ///< unit c_max directions
   Eigen::ArrayXf weight;     ///< per-point vote weight (eq. 3's curvature term; 1 otherwise)
 
-  Eigen::Index
-  size() const
+  Eigen::Index size() const
   {
     return nx.size();
   }
-  void
-  resize(Eigen::Index n);
+  void resize(Eigen::Index n);
 };
 
 /** \brief Casts the votes of all \a cues into the cells \a directions (3 x N_d): one inner
@@ -59,16 +55,15 @@ struct VotingCues {
  * \param hard_threshold Rabbani only: a cell gets a vote when |d.n| < hard_threshold.
  * \param[out] votes A(i), one per cell.
  */
-void
-castVotes(const Eigen::Matrix3Xf& directions, const VotingCues& cues, VotingMode mode,
-          int kernel_exponent, float hard_threshold, Eigen::VectorXf& votes);
+void castVotes(const Eigen::Matrix3Xf& directions, const VotingCues& cues, VotingMode mode,
+               int kernel_exponent, float hard_threshold, Eigen::VectorXf& votes);
 
 /** \brief Up to \a max_peaks cells in decreasing vote order, each at least
  * \a min_separation (rad) from the cells already taken (non-maximum suppression on the
  * sphere of axes). Cells without votes are never peaks. */
-std::vector<Eigen::Index>
-findPeaks(const Eigen::Matrix3Xf& directions, const Eigen::VectorXf& votes,
-          std::size_t max_peaks, float min_separation);
+std::vector<Eigen::Index> findPeaks(const Eigen::Matrix3Xf& directions,
+                                    const Eigen::VectorXf& votes, std::size_t max_peaks,
+                                    float min_separation);
 
 /** \brief Sub-cell axis refinement: iteratively reweighted least squares on the normals.
  *
@@ -79,9 +74,8 @@ findPeaks(const Eigen::Matrix3Xf& directions, const Eigen::VectorXf& votes,
  * normal is near the axis (lids, tables under an upright can) get no weight.
  * \return the refined unit axis (folded), or \a initial if there was no support.
  */
-Eigen::Vector3f
-refineAxis(const VotingCues& cues, const Eigen::Vector3f& initial, float initial_tolerance,
-           int iterations = 10);
+Eigen::Vector3f refineAxis(const VotingCues& cues, const Eigen::Vector3f& initial,
+                           float initial_tolerance, int iterations = 10);
 
 /** \brief A circle in the plane. */
 struct Circle {
@@ -96,27 +90,24 @@ struct Circle {
  * \param normals unit 2-D normals, one per point (sign not needed)
  * \return false if no centre got votes.
  */
-bool
-houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, float r_min,
-            float r_max, int grid, Circle& circle);
+bool houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, float r_min,
+                 float r_max, int grid, Circle& circle);
 
 /** \brief Geometric circle fit (Gauss-Newton on sum (|p - c| - r)^2), robust: the points within
  * \a threshold of the current circle are refitted, the threshold shrinking to 3 robust sigmas.
  * \return false if fewer than 3 points support the circle. */
-bool
-fitCircle(const Eigen::Matrix2Xf& points, float threshold, Circle& circle, int iterations = 8);
+bool fitCircle(const Eigen::Matrix2Xf& points, float threshold, Circle& circle, int iterations = 8);
 
 /** \brief Least-squares refinement of all 5 degrees of freedom of an infinite cylinder (axis
  * direction, axis position, radius) on \a points (Gauss-Newton, analytic Jacobian).
  * \return false if the system is degenerate (the model is then unchanged). */
-bool
-refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
-               Eigen::Vector3f& axis, float& radius, int iterations = 5);
+bool refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
+                    Eigen::Vector3f& axis, float& radius, int iterations = 5);
 
 /** \brief Which normals agree with a cylinder's surface normal at their point. */
 struct NormalGate {
   float max_angle{1.5707964f}; ///< rad, largest angle to the surface normal (pi/2: any)
-  bool outward{false}; ///< the normal must also point away from the axis
+  bool outward{false};         ///< the normal must also point away from the axis
 };
 
 /** \brief An infinite cylinder with the robust scale of the points' distances to it. */
@@ -132,33 +123,30 @@ struct RobustCylinder {
 };
 
 /** \brief Robust refinement of all 5 degrees of freedom on the point-to-surface distances
- * e = |P_a(x - p)| - r (normals, when given, only decide which points count): iteratively reweighted Gauss-Newton with Tukey's
- * biweight at c.cutoff x s, the scale s re-estimated after every step as 1.4826 MAD of the
- * distances within 4.685 s and never growing (so a start a few degrees off still sees its
- * surface, and the window then closes on the points the converged model explains).
- * Points far from the surface (lids, a table, other objects) get no weight.
- * \param normals unit normals of \a points, or an empty matrix: with normals, a point whose
- *        normal does not pass \a gate gets no weight (a table cutting the surface, a lid's rim).
- * \param c in: the start, and its scale (0: 1.4826 MAD of the distances below the radius);
- *        out: the refined cylinder, its scale and support.
- * \return false if the system is degenerate or too few points support it (c unchanged). */
-bool
-refineCylinderRobust(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-                     const NormalGate& gate, RobustCylinder& c, int iterations = 20);
+ * e = |P_a(x - p)| - r (normals, when given, only decide which points count): iteratively
+ * reweighted Gauss-Newton with Tukey's biweight at c.cutoff x s, the scale s re-estimated after
+ * every step as 1.4826 MAD of the distances within 4.685 s and never growing (so a start a few
+ * degrees off still sees its surface, and the window then closes on the points the converged model
+ * explains). Points far from the surface (lids, a table, other objects) get no weight. \param
+ * normals unit normals of \a points, or an empty matrix: with normals, a point whose normal does
+ * not pass \a gate gets no weight (a table cutting the surface, a lid's rim). \param c in: the
+ * start, and its scale (0: 1.4826 MAD of the distances below the radius); out: the refined
+ * cylinder, its scale and support. \return false if the system is degenerate or too few points
+ * support it (c unchanged). */
+bool refineCylinderRobust(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                          const NormalGate& gate, RobustCylinder& c, int iterations = 20);
 
 /** \brief The points that the surface of \a c explains at \a scale: the sum of their Tukey
  * weights (cut-off c.cutoff x \a scale), with \a normals (or an empty matrix) through
  * \a gate. Compared at one scale, it ranks cylinders by the points they explain. */
-float
-pointSupport(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-             const NormalGate& gate, const RobustCylinder& c, float scale);
+float pointSupport(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                   const NormalGate& gate, const RobustCylinder& c, float scale);
 
 /** \brief The median angle (rad) between the normals of the points within \a window of the
  * surface of \a c and the surface normal there: the normals' own noise once the model is
  * right (Rayleigh-distributed, median = 1.18 sigma). 0 when fewer than 5 points are near. */
-float
-normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-                const RobustCylinder& c, float window);
+float normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                      const RobustCylinder& c, float window);
 
 /** \brief How fast the inliers' normals turn with their position around the axis: the
  * least-squares slope of (normal angle) against (position angle) over the inliers, about 1 on
@@ -169,15 +157,13 @@ normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
  * quarter turn (modulo pi; no plane strip does) or are fewer than 3.
  * \param normals unit normals of \a points (sign not needed)
  */
-float
-normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
-                    const Eigen::Vector3f& point_on_axis, const Eigen::Vector3f& axis);
+float normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+                          const Eigen::Vector3f& point_on_axis, const Eigen::Vector3f& axis);
 
 /** \brief Completes \a model from its inlier points (3 x N): base and top (the extreme
  * sections along the axis, with point_on_axis set to the base), height, rms_error and
  * angular_coverage. Axis, a point on it and radius must be set; the axis is folded. */
-void
-describeInliers(const Eigen::Matrix3Xf& inlier_points, CylinderModel& model);
+void describeInliers(const Eigen::Matrix3Xf& inlier_points, CylinderModel& model);
 
 /** \brief Allowed range of HoughCylinderParameters::orientations (N_d); validate() checks it. */
 constexpr std::size_t kMinOrientations = 10;
@@ -196,16 +182,16 @@ struct HoughCylinderParameters {
   /** N_d, cells per orientation accumulator (450, as in the paper), in [kMinOrientations,
    * kMaxOrientations]. */
   std::size_t orientations{450};
-  std::size_t accumulators{1};          ///< independent accumulators per fit, in [1, kMaxAccumulators]
-  std::uint64_t seed{0};                ///< seed of the accumulator draws: equal seeds, equal results
+  std::size_t accumulators{1}; ///< independent accumulators per fit, in [1, kMaxAccumulators]
+  std::uint64_t seed{0};       ///< seed of the accumulator draws: equal seeds, equal results
   VotingMode voting_mode{VotingMode::SoftCurvature};
-  int kernel_exponent{2};               ///< >= 1; 1 is the paper's eq. 3
-  float radius_min{0.f};                ///< >= 0
+  int kernel_exponent{2};                                   ///< >= 1; 1 is the paper's eq. 3
+  float radius_min{0.f};                                    ///< >= 0
   float radius_max{std::numeric_limits<float>::infinity()}; ///< > radius_min; inf: data extent
-  float distance_threshold{0.f};        ///< > 0, or 0: estimated from the residuals
-  float normal_angle_threshold{0.6f};   ///< rad, in (0, pi/2]: normal vs surface normal
+  float distance_threshold{0.f};         ///< > 0, or 0: estimated from the residuals
+  float normal_angle_threshold{0.6f};    ///< rad, in (0, pi/2]: normal vs surface normal
   std::size_t orientation_candidates{1}; ///< peaks per accumulator that are fitted
-  bool refine{true};                    ///< sub-cell axis + 5-dof least squares
+  bool refine{true};                     ///< sub-cell axis + 5-dof least squares
   /** With refine: how many candidates (the best by their normals' score) are refined on the
    * points (refineCylinderRobust) and then compared on the points they explain at one scale
    * (pointSupport). Points stay informative where normals turn to noise (sigma above ~10% of
@@ -220,10 +206,10 @@ struct HoughCylinderParameters {
   /** The coarse scale, in [0, 2]: neighbours within this share of the winner's radius (a
    * patch its tangent plane still fits). 0: cues are never estimated again. */
   float coarse_scale{0.5f};
-  std::size_t max_cylinders{1};         ///< >= 1
-  std::size_t min_inliers{0};           ///< 0: max(10, 5% of the points)
-  std::size_t max_voting_points{500};   ///< voters are subsampled above this; 0: all
-  int circle_grid{48};                  ///< CHT accumulator size per side, >= 8
+  std::size_t max_cylinders{1};       ///< >= 1
+  std::size_t min_inliers{0};         ///< 0: max(10, 5% of the points)
+  std::size_t max_voting_points{500}; ///< voters are subsampled above this; 0: all
+  int circle_grid{48};                ///< CHT accumulator size per side, >= 8
   /** Inliers' normals must point away from the axis, as normals oriented towards a sensor
    * outside the cylinder do: a cup's inner wall, seen through its opening, is then no inlier.
    * Off by default (pipes seen from inside). */
@@ -231,15 +217,14 @@ struct HoughCylinderParameters {
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const HoughCylinderParameters& params);
+std::string validate(const HoughCylinderParameters& params);
 
 /** \brief The cloud in the form the estimator works on: finite points with finite normals. */
 struct CylinderCues {
   Eigen::Matrix3Xf points;
-  Eigen::Matrix3Xf normals;     ///< unit
+  Eigen::Matrix3Xf normals;              ///< unit
   Eigen::Matrix3Xf curvature_directions; ///< unit c_max (empty: none given)
-  Eigen::VectorXf weights;      ///< eq. 3 curvature weights (empty: none given)
+  Eigen::VectorXf weights;               ///< eq. 3 curvature weights (empty: none given)
 };
 
 /** \brief Fits up to params.max_cylinders cylinders to \a cues, one after another: vote with
@@ -248,8 +233,9 @@ struct CylinderCues {
  * has at least min_inliers inliers. Model inliers index the columns of cues.points.
  * \a total_points is N_cluster of eq. 4 (the points given, finite or not).
  */
-std::vector<CylinderModel>
-fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>& accumulators,
-             const HoughCylinderParameters& params, std::size_t total_points);
+std::vector<CylinderModel> fitCylinders(const CylinderCues& cues,
+                                        const std::vector<OrientationAccumulator>& accumulators,
+                                        const HoughCylinderParameters& params,
+                                        std::size_t total_points);
 
 } // namespace facyl

@@ -101,27 +101,23 @@ public:
   HoughCylinderEstimation() = default;
 
   /** \brief Normals, one per input point (required). */
-  void
-  setInputNormals(const NormalsConstPtr& normals)
+  void setInputNormals(const NormalsConstPtr& normals)
   {
     normals_ = normals;
   }
   /** \brief The normals given, or nullptr. */
-  NormalsConstPtr
-  getInputNormals() const
+  NormalsConstPtr getInputNormals() const
   {
     return normals_;
   }
   /** \brief Principal curvatures, one per input point, for SoftCurvature voting when PointNT
    * carries none (e.g. from pcl::PrincipalCurvaturesEstimation). Overrides PointNT's. */
-  void
-  setInputCurvatures(const CurvaturesConstPtr& curvatures)
+  void setInputCurvatures(const CurvaturesConstPtr& curvatures)
   {
     curvatures_ = curvatures;
   }
   /** \brief The curvatures given, or nullptr. */
-  CurvaturesConstPtr
-  getInputCurvatures() const
+  CurvaturesConstPtr getInputCurvatures() const
   {
     return curvatures_;
   }
@@ -129,20 +125,17 @@ public:
   /** \brief With SoftCurvature voting, when PointNT carries no curvatures and none were
    * given: estimate the curvatures from the 16 nearest points (default true). false:
    * segment() fails with HoughFailure::NoCurvatures instead. */
-  void
-  setEstimateCurvatures(bool estimate)
+  void setEstimateCurvatures(bool estimate)
   {
     estimate_curvatures_ = estimate;
   }
   /** \brief Whether missing curvatures are estimated. */
-  bool
-  getEstimateCurvatures() const
+  bool getEstimateCurvatures() const
   {
     return estimate_curvatures_;
   }
   /** \brief Whether the last segment() estimated the curvatures itself. */
-  bool
-  curvaturesWereEstimated() const
+  bool curvaturesWereEstimated() const
   {
     return curvatures_estimated_;
   }
@@ -152,205 +145,175 @@ public:
    * reported as HoughFailure::RadiusLimits with its radius, and the outcome is printed with
    * PCL_WARN. false (pipelines for which "no cylinder" is a normal answer, e.g. one fit per
    * cluster): no second search (HoughFailure::NoCylinder or TooFewPoints) and PCL_DEBUG. */
-  void
-  setDiagnoseFailures(bool diagnose)
+  void setDiagnoseFailures(bool diagnose)
   {
     diagnose_failures_ = diagnose;
   }
   /** \brief Whether a search that finds nothing is diagnosed. */
-  bool
-  getDiagnoseFailures() const
+  bool getDiagnoseFailures() const
   {
     return diagnose_failures_;
   }
 
   /** \brief Why the last segment() returned false (HoughFailure::None after a success). */
-  HoughFailure
-  getFailureReason() const
+  HoughFailure getFailureReason() const
   {
     return failure_;
   }
   /** \brief The reason in words, as printed (empty after a success). */
-  const std::string&
-  getFailureMessage() const
+  const std::string& getFailureMessage() const
   {
     return failure_message_;
   }
 
   /** \brief All numeric settings at once (see HoughCylinderParameters). */
-  void
-  setParameters(const HoughCylinderParameters& params)
+  void setParameters(const HoughCylinderParameters& params)
   {
     params_ = params;
     explicit_mixture_ = false; // params.prior is the prior again
     drawn_.clear();
   }
   /** \brief All numeric settings. */
-  const HoughCylinderParameters&
-  getParameters() const
+  const HoughCylinderParameters& getParameters() const
   {
     return params_;
   }
 
   /** \brief Voting mode (default SoftCurvature, paper eq. 3). */
-  void
-  setVotingMode(VotingMode mode)
+  void setVotingMode(VotingMode mode)
   {
     params_.voting_mode = mode;
   }
   /** \brief Voting mode. */
-  VotingMode
-  getVotingMode() const
+  VotingMode getVotingMode() const
   {
     return params_.voting_mode;
   }
   /** \brief Radius interval [min, max] in cloud units (default [0, inf): inf is read as twice
    * the extent of the points). */
-  void
-  setRadiusLimits(float min_radius, float max_radius)
+  void setRadiusLimits(float min_radius, float max_radius)
   {
     params_.radius_min = min_radius;
     params_.radius_max = max_radius;
   }
   /** \brief Radius interval. */
-  void
-  getRadiusLimits(float& min_radius, float& max_radius) const
+  void getRadiusLimits(float& min_radius, float& max_radius) const
   {
     min_radius = params_.radius_min;
     max_radius = params_.radius_max;
   }
   /** \brief Inlier distance to the surface, > 0; 0 (default) estimates 3 robust sigmas of the
    * residuals, clamped to [0.001, 0.1] x radius. */
-  void
-  setDistanceThreshold(float threshold)
+  void setDistanceThreshold(float threshold)
   {
     params_.distance_threshold = threshold;
   }
   /** \brief Inlier distance threshold (0: estimated). */
-  float
-  getDistanceThreshold() const
+  float getDistanceThreshold() const
   {
     return params_.distance_threshold;
   }
   /** \brief Largest angle (rad) between an inlier's normal and the cylinder's surface normal,
    * in (0, pi/2] (default 0.6 rad, 34 deg). */
-  void
-  setNormalAngleThreshold(float radians)
+  void setNormalAngleThreshold(float radians)
   {
     params_.normal_angle_threshold = radians;
   }
   /** \brief Inlier normal angle threshold (rad). */
-  float
-  getNormalAngleThreshold() const
+  float getNormalAngleThreshold() const
   {
     return params_.normal_angle_threshold;
   }
   /** \brief Extract up to n cylinders, one after another (default 1). */
-  void
-  setMaxCylinders(std::size_t n)
+  void setMaxCylinders(std::size_t n)
   {
     params_.max_cylinders = n;
   }
   /** \brief Largest number of cylinders extracted. */
-  std::size_t
-  getMaxCylinders() const
+  std::size_t getMaxCylinders() const
   {
     return params_.max_cylinders;
   }
   /** \brief A cylinder needs this many inliers; 0 (default): max(10, 5% of the points). */
-  void
-  setMinInliers(std::size_t n)
+  void setMinInliers(std::size_t n)
   {
     params_.min_inliers = n;
   }
   /** \brief Minimum inliers (0: automatic). */
-  std::size_t
-  getMinInliers() const
+  std::size_t getMinInliers() const
   {
     return params_.min_inliers;
   }
   /** \brief Accumulator peaks per accumulator that are refined and fitted (default 1;
-   * with SoftCurvature, the dominant planar normal and the best normals-only peak are fitted too). */
-  void
-  setOrientationCandidates(std::size_t n)
+   * with SoftCurvature, the dominant planar normal and the best normals-only peak are fitted too).
+   */
+  void setOrientationCandidates(std::size_t n)
   {
     params_.orientation_candidates = n;
   }
   /** \brief Peaks fitted per accumulator. */
-  std::size_t
-  getOrientationCandidates() const
+  std::size_t getOrientationCandidates() const
   {
     return params_.orientation_candidates;
   }
   /** \brief Power applied to soft votes, >= 1 (default 2; 1 is the paper's eq. 3). */
-  void
-  setKernelExponent(int p)
+  void setKernelExponent(int p)
   {
     params_.kernel_exponent = p;
   }
   /** \brief Soft-vote power. */
-  int
-  getKernelExponent() const
+  int getKernelExponent() const
   {
     return params_.kernel_exponent;
   }
   /** \brief Sub-cell axis and least-squares refinement (default true; false reproduces the
    * paper's cell-quantised axis). */
-  void
-  setRefine(bool refine)
+  void setRefine(bool refine)
   {
     params_.refine = refine;
   }
   /** \brief Whether the model is refined. */
-  bool
-  getRefine() const
+  bool getRefine() const
   {
     return params_.refine;
   }
   /** \brief Candidates refined and compared on the points (default 3; 0: the best candidate
    * alone, refined by least squares on its inliers, as facyl 0.1 did). */
-  void
-  setPointCandidates(std::size_t n)
+  void setPointCandidates(std::size_t n)
   {
     params_.point_candidates = n;
   }
   /** \brief Candidates refined and compared on the points. */
-  std::size_t
-  getPointCandidates() const
+  std::size_t getPointCandidates() const
   {
     return params_.point_candidates;
   }
   /** \brief Noise (robust sigma / radius, > 0) above which the given cues count as noise
    * (default 0.04). */
-  void
-  setNoisyCuesRatio(float ratio)
+  void setNoisyCuesRatio(float ratio)
   {
     params_.noisy_cues_ratio = ratio;
   }
   /** \brief Noise ratio above which the given cues count as noise. */
-  float
-  getNoisyCuesRatio() const
+  float getNoisyCuesRatio() const
   {
     return params_.noisy_cues_ratio;
   }
   /** \brief Neighbourhood of the cues estimated again at high noise, as a share of the
    * radius, in [0, 2] (default 0.5; 0: never). */
-  void
-  setCoarseScale(float share_of_radius)
+  void setCoarseScale(float share_of_radius)
   {
     params_.coarse_scale = share_of_radius;
   }
   /** \brief Neighbourhood of the coarse cues, as a share of the radius. */
-  float
-  getCoarseScale() const
+  float getCoarseScale() const
   {
     return params_.coarse_scale;
   }
 
   /** \brief Orientation prior from a preset (HoughCylinderParameters::prior, default
    * Uniform). */
-  void
-  setOrientationPrior(OrientationPrior prior)
+  void setOrientationPrior(OrientationPrior prior)
   {
     params_.prior = prior;
     explicit_mixture_ = false;
@@ -358,140 +321,118 @@ public:
   }
   /** \brief Orientation prior as an explicit Gaussian mixture, in the reference frame; it
    * replaces the preset until setOrientationPrior or setParameters. */
-  void
-  setOrientationMixture(const GaussianMixture& mixture)
+  void setOrientationMixture(const GaussianMixture& mixture)
   {
     mixture_ = mixture;
     explicit_mixture_ = true;
     drawn_.clear();
   }
   /** \brief The orientation prior: the explicit mixture, or the preset's. */
-  GaussianMixture
-  getOrientationMixture() const
+  GaussianMixture getOrientationMixture() const
   {
     return explicit_mixture_ ? mixture_ : GaussianMixture::fromPrior(params_.prior);
   }
   /** \brief Frame of the prior: its columns are the prior's x, y, z ("up") axes in cloud
    * coordinates (default identity). */
-  void
-  setReferenceFrame(const Eigen::Matrix3f& frame)
+  void setReferenceFrame(const Eigen::Matrix3f& frame)
   {
     frame_ = frame;
     drawn_.clear();
   }
   /** \brief Sets the reference frame from its "up" axis only (e.g. a table normal). */
-  void
-  setUpDirection(const Eigen::Vector3f& up);
+  void setUpDirection(const Eigen::Vector3f& up);
   /** \brief Frame of the prior. */
-  const Eigen::Matrix3f&
-  getReferenceFrame() const
+  const Eigen::Matrix3f& getReferenceFrame() const
   {
     return frame_;
   }
   /** \brief Cells per accumulator, N_d (HoughCylinderParameters::orientations: default 450,
    * as in the paper). */
-  void
-  setNumberOfOrientations(std::size_t n)
+  void setNumberOfOrientations(std::size_t n)
   {
     params_.orientations = n;
     drawn_.clear();
   }
   /** \brief N_d. */
-  std::size_t
-  getNumberOfOrientations() const
+  std::size_t getNumberOfOrientations() const
   {
     return params_.orientations;
   }
   /** \brief Independent accumulators voted per fit (HoughCylinderParameters::accumulators,
    * default 1); their peaks compete. */
-  void
-  setNumberOfAccumulators(std::size_t n)
+  void setNumberOfAccumulators(std::size_t n)
   {
     params_.accumulators = n;
     drawn_.clear();
   }
   /** \brief Accumulators per fit. */
-  std::size_t
-  getNumberOfAccumulators() const
+  std::size_t getNumberOfAccumulators() const
   {
     return params_.accumulators;
   }
   /** \brief Seed of the accumulator draws (HoughCylinderParameters::seed, default 0): equal
    * seeds give equal results. */
-  void
-  setSeed(std::uint64_t seed)
+  void setSeed(std::uint64_t seed)
   {
     params_.seed = seed;
     drawn_.clear();
   }
   /** \brief The seed. */
-  std::uint64_t
-  getSeed() const
+  std::uint64_t getSeed() const
   {
     return params_.seed;
   }
   /** \brief Explicit accumulators; they replace the drawn ones until cleared with {}. */
-  void
-  setAccumulators(const std::vector<OrientationAccumulator>& accumulators)
+  void setAccumulators(const std::vector<OrientationAccumulator>& accumulators)
   {
     user_accumulators_ = accumulators;
   }
   /** \brief The accumulators the last segment() used (drawn lazily). */
-  const std::vector<OrientationAccumulator>&
-  getAccumulators()
+  const std::vector<OrientationAccumulator>& getAccumulators()
   {
     return accumulators();
   }
 
   /** \brief Fits the best cylinder: its inliers and the 7 SACMODEL_CYLINDER coefficients.
    * \return false (and empty outputs) on invalid input or when no cylinder was found. */
-  bool
-  segment(pcl::PointIndices& inliers, pcl::ModelCoefficients& coefficients);
+  bool segment(pcl::PointIndices& inliers, pcl::ModelCoefficients& coefficients);
 
   /** \brief Fits up to getMaxCylinders() cylinders, best first; inlier indices refer to the
    * input cloud. \return false on invalid input or when none was found. */
-  bool
-  segment(std::vector<CylinderModel>& cylinders);
+  bool segment(std::vector<CylinderModel>& cylinders);
 
   /** \brief "HoughCylinderEstimation". */
-  std::string
-  getClassName() const
+  std::string getClassName() const
   {
     return "HoughCylinderEstimation";
   }
 
 private:
-  const std::vector<OrientationAccumulator>&
-  accumulators();
+  const std::vector<OrientationAccumulator>& accumulators();
 
   static constexpr bool kNormalsCarryCurvature =
-      pcl::traits::has_field<PointNT, pcl::fields::pc1>::value &&
-      pcl::traits::has_field<PointNT, pcl::fields::pc2>::value &&
-      pcl::traits::has_field<PointNT, pcl::fields::principal_curvature_x>::value;
+    pcl::traits::has_field<PointNT, pcl::fields::pc1>::value &&
+    pcl::traits::has_field<PointNT, pcl::fields::pc2>::value &&
+    pcl::traits::has_field<PointNT, pcl::fields::principal_curvature_x>::value;
   /** SoftCurvature voting without curvatures given (setInputCurvatures or in the normals). */
-  bool
-  curvaturesToEstimate() const
+  bool curvaturesToEstimate() const
   {
     return params_.voting_mode == VotingMode::SoftCurvature && !curvatures_ &&
            !kNormalsCarryCurvature;
   }
   /** The checks before a fit (input, normals, parameters, prior); false, recorded, when one
    * fails. */
-  bool
-  checkInput();
+  bool checkInput();
   /** The indexed points with a finite position and normal as columns of \a cues (with the
    * given curvatures' directions and eq. 3 weights when SoftCurvature has them), and the cloud
    * index of each column; false, recorded, for a bad index or no such point. */
-  bool
-  gatherCues(CylinderCues& cues, std::vector<pcl::index_t>& column_to_index);
+  bool gatherCues(CylinderCues& cues, std::vector<pcl::index_t>& column_to_index);
 
   enum class Level { Error, Warn, Debug };
   /** Records the failure, prints it at \a level, returns false. */
-  bool
-  fail(HoughFailure reason, const std::string& message, Level level = Level::Error);
+  bool fail(HoughFailure reason, const std::string& message, Level level = Level::Error);
   /** After fitCylinders found nothing among \a n usable points: the reason. */
-  bool
-  explainNoCylinder(const CylinderCues& cues, std::size_t total_points);
+  bool explainNoCylinder(const CylinderCues& cues, std::size_t total_points);
 
   bool estimate_curvatures_{true};
   bool diagnose_failures_{true};

@@ -49,28 +49,26 @@ struct ObjectSegmentationParameters {
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const ObjectSegmentationParameters& params);
+std::string validate(const ObjectSegmentationParameters& params);
 
 /** \brief Focal length in pixels of an organized cloud taken by a pinhole camera: the median
  * of x / (u - cx) over finite pixels, with cx = (width - 1) / 2. 0 when it cannot tell. */
-float
-estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud);
+float estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud);
 
 /** \brief The direction in which the image rows of an organized cloud go down (the camera's
  * y axis), in the cloud's frame, from the data alone: the mean over columns of the unit ray
  * (from \a viewpoint) of the lowest point minus that of the highest. Zero when it cannot tell.
  * Needs no sensor orientation, so clouds stored in any frame give the camera's. */
-Eigen::Vector3f
-imageDownDirection(const pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Vector3f& viewpoint);
+Eigen::Vector3f imageDownDirection(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                   const Eigen::Vector3f& viewpoint);
 
 /** \brief Per pixel of \a cloud (organized, non-object pixels NaN): 1 on a concave crease
  * seen from \a viewpoint, in either image direction (see ObjectSegmentationParameters). Each
  * test compares three points, each the mean of 5 pixels across the test direction, which
  * averages depth noise along the crease without blurring it. */
-std::vector<std::uint8_t>
-concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
-               const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& params);
+std::vector<std::uint8_t> concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
+                                         const Eigen::Vector3f& viewpoint,
+                                         const ObjectSegmentationParameters& params);
 
 /** \brief Splits the finite points of \a cloud (organized; only the candidate object points
  * finite) into objects:
@@ -85,11 +83,10 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
  *        discontinuity is then at least its half-width (3 sigma), so that a noisy sensor's
  *        surfaces do not shatter into fragments.
  * \return the segments' point indices, ascending, in no particular order of segments. */
-std::vector<pcl::Indices>
-segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                        const std::vector<std::uint8_t>& has_depth, float focal,
-                        const Eigen::Vector3f& viewpoint,
-                        const ObjectSegmentationParameters& params,
-                        const DepthBand* noise = nullptr);
+std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                                  const std::vector<std::uint8_t>& has_depth,
+                                                  float focal, const Eigen::Vector3f& viewpoint,
+                                                  const ObjectSegmentationParameters& params,
+                                                  const DepthBand* noise = nullptr);
 
 } // namespace facyl

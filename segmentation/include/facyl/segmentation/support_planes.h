@@ -31,29 +31,25 @@ struct DepthBand {
 
   /** \brief The residuals' robust scale at \a range (m); the fixed half-width / factor for
    * a fixed band. */
-  float
-  sigma(float range) const;
+  float sigma(float range) const;
   /** \brief Half-width of the band at \a range: a point is on the support when its
    * distance from the plane is at most this. */
-  float
-  halfWidth(float range) const
+  float halfWidth(float range) const
   {
     return fixed > 0.f ? fixed : factor * sigma(range);
   }
 };
 
 /** \brief A band of the same half-width \a half_width (> 0) at every range. */
-DepthBand
-fixedBand(float half_width);
+DepthBand fixedBand(float half_width);
 
 /** \brief The DepthBand of signed \a residuals (distances from a plane) measured at \a
  * ranges (at most 4000 of them, evenly): up to 8 bins of equal counts (at least 150 samples
  * each), each with 1.4826 x the
  * median |residual| (at least \a min_sigma), made non-decreasing with range. Pairs with a
  * non-finite value are skipped. With no finite pair, a fixed band of factor x min_sigma. */
-DepthBand
-estimateDepthBand(const std::vector<float>& ranges, const std::vector<float>& residuals,
-                  float factor, float min_sigma);
+DepthBand estimateDepthBand(const std::vector<float>& ranges, const std::vector<float>& residuals,
+                            float factor, float min_sigma);
 
 /** \brief Settings of refinePlaneRegion. */
 struct PlaneRegionSettings {
@@ -74,8 +70,8 @@ struct PlaneRegionSettings {
 struct PlaneRegion {
   Eigen::Vector4f plane{Eigen::Vector4f::Zero()}; ///< unit normal towards the viewpoint
   DepthBand band;
-  float max_angle{0.f};              ///< the normal tolerance used (rad)
-  std::vector<std::uint8_t> member;  ///< per cell: 1 on the plane
+  float max_angle{0.f};             ///< the normal tolerance used (rad)
+  std::vector<std::uint8_t> member; ///< per cell: 1 on the plane
   std::size_t members{0};
 };
 
@@ -95,46 +91,43 @@ struct PlaneRegion {
  * \param excluded  per cell, 1 for cells that are never members (those of other planes);
  *                  nullptr: none
  * \return false when the region does not span a plane or its normals spread too much. */
-bool
-refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
-                  const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
-                  const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& settings,
-                  PlaneRegion& region, const std::vector<std::uint8_t>* excluded = nullptr);
+bool refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
+                       const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
+                       const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& settings,
+                       PlaneRegion& region, const std::vector<std::uint8_t>* excluded = nullptr);
 
 /** \brief Least-squares plane through the columns of \a points with \a weights (>= 0), unit
  * normal pointing to \a viewpoint's side. \return false when they do not span a plane. */
-bool
-fitWeightedPlane(const Eigen::Matrix3Xf& points, const Eigen::VectorXf& weights,
-                 const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane);
+bool fitWeightedPlane(const Eigen::Matrix3Xf& points, const Eigen::VectorXf& weights,
+                      const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane);
 
 /** \brief Groups planes (a, b, c, d; unit normals on the same side, e.g. towards the sensor)
  * that are one plane: normals within \a angle (rad) and offsets within \a distance. Planes are
  * visited in \a order (e.g. largest first); each group is led by its first plane.
  * \return for each group, the indices of its planes. */
-std::vector<std::vector<std::size_t>>
-groupCoplanar(const std::vector<Eigen::Vector4f>& planes, const std::vector<std::size_t>& order,
-              float angle, float distance);
+std::vector<std::vector<std::size_t>> groupCoplanar(const std::vector<Eigen::Vector4f>& planes,
+                                                    const std::vector<std::size_t>& order,
+                                                    float angle, float distance);
 
 /** \brief Where a cluster lies relative to a plane: robust lowest and highest heights, and the
  * share of its points inside a height band. */
 struct HeightProfile {
-  float base{0.f};          ///< 2nd percentile of the heights
-  float top{0.f};           ///< 98th percentile
-  float in_band{0.f};       ///< share of the points with height in [min, max]
-  float extent{0.f};        ///< diagonal of the points' bounding box along the plane
+  float base{0.f};    ///< 2nd percentile of the heights
+  float top{0.f};     ///< 98th percentile
+  float in_band{0.f}; ///< share of the points with height in [min, max]
+  float extent{0.f};  ///< diagonal of the points' bounding box along the plane
 };
 
 /** \brief HeightProfile of \a points (3 x n) over \a plane (unit normal), band [min, max]. */
-HeightProfile
-heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, float min_height,
-              float max_height);
+HeightProfile heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane,
+                            float min_height, float max_height);
 
 /** \brief HeightProfile of \a points over \a plane whose object band starts, for each point,
  * at the larger of \a min_height and the plane's \a band at the point's range from \a
  * viewpoint (the points clearly above the support), and ends at \a max_height. */
-HeightProfile
-heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane, const DepthBand& band,
-              const Eigen::Vector3f& viewpoint, float min_height, float max_height);
+HeightProfile heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4f& plane,
+                            const DepthBand& band, const Eigen::Vector3f& viewpoint,
+                            float min_height, float max_height);
 
 /** \brief A cluster stands on a plane when it reaches down to it (base <= contact) and is
  * whole inside the object band, a box max_height high and wide (top below max_height -

@@ -20,14 +20,12 @@ struct PinholeCamera {
   float fx{0.f}, fy{0.f}, cx{0.f}, cy{0.f};
   int width{0}, height{0};
   /** \brief True when fx, fy > 0 and the image is not empty. */
-  bool
-  valid() const
+  bool valid() const
   {
     return fx > 0.f && fy > 0.f && width > 0 && height > 0;
   }
   /** \brief The pixel of camera-frame point \a p (z > 0). */
-  Eigen::Vector2f
-  project(const Eigen::Vector3f& p) const
+  Eigen::Vector2f project(const Eigen::Vector3f& p) const
   {
     return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   }
@@ -48,43 +46,36 @@ using PixelBox = std::array<int, 4>;
 
 /** \brief Least-squares plane through \a points (3 x n, n >= 3): unit normal, d; its normal
  * points to the side of \a viewpoint. \return false when the points do not span a plane. */
-bool
-fitPlane(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane);
+bool fitPlane(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& viewpoint,
+              Eigen::Vector4f& plane);
 
 /** \brief \a plane (a, b, c, d) scaled to a unit normal that points to \a viewpoint's side. */
-Eigen::Vector4f
-orientPlane(const Eigen::Vector4f& plane, const Eigen::Vector3f& viewpoint);
+Eigen::Vector4f orientPlane(const Eigen::Vector4f& plane, const Eigen::Vector3f& viewpoint);
 
 /** \brief Frame of a plane: z is its unit normal, origin the projection of \a origin_hint on it,
  * x the projection of the sensor's x axis (or y when x is nearly normal to the plane). Maps
  * table coordinates to sensor coordinates. */
-Eigen::Affine3f
-planeFrame(const Eigen::Vector4f& plane, const Eigen::Vector3f& origin_hint);
+Eigen::Affine3f planeFrame(const Eigen::Vector4f& plane, const Eigen::Vector3f& origin_hint);
 
 /** \brief Even-odd test of \a p against a simple polygon (vertices in order). */
-bool
-pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon);
+bool pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon);
 
 /** \brief Bounding box of organized-cloud indices in an image \a width pixels wide. */
-PixelBox
-pixelBox(const pcl::Indices& indices, std::uint32_t width);
+PixelBox pixelBox(const pcl::Indices& indices, std::uint32_t width);
 
 /** \brief Of organized-cloud \a indices (an image \a width x \a height pixels), the first and the
  * last of each image row (one when a row holds one), rows in order. The image of a plane is a
  * projective map of it, which keeps convex hulls: the convex hull of points of a plane seen in
  * an image has its vertices among these. Indices outside the image are skipped. */
-pcl::Indices
-rowExtremes(const pcl::Indices& indices, std::uint32_t width, std::uint32_t height);
+pcl::Indices rowExtremes(const pcl::Indices& indices, std::uint32_t width, std::uint32_t height);
 
 /** \brief Bounding box of the projections of \a points (camera frame; points with z <= 0 are
  * skipped), clipped to the image. All -1 when nothing projects inside. */
-PixelBox
-projectedBox(const Eigen::Matrix3Xf& points, const PinholeCamera& camera);
+PixelBox projectedBox(const Eigen::Matrix3Xf& points, const PinholeCamera& camera);
 
 /** \brief The sensor's pose in a cloud's frame (PCL's sensor_origin_ and sensor_orientation_,
  * the PCD file's VIEWPOINT): maps sensor coordinates to the cloud's. */
-Eigen::Affine3f
-sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation);
+Eigen::Affine3f sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation);
 
 /** \brief The sensor pose to use for a cloud whose points include \a sample (3 x n): the stored
  * one (sensorPose), unless its rotation puts fewer of the sample in front of the sensor (z > 0
@@ -92,23 +83,19 @@ sensorPose(const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation)
  * rather than the sensor's (PCL's grabber frames: a 180-degree turn about x, with the points in
  * the camera's frame); an RGB-D frame's points lie in front of its sensor. The origin is always
  * kept. */
-Eigen::Affine3f
-plausibleSensorPose(const Eigen::Matrix3Xf& sample, const Eigen::Vector4f& origin,
-                    const Eigen::Quaternionf& orientation);
+Eigen::Affine3f plausibleSensorPose(const Eigen::Matrix3Xf& sample, const Eigen::Vector4f& origin,
+                                    const Eigen::Quaternionf& orientation);
 
 /** \brief True when \a pose is the identity within 1e-6 (the cloud is in the sensor's frame). */
-bool
-isIdentityPose(const Eigen::Affine3f& pose);
+bool isIdentityPose(const Eigen::Affine3f& pose);
 
 /** \brief Plane (a, b, c, d) with unit normal moved by the rigid transform \a t. */
-Eigen::Vector4f
-transformPlane(const Eigen::Vector4f& plane, const Eigen::Affine3f& t);
+Eigen::Vector4f transformPlane(const Eigen::Vector4f& plane, const Eigen::Affine3f& t);
 
 /** \brief Pinhole intrinsics from points and the pixels they were measured at (least squares
  * on u = fx x/z + cx and v = fy y/z + cy). \return false with fewer than 10 usable points or a
  * degenerate fit. */
-bool
-estimatePinhole(const Eigen::Matrix3Xf& points, const Eigen::Matrix2Xf& pixels, int width,
-                int height, PinholeCamera& camera);
+bool estimatePinhole(const Eigen::Matrix3Xf& points, const Eigen::Matrix2Xf& pixels, int width,
+                     int height, PinholeCamera& camera);
 
 } // namespace facyl

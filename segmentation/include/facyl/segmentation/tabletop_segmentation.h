@@ -8,9 +8,9 @@
 #include <facyl/segmentation/tabletop_geometry.h>
 
 #include <pcl/ModelCoefficients.h>
+#include <pcl/PointIndices.h>
 #include <pcl/common/point_tests.h>
 #include <pcl/common/transforms.h>
-#include <pcl/PointIndices.h>
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -34,7 +34,7 @@ struct TabletopSegmentationParameters {
    * growing with range. > 0: this band at every range (the behaviour of earlier versions,
    * 0.015 there). */
   float plane_distance{0.f};
-  float band_factor{3.f};         ///< measured bands: half-width in robust sigmas, in [1, 10]
+  float band_factor{3.f}; ///< measured bands: half-width in robust sigmas, in [1, 10]
   /** Organized: regions of the plane search grow between neighbours whose normals differ by
    * less than this (rad, > 0); a seed setting, the support's own normal tolerance is measured
    * (see PlaneRegionSettings). */
@@ -56,7 +56,7 @@ struct TabletopSegmentationParameters {
    * - Euclidean: connected components within cluster_tolerance (the paper's clustering). */
   enum class Clustering { Euclidean, EdgeAware } clustering{Clustering::EdgeAware};
   ObjectSegmentationParameters objects; ///< settings of the EdgeAware clustering
-  float cluster_tolerance{0.02f}; ///< Euclidean cluster tolerance, > 0
+  float cluster_tolerance{0.02f};       ///< Euclidean cluster tolerance, > 0
   std::size_t min_cluster_size{300};
   std::size_t max_cluster_size{200000};
   /** A cluster is an object on a support if at least this share of its points lies over the
@@ -70,7 +70,7 @@ struct TabletopSegmentationParameters {
    *   is the one with the most object points standing on it;
    * - LargestPlane: the plane with the most points is the table (the paper's choice). */
   enum class Support { LargestPlane, ObjectsStanding } support{Support::ObjectsStanding};
-  float max_support_tilt{0.35f};  ///< rad, with an up direction: support normal vs up
+  float max_support_tilt{0.35f}; ///< rad, with an up direction: support normal vs up
   /** Supports are at least this large (m^2, the convex hull of their points; a stool or a
    * chair-arm tablet shows 0.05 m^2): smaller planes are faces of objects, and their points
    * stay object points. */
@@ -89,12 +89,11 @@ struct TabletopSegmentationParameters {
    * grid at every resolution. */
   int plane_step{0};
   std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
-  std::size_t max_planes{6};      ///< support candidates examined, in [1, 8]
+  std::size_t max_planes{6};        ///< support candidates examined, in [1, 8]
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const TabletopSegmentationParameters& params);
+std::string validate(const TabletopSegmentationParameters& params);
 
 /** \brief The distance threshold (m, scaled by depth^2 inside PCL) with which
  * pcl::OrganizedMultiPlaneSegmentation grows the seed regions of the plane search when
@@ -161,10 +160,10 @@ sensorFrameCopy(const pcl::PointCloud<PointT>& cloud, const Eigen::Affine3f& pos
 
 /** \brief One object above a support. */
 struct TabletopCluster {
-  pcl::PointIndices indices;   ///< into the input cloud, ascending
+  pcl::PointIndices indices;    ///< into the input cloud, ascending
   PixelBox box{-1, -1, -1, -1}; ///< pixel box (organized input, or projection with a camera)
   Eigen::Vector3f centroid{Eigen::Vector3f::Zero()};
-  int support{0};              ///< index into TabletopSegmentation::getSupports()
+  int support{0}; ///< index into TabletopSegmentation::getSupports()
 };
 
 /** \brief A plane that objects stand on (a table, a shelf, the floor). */
@@ -173,7 +172,7 @@ struct SupportPlane {
   /** z = the plane's normal (up), origin = centre of its points; maps plane coordinates to
    * the cloud's. */
   Eigen::Affine3f frame{Eigen::Affine3f::Identity()};
-  pcl::PointIndices inliers;            ///< points within the band (full resolution)
+  pcl::PointIndices inliers; ///< points within the band (full resolution)
   /** Distance from the plane that its points keep, by range from the sensor: the support's
    * measured noise and bias (or the fixed plane_distance). */
   DepthBand band;
@@ -218,8 +217,7 @@ struct SupportPlane {
  * makes segment() return false with empty outputs. segment() is not reentrant on one object;
  * distinct objects may run concurrently.
  */
-template <typename PointT>
-class TabletopSegmentation : public pcl::PCLBase<PointT> {
+template <typename PointT> class TabletopSegmentation : public pcl::PCLBase<PointT> {
 public:
   using Ptr = std::shared_ptr<TabletopSegmentation<PointT>>;
   using ConstPtr = std::shared_ptr<const TabletopSegmentation<PointT>>;
@@ -230,128 +228,108 @@ public:
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
 
   /** \brief All settings. */
-  void
-  setParameters(const TabletopSegmentationParameters& params)
+  void setParameters(const TabletopSegmentationParameters& params)
   {
     params_ = params;
   }
-  const TabletopSegmentationParameters&
-  getParameters() const
+  const TabletopSegmentationParameters& getParameters() const
   {
     return params_;
   }
   /** \brief Table inlier distance. */
-  void
-  setPlaneDistanceThreshold(float d)
+  void setPlaneDistanceThreshold(float d)
   {
     params_.plane_distance = d;
   }
   /** \brief Objects are points whose height above the table is in [min, max]. */
-  void
-  setHeightLimits(float min_height, float max_height)
+  void setHeightLimits(float min_height, float max_height)
   {
     params_.min_height = min_height;
     params_.max_height = max_height;
   }
   /** \brief Euclidean cluster tolerance. */
-  void
-  setClusterTolerance(float tolerance)
+  void setClusterTolerance(float tolerance)
   {
     params_.cluster_tolerance = tolerance;
   }
   /** \brief Cluster size limits (points). */
-  void
-  setClusterSizeLimits(std::size_t min_size, std::size_t max_size)
+  void setClusterSizeLimits(std::size_t min_size, std::size_t max_size)
   {
     params_.min_cluster_size = min_size;
     params_.max_cluster_size = max_size;
   }
   /** \brief Camera for the boxes of unorganized clouds (organized clouds use pixel indices);
    * its focal length also sets the pixel footprint of organized clouds (else estimated). */
-  void
-  setCamera(const PinholeCamera& camera)
+  void setCamera(const PinholeCamera& camera)
   {
     camera_ = camera;
   }
-  const PinholeCamera&
-  getCamera() const
+  const PinholeCamera& getCamera() const
   {
     return camera_;
   }
   /** \brief Gravity's opposite in the cloud's frame (e.g. from an IMU or tf): supports are
    * within max_support_tilt of horizontal. Zero (default): unknown, and "up" is the normal of
    * the family of parallel planes with the most points. */
-  void
-  setUpDirection(const Eigen::Vector3f& up)
+  void setUpDirection(const Eigen::Vector3f& up)
   {
     up_ = up;
   }
-  const Eigen::Vector3f&
-  getUpDirection() const
+  const Eigen::Vector3f& getUpDirection() const
   {
     return up_;
   }
 
   /** \brief Runs the segmentation. \return false (with PCL_ERROR) on bad input. */
-  bool
-  segment(std::vector<TabletopCluster>& clusters);
+  bool segment(std::vector<TabletopCluster>& clusters);
 
   /** \brief Moves the results of the last run (supports, table, hull, and \a clusters'
    * centroids) by the rigid transform \a t: for a caller that ran segment() on a copy of its
    * cloud in another frame. segment() itself does this for a cloud with a sensor pose. */
-  void
-  transformResults(const Eigen::Affine3f& t, std::vector<TabletopCluster>& clusters);
+  void transformResults(const Eigen::Affine3f& t, std::vector<TabletopCluster>& clusters);
 
   /** \brief Supports of the last run that hold objects, and the table (there unless the
    * frame showed no support at all). */
-  const std::vector<SupportPlane>&
-  getSupports() const
+  const std::vector<SupportPlane>& getSupports() const
   {
     return supports_;
   }
   /** \brief Focal length in pixels of the last organized input (the camera's, or estimated
    * from the cloud); 0 for unorganized clouds. */
-  float
-  getFocalLength() const
+  float getFocalLength() const
   {
     return focal_;
   }
   /** \brief Index of the table in getSupports() (0 when there is none). */
-  std::size_t
-  getTableIndex() const
+  std::size_t getTableIndex() const
   {
     return table_;
   }
   /** \brief False when no object stands on any plane: the table is then the largest plane,
    * or there is none (getSupports() empty). */
-  bool
-  tableFound() const
+  bool tableFound() const
   {
     return table_found_;
   }
   /** \brief Table plane (a, b, c, d), unit normal towards the sensor (SACMODEL_PLANE layout),
    * in the cloud's frame; no values when the frame showed no support. */
-  const pcl::ModelCoefficients&
-  getTableCoefficients() const
+  const pcl::ModelCoefficients& getTableCoefficients() const
   {
     return table_coefficients_;
   }
   /** \brief Table frame: z = table normal (up), origin = centre of the table points; maps table
    * coordinates to the cloud's. */
-  const Eigen::Affine3f&
-  getTableFrame() const
+  const Eigen::Affine3f& getTableFrame() const
   {
     return supports_.empty() ? identity_ : supports_[table_].frame;
   }
   /** \brief Table inliers (full resolution). */
-  const pcl::PointIndices&
-  getTableIndices() const
+  const pcl::PointIndices& getTableIndices() const
   {
     return supports_.empty() ? no_indices_ : supports_[table_].inliers;
   }
   /** \brief Vertices of the table's convex hull. */
-  const PointCloud&
-  getTableHull() const
+  const PointCloud& getTableHull() const
   {
     return *hull_;
   }
@@ -379,133 +357,105 @@ private:
     std::vector<SupportPlane> supports;
     std::vector<TabletopCluster> clusters;
     std::size_t table{0};
-    std::size_t standing{0}; ///< object points standing on the supports
+    std::size_t standing{0};         ///< object points standing on the supports
     std::size_t standing_objects{0}; ///< objects standing on them
   };
 
   /** The block size of the plane search on organized input (see plane_step). */
-  int
-  planeStep() const;
+  int planeStep() const;
   /** True when the input is searched as an image (organized and at least 16 plane-grid cells
    * wide and high), else as a point set. */
-  bool
-  searchedAsImage() const;
+  bool searchedAsImage() const;
   /** segment() on a cloud in the sensor's frame (identity sensor pose). */
-  bool
-  segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
+  bool segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
   /** The plane-search grid of an organized input at one block size. */
   struct PlaneGrid {
-    int step{1};                                  ///< block size (pixels)
-    pcl::PointCloud<pcl::PointXYZ>::Ptr small;    ///< the cells, organized
-    std::vector<pcl::index_t> source;             ///< each cell's first pixel (-1: none)
-    pcl::PointCloud<pcl::Normal>::Ptr normals;    ///< the cells' normals
+    int step{1};                                   ///< block size (pixels)
+    pcl::PointCloud<pcl::PointXYZ>::Ptr small;     ///< the cells, organized
+    std::vector<pcl::index_t> source;              ///< each cell's first pixel (-1: none)
+    pcl::PointCloud<pcl::Normal>::Ptr normals;     ///< the cells' normals
     Eigen::Matrix3Xf cells, cell_normals, samples; ///< as columns; samples: the first pixels
   };
   /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
    * depth near the first one's, its normal, and its first pixel; with \a twice, also the grid
    * of 2 \a step pixels, from the same pass over the image. */
-  void
-  planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice = nullptr) const;
+  void planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice = nullptr) const;
   /** \a grid from the block means of one step (normals, columns); empties \a blocks. */
-  void
-  finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const;
+  void finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const;
   /** The seed regions of the plane search on \a grid (cells), largest first. */
-  std::vector<pcl::PointIndices>
-  planeSeeds(const PlaneGrid& grid) const;
-  void
-  findPlanesOrganized(std::vector<Candidate>& candidates);
+  std::vector<pcl::PointIndices> planeSeeds(const PlaneGrid& grid) const;
+  void findPlanesOrganized(std::vector<Candidate>& candidates);
   /** Grows \a seeds of \a grid into candidates (growCandidate), skipping the seeds mostly on
    * the cells of \a candidates found before; appends them. */
-  void
-  growCandidates(const PlaneGrid& grid, const std::vector<pcl::PointIndices>& seeds,
-                 std::vector<Candidate>& candidates) const;
-  void
-  findPlanesUnorganized(std::vector<Candidate>& candidates);
+  void growCandidates(const PlaneGrid& grid, const std::vector<pcl::PointIndices>& seeds,
+                      std::vector<Candidate>& candidates) const;
+  void findPlanesUnorganized(std::vector<Candidate>& candidates);
   /** How seeds grow into planes: the band measured, or plane_distance. */
-  PlaneRegionSettings
-  regionSettings() const;
+  PlaneRegionSettings regionSettings() const;
   /** Grows \a seed (cells of \a cells) into a candidate; cells already \a taken by earlier
    * candidates stay with them, the new ones are marked. \a source maps cells to input
    * indices, \a cell_points is the number of pixels a cell stands for.
    * \return false when the region is not a plane of min_plane_points. */
-  bool
-  growCandidate(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
-                const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
-                const std::vector<pcl::index_t>& source, std::size_t cell_points,
-                std::vector<std::uint8_t>& taken, Candidate& out) const;
+  bool growCandidate(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
+                     const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
+                     const std::vector<pcl::index_t>& source, std::size_t cell_points,
+                     std::vector<std::uint8_t>& taken, Candidate& out) const;
   /** Supports span a plane that does not pass by the sensor, are not a part of a larger
    * candidate, and (with an up direction) are horizontal. */
-  void
-  keepSupportCandidates(std::vector<Candidate>& candidates) const;
+  void keepSupportCandidates(std::vector<Candidate>& candidates) const;
   /** One pass over the points: each candidate's inliers (in \a all) and the points above
    * some candidate. */
-  void
-  classifyPoints(const std::vector<Candidate>& candidates, std::vector<SupportPlane>& all,
-                 std::vector<Above>& above) const;
+  void classifyPoints(const std::vector<Candidate>& candidates, std::vector<SupportPlane>& all,
+                      std::vector<Above>& above) const;
   /** The families of parallel candidates, those an upright camera would see facing up first,
    * then by their number of points. */
-  std::vector<std::vector<std::size_t>>
-  rankFamilies(const std::vector<Candidate>& candidates, const std::vector<SupportPlane>& all) const;
+  std::vector<std::vector<std::size_t>> rankFamilies(const std::vector<Candidate>& candidates,
+                                                     const std::vector<SupportPlane>& all) const;
   /** The supports of \a family (large enough, see min_support_area) and the objects on
    * them, on every \a stride-th pixel and row of an organized input (1: all; larger: only the
    * standing points are counted, to compare families). \a final: the result (the family's
    * planes are moved out of \a all). */
-  Trial
-  tryFamily(const std::vector<std::size_t>& family, const std::vector<Candidate>& candidates,
-            std::vector<SupportPlane>& all, const std::vector<Above>& above, int stride,
-            bool final);
+  Trial tryFamily(const std::vector<std::size_t>& family, const std::vector<Candidate>& candidates,
+                  std::vector<SupportPlane>& all, const std::vector<Above>& above, int stride,
+                  bool final);
   /** The pixel stride of the coarse trials of families (1 for point sets). */
-  int
-  coarseStride() const;
+  int coarseStride() const;
   /** Of a candidate's \a region, the points that can be vertices of its convex hull: on an
    * image, each row's first and last (rowExtremes); all of them in a point set. */
-  pcl::Indices
-  hullCandidates(const pcl::Indices& region) const;
+  pcl::Indices hullCandidates(const pcl::Indices& region) const;
   /** Area of the convex hull of the points that found \a c, in \a frame's plane. */
-  float
-  regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;
+  float regionArea(const Candidate& c, const Eigen::Affine3f& frame) const;
   /** Convex hull of a support's \a inliers, in the coordinates of its plane's \a frame: on
    * organized clouds those near the region found as candidate \a c (every point when
    * nullptr). */
-  std::vector<Eigen::Vector2f>
-  supportHull(const Eigen::Affine3f& frame, const pcl::Indices& inliers, const Candidate* c) const;
+  std::vector<Eigen::Vector2f> supportHull(const Eigen::Affine3f& frame,
+                                           const pcl::Indices& inliers, const Candidate* c) const;
   /** The object points split into clusters (see Clustering). */
-  void
-  cluster(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  void cluster(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** cluster() on a grid of every \a stride-th pixel and row of an organized input (\a objects
    * on that grid), without joining parts seen around occluders: the clusters hold those
    * pixels only (enough to count the objects standing on a family of supports). */
-  void
-  clusterCoarse(const pcl::Indices& objects, int stride, std::vector<pcl::Indices>& out) const;
-  void
-  clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
-  void
-  clusterUnorganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  void clusterCoarse(const pcl::Indices& objects, int stride, std::vector<pcl::Indices>& out) const;
+  void clusterOrganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  void clusterUnorganized(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** EdgeAware on unorganized clouds: the points projected into a depth image (the camera
    * given, else a pinhole at the sensor origin looking at the objects), segmented as an
    * organized frame; each point takes its pixel's segment. */
-  void
-  segmentProjected(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
+  void segmentProjected(const pcl::Indices& objects, std::vector<pcl::Indices>& out) const;
   /** The support of a cluster (points \a pts) among supports_. */
-  Placement
-  place(const Eigen::Matrix3Xf& pts) const;
+  Placement place(const Eigen::Matrix3Xf& pts) const;
   /** Each cluster to the support under it; the table; supports without objects dropped.
    * \a scale: the points each point of \a groups stands for (coarse trials, which keep no
    * clusters). */
-  void
-  assignClusters(std::vector<pcl::Indices>& groups, Trial& trial, std::size_t scale);
+  void assignClusters(std::vector<pcl::Indices>& groups, Trial& trial, std::size_t scale);
   /** Makes \a trial the result: supports, table, its coefficients and hull. */
-  void
-  adopt(Trial trial, std::vector<TabletopCluster>& clusters);
+  void adopt(Trial trial, std::vector<TabletopCluster>& clusters);
   /** No support in view (or none that objects stand on): the compact segments of the frame
    * (of its points not flagged in \a taken) are objects too, with support -1. */
-  void
-  segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
-                        const std::vector<std::uint8_t>* taken = nullptr);
-  TabletopCluster
-  makeCluster(pcl::Indices indices, int support) const;
-  void
-  reset();
+  void segmentWithoutSupport(std::vector<TabletopCluster>& clusters,
+                             const std::vector<std::uint8_t>* taken = nullptr);
+  TabletopCluster makeCluster(pcl::Indices indices, int support) const;
+  void reset();
 
   TabletopSegmentationParameters params_;
   PinholeCamera camera_;
@@ -520,11 +470,11 @@ private:
     float region{0.f};
   };
   std::vector<Hulls> hulls_;
-  DepthBand noise_;        ///< the band of the largest plane of the last run
+  DepthBand noise_; ///< the band of the largest plane of the last run
   bool has_noise_{false};
   std::size_t table_{0};
   bool table_found_{false};
-  float focal_{0.f}; ///< pixels (organized input)
+  float focal_{0.f};                                    ///< pixels (organized input)
   Eigen::Vector3f image_down_{Eigen::Vector3f::Zero()}; ///< organized input; zero: unknown
   pcl::ModelCoefficients table_coefficients_;
   typename PointCloud::Ptr hull_{new PointCloud};

@@ -7,8 +7,8 @@
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 
 namespace facyl {
 

@@ -19,43 +19,40 @@ namespace facyl {
  * Not thread safe: one object per thread. */
 class Random {
 public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
+  explicit Random(std::uint64_t seed)
+      : engine_(seed)
+  {
+  }
 
   /** \brief 64 random bits. */
-  std::uint64_t
-  bits()
+  std::uint64_t bits()
   {
     return engine_();
   }
   /** \brief Uniform in [0, 1). */
-  double
-  unit()
+  double unit()
   {
     return static_cast<double>(engine_() >> 11) * 0x1.0p-53;
   }
   /** \brief Uniform in [a, b). */
-  float
-  uniform(float a, float b)
+  float uniform(float a, float b)
   {
     return a + static_cast<float>(unit() * (static_cast<double>(b) - a));
   }
   /** \brief Uniform integer in [lo, hi] (hi >= lo; the bias of the modulo is below 2^-40 for
    * the small ranges used here). */
-  int
-  integer(int lo, int hi)
+  int integer(int lo, int hi)
   {
     const auto span = static_cast<std::uint64_t>(static_cast<std::int64_t>(hi) - lo + 1);
     return lo + static_cast<int>(engine_() % span);
   }
   /** \brief True with probability \a p. */
-  bool
-  chance(double p)
+  bool chance(double p)
   {
     return unit() < p;
   }
   /** \brief Standard normal deviate (Box-Muller; the second value of each pair is kept). */
-  float
-  normal()
+  float normal()
   {
     if (has_spare_) {
       has_spare_ = false;

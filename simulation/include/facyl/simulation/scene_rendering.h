@@ -28,27 +28,23 @@ struct RayCastImage {
 /** \brief Ray casts \a scene through every pixel of \a camera: table (rectangle or disc at
  * z = 0, curved by its top_sag), floor, wall, furniture, objects and scenery, with Lambertian
  * shading, textures and the highlights of glossy surfaces. */
-RayCastImage
-castRays(const TabletopScene& scene, const CameraIntrinsics& camera);
+RayCastImage castRays(const TabletopScene& scene, const CameraIntrinsics& camera);
 
 /** \brief True if a pixel of \a image sees a transparent surface. */
-bool
-hasTransparentSurfaces(const RayCastImage& image);
+bool hasTransparentSurfaces(const RayCastImage& image);
 
 /** \brief What lies behind the transparent surfaces of \a front: the pixels whose surface is
  * transparent, cast again through the transparent objects; the others are empty (infinite
  * depth). */
-RayCastImage
-castRaysBehindTransparent(const TabletopScene& scene, const CameraIntrinsics& camera,
-                          const RayCastImage& front);
+RayCastImage castRaysBehindTransparent(const TabletopScene& scene, const CameraIntrinsics& camera,
+                                       const RayCastImage& front);
 
 /** \brief Resolves the transparent pixels of \a image: their colour mixes in what lies
  * \a behind (castRaysBehindTransparent) by the transparency; with probability transparency x
  * sensor.see_through the pixel becomes the surface behind (depth, incidence, material, id,
  * class), otherwise it keeps its weak front return. Deterministic for a seed. */
-void
-seeThroughTransparent(RayCastImage& image, const RayCastImage& behind,
-                      const DepthSensorModel& sensor, std::uint64_t seed);
+void seeThroughTransparent(RayCastImage& image, const RayCastImage& behind,
+                           const DepthSensorModel& sensor, std::uint64_t seed);
 
 /** \brief Applies \a sensor to \a image: range limits, missing pixels (grazing angles, depth
  * edges, random dropouts, speckled holes, weak returns of dark, glossy and transparent
@@ -58,10 +54,9 @@ seeThroughTransparent(RayCastImage& image, const RayCastImage& behind,
  * (organized, camera frame, NaN without depth) and counts the pixels with depth of object id
  * 2 + k in visible_pixels[k] (sized by the caller: one per object).
  * Deterministic for a seed on every platform. */
-void
-applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
-                 const DepthSensorModel& sensor, std::uint64_t seed,
-                 pcl::PointCloud<pcl::PointXYZRGBA>& cloud,
-                 std::vector<std::size_t>& visible_pixels);
+void applySensorModel(const RayCastImage& image, const CameraIntrinsics& camera,
+                      const DepthSensorModel& sensor, std::uint64_t seed,
+                      pcl::PointCloud<pcl::PointXYZRGBA>& cloud,
+                      std::vector<std::size_t>& visible_pixels);
 
 } // namespace facyl

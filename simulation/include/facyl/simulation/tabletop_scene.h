@@ -30,8 +30,7 @@ enum class SceneClass : std::uint8_t {
 };
 
 /** \brief "background", "table", "cylinder", "box", "sphere", "cone", "bowl" or "scenery". */
-std::string
-toString(SceneClass c);
+std::string toString(SceneClass c);
 
 /** \brief Pixel id of scenery item 0 (RenderedScene::object_id); item j has this id + j. */
 constexpr std::uint16_t kFirstSceneryId = 1000;
@@ -51,8 +50,7 @@ struct SurfaceMaterial {
   float transparency{0.f};
 
   /** \brief True for the reference surface (all defaults). */
-  bool
-  isReference() const
+  bool isReference() const
   {
     return reflectance == 1.f && gloss == 0.f && transparency == 0.f;
   }
@@ -62,21 +60,21 @@ struct SurfaceMaterial {
  * its base (for spheres and bowls: the lowest point). */
 struct SceneObject {
   SceneClass cls{SceneClass::Cylinder};
-  std::string kind;            ///< can, tin, cup, tube, box, sphere, cone, bowl
+  std::string kind; ///< can, tin, cup, tube, box, sphere, cone, bowl
   Eigen::Isometry3f pose{Eigen::Isometry3f::Identity()}; ///< local to world (table) frame
-  float radius{0.04f};         ///< cylinder, cone base, sphere, bowl
-  float height{0.1f};          ///< cylinder, cone
+  float radius{0.04f};                                   ///< cylinder, cone base, sphere, bowl
+  float height{0.1f};                                    ///< cylinder, cone
   Eigen::Vector3f size{Eigen::Vector3f::Constant(0.1f)}; ///< box: x, y, z
-  bool open_top{false};        ///< cylinder: a cup (inner wall and bottom visible)
-  float wall{0.004f};          ///< wall thickness of cups and bowls
-  bool handle{false};          ///< cylinder: a handle on the local +x side
-  bool lying{false};           ///< cylinder with a horizontal axis
-  bool leaning{false};         ///< tilted against another object
-  int support{-1};             ///< index of the object it stands on; -1: the table
-  std::vector<int> touches;    ///< indices of the objects it was placed in contact with
+  bool open_top{false};     ///< cylinder: a cup (inner wall and bottom visible)
+  float wall{0.004f};       ///< wall thickness of cups and bowls
+  bool handle{false};       ///< cylinder: a handle on the local +x side
+  bool lying{false};        ///< cylinder with a horizontal axis
+  bool leaning{false};      ///< tilted against another object
+  int support{-1};          ///< index of the object it stands on; -1: the table
+  std::vector<int> touches; ///< indices of the objects it was placed in contact with
   Eigen::Vector3f colour[2]{Eigen::Vector3f::Ones(), Eigen::Vector3f::Ones()}; ///< RGB in [0, 1]
-  int texture{0};              ///< 0 plain, 1 stripes, 2 checker (between the two colours)
-  SurfaceMaterial material;    ///< what the depth sensor sees of it
+  int texture{0};           ///< 0 plain, 1 stripes, 2 checker (between the two colours)
+  SurfaceMaterial material; ///< what the depth sensor sees of it
   /** Box and closed cylinder (table tops): the top face is a paraboloid that rises this far
    * (m) above the top's corners (box) or rim (cylinder) at its centre; < 0: it sags. */
   float top_sag{0.f};
@@ -84,12 +82,11 @@ struct SceneObject {
 
 /** \brief Height (local z, above the flat top) of the curved top of \a o at local (x, y):
  * top_sag * (1 - (x^2 + y^2) / rho^2), rho the half diagonal of a box or a cylinder's radius. */
-float
-curvedTopHeight(const SceneObject& o, float x, float y);
+float curvedTopHeight(const SceneObject& o, float x, float y);
 
 /** \brief A piece of scenery: its parts share one pixel id and SceneClass::Scenery. */
 struct SceneryItem {
-  std::string kind; ///< table, shelf, chair, cabinet, boxes, robot
+  std::string kind;               ///< table, shelf, chair, cabinet, boxes, robot
   std::vector<SceneObject> parts; ///< world frame; cls gives the shape only
 };
 
@@ -109,20 +106,20 @@ struct DepthSensorModel {
   float noise_coefficient{1.5e-3f}; ///< axial sigma = coefficient * z^2 (m), >= 0
   float baseline_focal{43.5f};      ///< baseline (m) x focal (px) of the disparity, > 0
   float disparity_step{0.125f};     ///< disparity quantum (px); 0: no quantisation
-  float edge_jump{0.04f};  ///< pixels next to a depth jump > edge_jump * z are missing; 0: off
+  float edge_jump{0.04f};   ///< pixels next to a depth jump > edge_jump * z are missing; 0: off
   float grazing_cos{0.15f}; ///< pixels whose |cos(incidence)| is below this are missing
   float dropout{0.002f};    ///< share of pixels missing at random, in [0, 1)
   /** Speckled holes: blobs of missing pixels are centred on this share of the pixels, in
    * [0, 0.1]; 0: none. */
   float hole_rate{0.f};
-  float hole_radius{2.f};   ///< mean radius of a hole (px), in [0.5, 20]
+  float hole_radius{2.f}; ///< mean radius of a hole (px), in [0.5, 20]
   /** Stereo matching fattens foreground objects: a background pixel beside a foreground
    * edge takes the foreground depth with this probability, in [0, 1]. */
   float edge_fattening{0.f};
-  int colour_shift_u{0};    ///< colour-to-depth misregistration (px), |shift| <= 16
+  int colour_shift_u{0}; ///< colour-to-depth misregistration (px), |shift| <= 16
   int colour_shift_v{0};
-  float min_range{0.4f};    ///< no depth nearer than this (m)
-  float max_range{4.0f};    ///< or farther than this (m)
+  float min_range{0.4f};     ///< no depth nearer than this (m)
+  float max_range{4.0f};     ///< or farther than this (m)
   float colour_noise{0.02f}; ///< std. dev. of RGB noise, in [0, 1] units
 
   // Systematic depth errors (calibration), off by default.
@@ -164,19 +161,16 @@ struct DepthSensorModel {
   bool randomize{false};
 
   /** \brief Kinect-like structured light (the defaults). */
-  static DepthSensorModel
-  structuredLight();
+  static DepthSensorModel structuredLight();
   /** \brief RealSense D4xx-like active stereo: noise growing with z^2 (sigma 3 mm at 1 m),
    * 1/32 px sub-pixel disparity, speckled holes, fattened edges and 2 px of colour/depth
    * misregistration. */
-  static DepthSensorModel
-  activeStereo();
+  static DepthSensorModel activeStereo();
 };
 
 /** \brief Sensor presets by name: "kinect" (structured light), "stereo" (active stereo) or
  * "random" (a sensor drawn per frame, see drawSensor). \return false for an unknown name. */
-bool
-parseSensorPreset(const std::string& name, DepthSensorModel& sensor, CameraIntrinsics& camera);
+bool parseSensorPreset(const std::string& name, DepthSensorModel& sensor, CameraIntrinsics& camera);
 
 /** \brief Depth sensing principle of a drawn sensor. */
 enum class SensorFamily : std::uint8_t {
@@ -186,8 +180,7 @@ enum class SensorFamily : std::uint8_t {
 };
 
 /** \brief "structured_light", "active_stereo" or "time_of_flight". */
-std::string
-toString(SensorFamily f);
+std::string toString(SensorFamily f);
 
 /** \brief A sensor drawn for one frame. */
 struct DrawnSensor {
@@ -200,8 +193,7 @@ struct DrawnSensor {
  * settings (noise, bias, holes, dropout, edges, misregistration, response to materials, range)
  * over ranges that cover that family's real sensors (docs/simulation.md). Deterministic for a
  * seed on every platform; \a base gives the image size and the focal length to scale. */
-DrawnSensor
-drawSensor(const CameraIntrinsics& base, std::uint64_t seed);
+DrawnSensor drawSensor(const CameraIntrinsics& base, std::uint64_t seed);
 
 /** \brief A closed interval of a random setting. */
 struct Range {
@@ -225,23 +217,23 @@ struct MaterialShares {
 struct TabletopSceneParameters {
   std::size_t min_objects{3};
   std::size_t max_objects{10};
-  float cylinder_share{0.5f};   ///< probability that an object is a cylinder, in [0, 1]
-  float lying_share{0.25f};     ///< probability that a can or tube lies on its side
+  float cylinder_share{0.5f}; ///< probability that an object is a cylinder, in [0, 1]
+  float lying_share{0.25f};   ///< probability that a can or tube lies on its side
   /** Probabilities that an object is placed in contact with one already there, in [0, 1],
    * summing to at most 1: beside it (touching), on top of it (stacked), or tilted against it
    * (leaning). The rest stand apart. */
   float touch_share{0.f}, stack_share{0.f}, lean_share{0.f};
-  float round_table_share{0.f}; ///< probability that the table is round
-  Range table_width{1.4f, 1.4f};  ///< rectangular table: extent along world x (m)
-  Range table_depth{1.0f, 1.0f};  ///< along world y (m)
-  Range table_radius{0.3f, 0.5f}; ///< round table (m)
-  Range table_height{0.75f, 0.75f}; ///< table top above the floor (m)
-  bool table_legs{false};       ///< legs (rectangular) or a pedestal (round) down to the floor
-  float wall_share{0.f};        ///< probability of a wall behind the table
-  Range camera_distance{0.7f, 1.1f};  ///< to the look-at point (m)
-  Range camera_elevation{0.6f, 1.0f}; ///< above the table plane (rad), in (0, pi/2)
+  float round_table_share{0.f};      ///< probability that the table is round
+  Range table_width{1.4f, 1.4f};     ///< rectangular table: extent along world x (m)
+  Range table_depth{1.0f, 1.0f};     ///< along world y (m)
+  Range table_radius{0.3f, 0.5f};    ///< round table (m)
+  Range table_height{0.75f, 0.75f};  ///< table top above the floor (m)
+  bool table_legs{false};            ///< legs (rectangular) or a pedestal (round) down to the floor
+  float wall_share{0.f};             ///< probability of a wall behind the table
+  Range camera_distance{0.7f, 1.1f}; ///< to the look-at point (m)
+  Range camera_elevation{0.6f, 1.0f};  ///< above the table plane (rad), in (0, pi/2)
   Range camera_azimuth{-0.35f, 0.35f}; ///< around the table's vertical (rad)
-  Range camera_roll{-0.08f, 0.08f};   ///< about the optical axis (rad)
+  Range camera_roll{-0.08f, 0.08f};    ///< about the optical axis (rad)
   /** The camera looks at a point this far (m, at most) from the objects' area centre, so
    * objects near the border are cut by the image edge. */
   float camera_target_jitter{0.05f};
@@ -271,24 +263,20 @@ struct TabletopSceneParameters {
  * leaning; tins among the cylinders; rectangular (0.5-1.4 m) or round (r 0.3-0.55 m) tables
  * 0.45-0.8 m high with legs, a wall behind in 30% of the scenes; cameras 0.55-1.6 m away, 20-80
  * degrees above the table, looking off-centre so objects get cut by the border. */
-TabletopSceneParameters
-clutteredSceneParameters();
+TabletopSceneParameters clutteredSceneParameters();
 
 /** \brief The realistic preset: the cluttered one plus table tops curved by up to 6 mm, glossy
  * (35%) and dark (30%) table tops, glossy, dark and transparent objects, 2-6 scenery items
  * 1.5-4 m from the camera, a robot arm in 35% of the scenes, cameras 15-85 degrees above the
  * table, rolled anywhere about the optical axis in 30% of the scenes, a wall in 15%. */
-TabletopSceneParameters
-realisticSceneParameters();
+TabletopSceneParameters realisticSceneParameters();
 
 /** \brief Layout presets by name: "spread" (the defaults), "cluttered" or "realistic"; sets
  * all of \a params (apply the sensor preset after). \return false for an unknown name. */
-bool
-parseLayoutPreset(const std::string& name, TabletopSceneParameters& params);
+bool parseLayoutPreset(const std::string& name, TabletopSceneParameters& params);
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const TabletopSceneParameters& params);
+std::string validate(const TabletopSceneParameters& params);
 
 /** \brief Table shape. */
 enum class TableShape : std::uint8_t { Rectangle, Round };
@@ -316,17 +304,14 @@ struct TabletopScene {
   std::vector<SceneryItem> scenery;
 
   /** \brief True if (x, y) lies on the table top. */
-  bool
-  onTable(float x, float y) const;
+  bool onTable(float x, float y) const;
 
   /** \brief The table top (the furniture piece of kind "table"), or nullptr. */
-  const SceneObject*
-  tableTop() const;
+  const SceneObject* tableTop() const;
 };
 
 /** \brief Height (world z) of the table's upper surface at (x, y): 0 for a flat top. */
-float
-tableTopHeight(const TabletopScene& scene, float x, float y);
+float tableTopHeight(const TabletopScene& scene, float x, float y);
 
 /** \brief A rendered RGB-D frame with per-pixel ground truth. Pixel ids: 0 background (floor,
  * wall), 1 table, 2 + i the i-th object, kFirstSceneryId + j the j-th scenery item; ids and
@@ -341,45 +326,40 @@ struct RenderedScene {
   TabletopScene scene;
   CameraIntrinsics camera;
   Eigen::Vector4f table_plane{Eigen::Vector4f::Zero()}; ///< camera frame, normal to the camera
-  DepthSensorModel sensor;                    ///< the model applied
+  DepthSensorModel sensor;                              ///< the model applied
   std::optional<SensorFamily> sensor_family; ///< set when the sensor was drawn (randomize)
 };
 
 /** \brief Ground truth of a cylinder object in the camera frame. */
 struct CylinderTruth {
-  Eigen::Vector3f base{Eigen::Vector3f::Zero()}; ///< base centre
+  Eigen::Vector3f base{Eigen::Vector3f::Zero()};  ///< base centre
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()}; ///< unit, base to top
   float radius{0.f};
   float height{0.f};
 };
 
 /** \brief \a object's cylinder in the frame of the camera of \a scene. */
-CylinderTruth
-cylinderTruth(const TabletopScene& scene, const SceneObject& object);
+CylinderTruth cylinderTruth(const TabletopScene& scene, const SceneObject& object);
 
 /** \brief Draws a random scene: table, camera pose, objects standing, lying, touching,
  * stacked or leaning without interpenetrating. Deterministic for a seed on every platform.
  * \throws std::invalid_argument if the parameters are invalid. */
-TabletopScene
-generateTabletopScene(const TabletopSceneParameters& params);
+TabletopScene generateTabletopScene(const TabletopSceneParameters& params);
 
 /** \brief Ray casts \a scene (exact intersections of the analytic shapes), shades it
  * (Lambertian, textures, highlights of glossy surfaces, transparency) and applies \a sensor
  * (drawn from \a seed first when sensor.randomize). Deterministic for a seed.
  * \throws std::invalid_argument if the camera or sensor settings are invalid. */
-RenderedScene
-renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
-                    const DepthSensorModel& sensor, std::uint64_t seed);
+RenderedScene renderTabletopScene(const TabletopScene& scene, const CameraIntrinsics& camera,
+                                  const DepthSensorModel& sensor, std::uint64_t seed);
 
 /** \brief generateTabletopScene then renderTabletopScene with params.seed. */
-RenderedScene
-simulateTabletopScene(const TabletopSceneParameters& params);
+RenderedScene simulateTabletopScene(const TabletopSceneParameters& params);
 
 /** \brief The scene's ground truth as a JSON object (camera intrinsics and frame, table plane
  * and shape, objects with class, kind, pose, visible pixels, support and contacts and, for
  * cylinders, axis/radius/height in the camera frame). Only where they are used: the table's
  * sag, materials other than the reference, the scenery items and the drawn sensor. */
-std::string
-groundTruthJson(const RenderedScene& rendered);
+std::string groundTruthJson(const RenderedScene& rendered);
 
 } // namespace facyl

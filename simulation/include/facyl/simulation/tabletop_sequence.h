@@ -34,16 +34,13 @@ struct TabletopSequenceParameters {
 };
 
 /** \brief "none", "remove" or "add". */
-std::string
-toString(TabletopSequenceParameters::Change c);
+std::string toString(TabletopSequenceParameters::Change c);
 
 /** \brief "none", "remove" or "add" into \a c. \return false for another name. */
-bool
-parseSequenceChange(const std::string& name, TabletopSequenceParameters::Change& c);
+bool parseSequenceChange(const std::string& name, TabletopSequenceParameters::Change& c);
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const TabletopSequenceParameters& params);
+std::string validate(const TabletopSequenceParameters& params);
 
 /** \brief A static scene and the camera's path. */
 struct TabletopSequence {
@@ -52,16 +49,14 @@ struct TabletopSequence {
   TabletopScene scene;
   std::vector<Eigen::Isometry3f> cameras; ///< camera_to_world of each frame
   TabletopSequenceParameters::Change change{TabletopSequenceParameters::Change::None};
-  int changed_object{-1};     ///< index into scene.objects of the object taken or put, -1
+  int changed_object{-1};      ///< index into scene.objects of the object taken or put, -1
   std::size_t change_frame{0}; ///< the frame of the change
 
   /** \brief True when object \a object is on the table in frame \a frame. */
-  bool
-  present(std::size_t object, std::size_t frame) const;
+  bool present(std::size_t object, std::size_t frame) const;
   /** \brief The scene as frame \a frame sees it: its camera, without the object that is not
    * there (the other objects keep their order; support and contact indices follow). */
-  TabletopScene
-  sceneAt(std::size_t frame) const;
+  TabletopScene sceneAt(std::size_t frame) const;
 };
 
 /** \brief The scene of \a scene_params (generateTabletopScene, the same for a seed as a single
@@ -71,28 +66,24 @@ struct TabletopSequence {
  * choices are drawn from their own stream of scene_params.seed (facyl::Random), so the scene
  * is unchanged. Deterministic for a seed.
  * \throws std::invalid_argument if a parameter is invalid. */
-TabletopSequence
-generateTabletopSequence(const TabletopSceneParameters& scene_params,
-                         const TabletopSequenceParameters& params);
+TabletopSequence generateTabletopSequence(const TabletopSceneParameters& scene_params,
+                                          const TabletopSequenceParameters& params);
 
 /** \brief Frame \a frame of \a sequence rendered (renderTabletopScene on sceneAt(frame) with
  * \a seed). Ground truth keeps the sequence's object numbering: object_id 2 + i is
  * scene.objects[i] in every frame, visible_pixels has one entry per object of the sequence
  * (0 when absent), and the result's scene is the whole sequence's with the frame's camera.
  * \throws std::out_of_range for a frame beyond the path. */
-RenderedScene
-renderSequenceFrame(const TabletopSequence& sequence, std::size_t frame,
-                    const CameraIntrinsics& camera, const DepthSensorModel& sensor,
-                    std::uint64_t seed);
+RenderedScene renderSequenceFrame(const TabletopSequence& sequence, std::size_t frame,
+                                  const CameraIntrinsics& camera, const DepthSensorModel& sensor,
+                                  std::uint64_t seed);
 
 /** \brief The seed with which frame \a frame of the sequence of scene seed \a seed is rendered
  * by the tools (facyl_synth --sequence, facyl_track_eval). */
-std::uint64_t
-sequenceFrameSeed(std::uint64_t seed, std::size_t frame);
+std::uint64_t sequenceFrameSeed(std::uint64_t seed, std::size_t frame);
 
 /** \brief The sequence's ground truth as JSON: the change, and per frame the camera pose
  * (camera_to_world, row-major 4 x 4) and the ids (2 + object index) present. */
-std::string
-sequenceJson(const TabletopSequence& sequence);
+std::string sequenceJson(const TabletopSequence& sequence);
 
 } // namespace facyl

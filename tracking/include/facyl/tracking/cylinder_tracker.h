@@ -64,9 +64,9 @@ struct CylinderTrackerParameters {
 
   // ---- filtering (per observation: the measurement's standard deviation; per frame: the
   // process noise, what re-anchoring may move a static object by)
-  float measurement_centroid{0.02f};  ///< m, the centroid of the visible points, > 0
-  float measurement_extent{0.01f};    ///< m, each end of a cylinder along its axis, > 0
-  float process_position{0.002f};     ///< m per frame, >= 0
+  float measurement_centroid{0.02f}; ///< m, the centroid of the visible points, > 0
+  float measurement_extent{0.01f};   ///< m, each end of a cylinder along its axis, > 0
+  float process_position{0.002f};    ///< m per frame, >= 0
   /** An observed end of a cylinder inside the tracked extent counts with this weight (an
    * occluded end), one beyond it fully; in (0, 1]. */
   float shrink_weight{0.3f};
@@ -102,8 +102,7 @@ struct CylinderTrackerParameters {
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string
-validate(const CylinderTrackerParameters& params);
+std::string validate(const CylinderTrackerParameters& params);
 
 /** \brief What happened to a track in the last frame. */
 enum class TrackStatus : std::uint8_t {
@@ -118,28 +117,27 @@ enum class TrackStatus : std::uint8_t {
 
 /** \brief "seen", "missed", "occluded", "merged", "seen_through", "out_of_view" or
  * "not_updated". */
-std::string
-toString(TrackStatus s);
+std::string toString(TrackStatus s);
 
 /** \brief One tracked object. Geometry in the tracker's world frame: the plane of the support
  * it was first anchored on (z up, z = 0 on the support), fixed to the table, so that a camera
  * moving over a static table leaves it unchanged. */
 struct CylinderTrack {
-  int id{0};               ///< stable, unique within the tracker's life
-  bool confirmed{false};   ///< reported (CylinderTrackerParameters::confirm_hits reached)
-  std::size_t age{0};      ///< frames since it started (this one included)
-  std::size_t hits{0};     ///< frames it was matched in
-  int misses{0};           ///< missed frames in a row (see_through_misses each when seen through)
-  int occluded{0};         ///< hidden or merged frames in a row
-  int out_of_view{0};      ///< frames in a row outside the image
+  int id{0};             ///< stable, unique within the tracker's life
+  bool confirmed{false}; ///< reported (CylinderTrackerParameters::confirm_hits reached)
+  std::size_t age{0};    ///< frames since it started (this one included)
+  std::size_t hits{0};   ///< frames it was matched in
+  int misses{0};         ///< missed frames in a row (see_through_misses each when seen through)
+  int occluded{0};       ///< hidden or merged frames in a row
+  int out_of_view{0};    ///< frames in a row outside the image
   /** Frames in a row the sensor saw through its place: while > 0 only an object right at its
    * place (a quarter of the association gate) continues it; what appears behind a taken-away
    * object does not take over its id. */
   int seen_through{0};
   TrackStatus status{TrackStatus::Seen};
-  int object{-1};          ///< the last frame's object matched to it, -1: none
-  int merged_into{-1};     ///< status Merged: the track whose object holds its place, -1: none
-  int support{-1};         ///< the support of its last observation (last frame's index), -1
+  int object{-1};      ///< the last frame's object matched to it, -1: none
+  int merged_into{-1}; ///< status Merged: the track whose object holds its place, -1: none
+  int support{-1};     ///< the support of its last observation (last frame's index), -1
 
   Eigen::Vector3f centroid{Eigen::Vector3f::Zero()}; ///< of the visible points, filtered
   float var_centroid{0.f};
@@ -150,7 +148,7 @@ struct CylinderTrack {
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()}; ///< unit; sign: away from the support
   float radius{0.f};
   float lo{0.f}, hi{0.f};
-  float var_extent{0.f}; ///< of lo and hi
+  float var_extent{0.f};        ///< of lo and hi
   std::size_t cylinder_hits{0}; ///< frames that gave a cylinder
   /** One fitted cylinder of a frame, in the world frame. */
   struct Fit {
@@ -160,17 +158,15 @@ struct CylinderTrack {
     float weight{0.f}; ///< quality squared (less in a frame without a support)
   };
   std::vector<Fit> fits; ///< the last observations (history), oldest first
-  float log_odds{0.f};          ///< of being a cylinder, from every frame's evidence
+  float log_odds{0.f};   ///< of being a cylinder, from every frame's evidence
 
   /** \brief The filtered probability that the object is a cylinder. */
-  float
-  pCylinder() const
+  float pCylinder() const
   {
     return probability(log_odds);
   }
   /** \brief The cylinder estimate in the world frame (base = centre + lo axis). */
-  CylinderModel
-  worldCylinder() const;
+  CylinderModel worldCylinder() const;
 };
 
 /** \brief What the tracker made of one object of the frame. */
@@ -181,19 +177,18 @@ struct TrackAssignment {
     Started,  ///< started a new (tentative) track
     Fragment, ///< a piece of an object matched to a track in the same frame (a split)
   } role{Role::Ignored};
-  int track_id{-1};             ///< the track's id, -1 for Ignored
-  std::vector<int> merged;      ///< ids of tracks whose place lies inside this object (a merge)
+  int track_id{-1};        ///< the track's id, -1 for Ignored
+  std::vector<int> merged; ///< ids of tracks whose place lies inside this object (a merge)
 };
 
 /** \brief "ignored", "matched", "started" or "fragment". */
-std::string
-toString(TrackAssignment::Role r);
+std::string toString(TrackAssignment::Role r);
 
 /** \brief What the tracker knows of the sensor of a frame, all optional: its intrinsics and a
  * depth lookup let it tell a missed track from one out of view, hidden behind a nearer surface
  * or taken away (the sensor sees through its place). */
 struct TrackerView {
-  PinholeCamera camera;  ///< invalid (default): every track counts as in view
+  PinholeCamera camera; ///< invalid (default): every track counts as in view
   /** The sensor's pose in the cloud's frame (sensor to cloud; PCL's sensor_origin_ and
    * sensor_orientation_). */
   Eigen::Affine3f sensor_pose{Eigen::Affine3f::Identity()};
@@ -205,25 +200,24 @@ struct TrackerView {
 /** \brief The view of an organized \a cloud (intrinsics estimated from its points unless
  * \a camera is valid; depth from its points); of an unorganized one with \a camera only. */
 template <typename PointT>
-TrackerView
-trackerViewOf(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
-              const PinholeCamera& camera = {});
+TrackerView trackerViewOf(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
+                          const PinholeCamera& camera = {});
 
 /** \brief Index of the table in \a supports: the support whose plane is \a table_coefficients
  * (TabletopCylinderRecognizer::getTableCoefficients); -1 when there is none. */
-int
-tableIndex(const std::vector<SupportPlane>& supports, const std::vector<float>& table_coefficients);
+int tableIndex(const std::vector<SupportPlane>& supports,
+               const std::vector<float>& table_coefficients);
 
 /** \brief Where the frame was, for the last update(). */
 struct TrackerFrameInfo {
-  std::size_t frame{0};       ///< frames given (update() and skipFrame()), this one included
-  std::size_t scene{0};       ///< scenes started (a new one when the tracks' scene is left)
-  int anchor{-1};             ///< the support the frame was anchored on, -1: none
-  bool anchored{false};       ///< the pose comes from a support (else predicted)
-  bool new_scene{false};      ///< this frame started a scene
-  bool skipped{false};        ///< skipFrame(): nothing known about this frame
-  std::size_t registered{0};  ///< objects the in-plane registration matched to tracks
-  PlanarRigid registration;   ///< the anchor's plane coordinates to the world's
+  std::size_t frame{0};      ///< frames given (update() and skipFrame()), this one included
+  std::size_t scene{0};      ///< scenes started (a new one when the tracks' scene is left)
+  int anchor{-1};            ///< the support the frame was anchored on, -1: none
+  bool anchored{false};      ///< the pose comes from a support (else predicted)
+  bool new_scene{false};     ///< this frame started a scene
+  bool skipped{false};       ///< skipFrame(): nothing known about this frame
+  std::size_t registered{0}; ///< objects the in-plane registration matched to tracks
+  PlanarRigid registration;  ///< the anchor's plane coordinates to the world's
 };
 
 /** \brief Tracks objects and cylinders across the frames of a stream: each frame's result of
@@ -236,8 +230,8 @@ struct TrackerFrameInfo {
  * camera's, so it moves with the camera. Each frame is re-anchored: its support's plane gives
  * the tilt and height of the camera, and the in-plane motion (a 2-D rigid transform about the
  * support's normal) is estimated robustly from the objects matched to tracks
- * (registerInPlane, with the pose predicted from the last two frames as prior). Objects are then matched to
- * tracks by minimum cost (associationCost, assignMinimumCost) and filtered (filterPoint,
+ * (registerInPlane, with the pose predicted from the last two frames as prior). Objects are then
+ * matched to tracks by minimum cost (associationCost, assignMinimumCost) and filtered (filterPoint,
  * filterAxis, filterScalar, filterExtent; robust to a bad fit); a confidence is updated from
  * every frame's p_cylinder (updateLogOdds).
  *
@@ -280,14 +274,15 @@ public:
 
   CylinderTracker() = default;
   /** \throws std::invalid_argument when \a params are invalid (validate). */
-  explicit CylinderTracker(const CylinderTrackerParameters& params) { setParameters(params); }
+  explicit CylinderTracker(const CylinderTrackerParameters& params)
+  {
+    setParameters(params);
+  }
 
   /** \brief All settings; the tracks are kept. \throws std::invalid_argument when \a params are
    * invalid (validate), naming the call. */
-  void
-  setParameters(const CylinderTrackerParameters& params);
-  const CylinderTrackerParameters&
-  getParameters() const
+  void setParameters(const CylinderTrackerParameters& params);
+  const CylinderTrackerParameters& getParameters() const
   {
     return params_;
   }
@@ -297,91 +292,77 @@ public:
    * recognizer's, in the same cloud frame), and what is known of the sensor (\a view).
    * \return false (PCL_ERROR, nothing changed but the frame count) when \a table is out of
    * range. Objects without a finite centroid are ignored (Role::Ignored). */
-  bool
-  update(const std::vector<SupportPlane>& supports, int table,
-         const std::vector<RecognizedObject>& objects, const TrackerView& view = {});
+  bool update(const std::vector<SupportPlane>& supports, int table,
+              const std::vector<RecognizedObject>& objects, const TrackerView& view = {});
 
   /** \brief update() with the last result of \a rec: its supports and table, and the view of
    * its input cloud (trackerViewOf; intrinsics estimated from an organized cloud unless
    * setCamera). */
   template <typename PointT>
-  bool
-  update(const TabletopCylinderRecognizer<PointT>& rec,
-         const std::vector<RecognizedObject>& objects)
+  bool update(const TabletopCylinderRecognizer<PointT>& rec,
+              const std::vector<RecognizedObject>& objects)
   {
-    return update(rec.getSupports(), tableIndex(rec.getSupports(), rec.getTableCoefficients().values),
-                  objects, trackerViewOf<PointT>(rec.getInputCloud(), camera_));
+    return update(rec.getSupports(),
+                  tableIndex(rec.getSupports(), rec.getTableCoefficients().values), objects,
+                  trackerViewOf<PointT>(rec.getInputCloud(), camera_));
   }
 
   /** \brief A frame that could not be processed (unreadable, empty, recognition failed): the
    * tracks stay as they are, nobody's misses count. */
-  void
-  skipFrame();
+  void skipFrame();
 
   /** \brief Ends every track and forgets the world frame (the frame count and the ids go on). */
-  void
-  reset();
+  void reset();
 
   /** \brief Intrinsics for the template update() (unorganized clouds; organized ones are
    * estimated when this is invalid, the default). */
-  void
-  setCamera(const PinholeCamera& camera)
+  void setCamera(const PinholeCamera& camera)
   {
     camera_ = camera;
   }
 
   /** \brief The live tracks (tentative and confirmed), by id. */
-  const std::vector<CylinderTrack>&
-  getTracks() const
+  const std::vector<CylinderTrack>& getTracks() const
   {
     return tracks_;
   }
   /** \brief The track with id \a id, or nullptr. */
-  const CylinderTrack*
-  findTrack(int id) const;
+  const CylinderTrack* findTrack(int id) const;
   /** \brief One per object of the last update(), in order. */
-  const std::vector<TrackAssignment>&
-  getAssignments() const
+  const std::vector<TrackAssignment>& getAssignments() const
   {
     return assignments_;
   }
   /** \brief Where the last frame was. */
-  const TrackerFrameInfo&
-  getFrameInfo() const
+  const TrackerFrameInfo& getFrameInfo() const
   {
     return info_;
   }
   /** \brief The world frame in the last frame's cloud frame (world to cloud). */
-  Eigen::Affine3f
-  getWorldToFrame() const
+  Eigen::Affine3f getWorldToFrame() const
   {
     return frame_to_world_.inverse();
   }
   /** \brief The last frame's cloud frame in the world (cloud to world). */
-  const Eigen::Affine3f&
-  getFrameToWorld() const
+  const Eigen::Affine3f& getFrameToWorld() const
   {
     return frame_to_world_;
   }
   /** \brief True when \a t is confirmed, has a cylinder estimate and its p_cylinder is at
    * least min_probability. */
-  bool
-  isCylinder(const CylinderTrack& t) const;
+  bool isCylinder(const CylinderTrack& t) const;
   /** \brief \a t's cylinder in the last frame's cloud frame, with the recognizer's convention
    * (base nearest the support, axis away from it; lying: towards the sensor; orientCylinder);
    * its inlier fields are empty. */
-  CylinderModel
-  cylinderInFrame(const CylinderTrack& t) const;
+  CylinderModel cylinderInFrame(const CylinderTrack& t) const;
   /** \brief \a t's centroid in the last frame's cloud frame. */
-  Eigen::Vector3f
-  centroidInFrame(const CylinderTrack& t) const
+  Eigen::Vector3f centroidInFrame(const CylinderTrack& t) const
   {
     return getWorldToFrame() * t.centroid;
   }
 
   /** \brief "CylinderTracker". */
-  static std::string
-  getClassName()
+  static std::string getClassName()
   {
     return "CylinderTracker";
   }
@@ -390,17 +371,12 @@ private:
   /** An object of the frame in the world. */
   struct Observation;
   /** The in-view state of an unmatched track. */
-  TrackStatus
-  viewStatus(const CylinderTrack& t, const TrackerView& view,
-             const std::vector<RecognizedObject>& objects, int& inside) const;
-  void
-  predict();
-  void
-  startTrack(const Observation& o, int object);
-  void
-  correct(CylinderTrack& t, const Observation& o, float weight);
-  void
-  endTracks();
+  TrackStatus viewStatus(const CylinderTrack& t, const TrackerView& view,
+                         const std::vector<RecognizedObject>& objects, int& inside) const;
+  void predict();
+  void startTrack(const Observation& o, int object);
+  void correct(CylinderTrack& t, const Observation& o, float weight);
+  void endTracks();
 
   CylinderTrackerParameters params_;
   PinholeCamera camera_;
@@ -413,15 +389,15 @@ private:
    * the next pose (constant velocity), when both were anchored and consecutive. */
   Eigen::Affine3f previous_frame_to_world_{Eigen::Affine3f::Identity()};
   bool has_velocity_{false};
-  bool has_pose_{false};       ///< frame_to_world_ holds a pose
+  bool has_pose_{false};         ///< frame_to_world_ holds a pose
   bool world_on_support_{false}; ///< the world frame is a support's plane
   int next_id_{0};
 };
 
 } // namespace facyl
 
-#define FACYL_INSTANTIATE_trackerViewOf(T)                                                    \
-  template facyl::TrackerView facyl::trackerViewOf<T>(                                       \
+#define FACYL_INSTANTIATE_trackerViewOf(T)                                                         \
+  template facyl::TrackerView facyl::trackerViewOf<T>(                                             \
     const typename pcl::PointCloud<T>::ConstPtr&, const facyl::PinholeCamera&);
 
 #ifdef PCL_NO_PRECOMPILE

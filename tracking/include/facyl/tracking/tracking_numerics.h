@@ -25,32 +25,28 @@ struct PlanarRigid {
   Eigen::Vector2f t{Eigen::Vector2f::Zero()};
 
   /** \brief The point \a p moved. */
-  Eigen::Vector2f
-  apply(const Eigen::Vector2f& p) const
+  Eigen::Vector2f apply(const Eigen::Vector2f& p) const
   {
     const float c = std::cos(yaw), s = std::sin(yaw);
     return {c * p.x() - s * p.y() + t.x(), s * p.x() + c * p.y() + t.y()};
   }
   /** \brief The same motion in 3-D (about the z axis). */
-  Eigen::Affine3f
-  asAffine() const;
+  Eigen::Affine3f asAffine() const;
 };
 
 /** \brief The in-plane part of \a m, a transform between two frames whose z axes should agree
  * (support frames): the yaw of the image of x projected on the xy plane, and the x, y of the
  * translation. Exact when \a m is a PlanarRigid; the closest in-plane motion otherwise (the
  * rest, a tilt and a height, is what re-anchoring on the support plane removes). */
-PlanarRigid
-inPlaneComponent(const Eigen::Affine3f& m);
+PlanarRigid inPlaneComponent(const Eigen::Affine3f& m);
 
 /** \brief Weighted least-squares rigid motion (2-D Procrustes, Umeyama 1991 without scale)
  * taking the columns of \a from onto those of \a to, with \a weights (>= 0, same count). With
  * fewer than two points of positive weight, or points that all coincide, the rotation cannot be
  * observed: \a fallback_yaw is kept and only the translation is fitted (the identity
  * translation when no weight is positive). */
-PlanarRigid
-fitPlanarRigid(const Eigen::Matrix2Xf& from, const Eigen::Matrix2Xf& to,
-               const Eigen::VectorXf& weights, float fallback_yaw);
+PlanarRigid fitPlanarRigid(const Eigen::Matrix2Xf& from, const Eigen::Matrix2Xf& to,
+                           const Eigen::VectorXf& weights, float fallback_yaw);
 
 /** \brief A possible correspondence between observation \a object and track \a track, with
  * the \a weight its agreement earns (a fitted cylinder's axis is a better landmark than the
@@ -108,19 +104,19 @@ struct PlanarRegistration {
  * between the axes as a distance at 30 cm; along the axis occlusion moves the visible centre),
  * and its yaw counts in the fits: a lying cylinder fixes the rotation better than points a few
  * centimetres apart. */
-PlanarRegistration
-registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
-                const std::vector<RegistrationCandidate>& candidates, const PlanarRigid& prior,
-                const RegistrationSettings& settings = {},
-                const Eigen::Matrix2Xf& object_axes = Eigen::Matrix2Xf(),
-                const Eigen::Matrix2Xf& track_axes = Eigen::Matrix2Xf());
+PlanarRegistration registerInPlane(const Eigen::Matrix2Xf& objects, const Eigen::Matrix2Xf& tracks,
+                                   const std::vector<RegistrationCandidate>& candidates,
+                                   const PlanarRigid& prior,
+                                   const RegistrationSettings& settings = {},
+                                   const Eigen::Matrix2Xf& object_axes = Eigen::Matrix2Xf(),
+                                   const Eigen::Matrix2Xf& track_axes = Eigen::Matrix2Xf());
 
 // ----------------------------------------------------------------------------- association
 
 /** \brief What association compares of a track or an observation (world frame). */
 struct AssociationGeometry {
   Eigen::Vector3f centroid{Eigen::Vector3f::Zero()}; ///< of the object's points
-  bool cylinder{false}; ///< the fields below hold a fitted cylinder
+  bool cylinder{false};                              ///< the fields below hold a fitted cylinder
   Eigen::Vector3f centre{Eigen::Vector3f::Zero()};   ///< middle of the axis segment
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()};    ///< unit (sign free)
   float radius{0.f};
@@ -144,58 +140,50 @@ struct AssociationSettings {
  * radius difference and the angle between the axes. Otherwise: the distance of the centroids.
  * The centroid term is kept for cylinders too, loosely (sigma_centroid x 2), so that a cylinder
  * fitted to the wrong part of a cluster does not pass. */
-float
-associationCost(const AssociationGeometry& t, const AssociationGeometry& o,
-                const AssociationSettings& settings = {});
+float associationCost(const AssociationGeometry& t, const AssociationGeometry& o,
+                      const AssociationSettings& settings = {});
 
 /** \brief Minimum-cost one-to-one assignment of rows (observations) to columns (tracks) of
  * \a cost (Hungarian method, Kuhn-Munkres, O(n^2 m) with the shorter side first); pairs
  * costing more than \a gate (or not finite) are not assigned. \return the column of each row,
  * or -1. */
-std::vector<int>
-assignMinimumCost(const Eigen::MatrixXf& cost, float gate);
+std::vector<int> assignMinimumCost(const Eigen::MatrixXf& cost, float gate);
 
 // ------------------------------------------------------------------------------- filtering
 
 /** \brief Huber weight of a residual \a r of standard deviation \a sigma: 1 within \a k
  * sigmas, k sigma / |r| beyond (an outlying fit pulls the estimate by at most k sigma). */
-float
-huberWeight(float r, float sigma, float k = 2.f);
+float huberWeight(float r, float sigma, float k = 2.f);
 
 /** \brief One robust Kalman step of a scalar \a x of variance \a var with a measurement \a z of
  * variance \a var_z: the measurement's variance is divided by its Huber weight (huberWeight on
  * the innovation with the innovation's standard deviation). */
-void
-filterScalar(float& x, float& var, float z, float var_z, float huber_k = 2.f);
+void filterScalar(float& x, float& var, float z, float var_z, float huber_k = 2.f);
 
 /** \brief The same for a point \a x (isotropic variance \a var) and a measurement \a z. */
-void
-filterPoint(Eigen::Vector3f& x, float& var, const Eigen::Vector3f& z, float var_z,
-            float huber_k = 2.f);
+void filterPoint(Eigen::Vector3f& x, float& var, const Eigen::Vector3f& z, float var_z,
+                 float huber_k = 2.f);
 
 /** \brief The same for an axis \a a (unit, sign free) of angular variance \a var (rad^2): \a z
  * is turned to \a a's side, the unit vectors are blended by the Kalman gain and normalised. */
-void
-filterAxis(Eigen::Vector3f& a, float& var, Eigen::Vector3f z, float var_z, float huber_k = 2.f);
+void filterAxis(Eigen::Vector3f& a, float& var, Eigen::Vector3f z, float var_z,
+                float huber_k = 2.f);
 
 /** \brief The extent [\a lo, \a hi] of a cylinder along its axis (variance \a var each),
  * updated with an observed extent [\a z_lo, \a z_hi]. Occlusion hides an end and never adds
  * one: an observed end inside the extent counts with \a shrink_weight (in (0, 1]), one beyond
  * it fully. */
-void
-filterExtent(float& lo, float& hi, float& var, float z_lo, float z_hi, float var_z,
-             float shrink_weight);
+void filterExtent(float& lo, float& hi, float& var, float z_lo, float z_hi, float var_z,
+                  float shrink_weight);
 
 /** \brief Median of \a values (the mean of the two middle ones for an even count); NaN when
  * empty. */
-float
-median(std::vector<float> values);
+float median(std::vector<float> values);
 
 /** \brief Weighted median of \a values with \a weights (> 0; same count): the smallest value
  * at which the cumulated weight reaches half the total. NaN when empty or no weight is
  * positive. */
-float
-weightedMedian(const std::vector<float>& values, const std::vector<float>& weights);
+float weightedMedian(const std::vector<float>& values, const std::vector<float>& weights);
 
 /** \brief The axis most of the weighted \a axes (unit, sign free) agree with: for each axis,
  * the weight of the axes within \a inlier_angle (rad) of it; the best supported one's agreeing
@@ -203,23 +191,20 @@ weightedMedian(const std::vector<float>& values, const std::vector<float>& weigh
  * outvoted as soon as the right ones outweigh it, which a filter of the axis, robust or not,
  * only approaches step by step. \a inliers (optional) flags the agreeing axes. Zero when
  * \a axes is empty. Cost O(n^2). */
-Eigen::Vector3f
-consensusAxis(const std::vector<Eigen::Vector3f>& axes, const std::vector<float>& weights,
-              float inlier_angle, std::vector<char>* inliers = nullptr);
+Eigen::Vector3f consensusAxis(const std::vector<Eigen::Vector3f>& axes,
+                              const std::vector<float>& weights, float inlier_angle,
+                              std::vector<char>* inliers = nullptr);
 
 /** \brief Log-odds of a probability, \a p clamped to [0.01, 0.99]. */
-float
-logOdds(float p);
+float logOdds(float p);
 
 /** \brief The confidence update of a track: log-odds \a l plus the evidence of one
  * observation \a p_observed (a calibrated probability that the object is a cylinder), clamped
  * to +-\a limit so that a long history can still be overturned by a few frames (Bayes' rule
  * with independent frames and a prior of 0.5). \return the new log-odds. */
-float
-updateLogOdds(float l, float p_observed, float limit);
+float updateLogOdds(float l, float p_observed, float limit);
 
 /** \brief Probability of log-odds \a l. */
-float
-probability(float l);
+float probability(float l);
 
 } // namespace facyl

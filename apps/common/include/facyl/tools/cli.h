@@ -9,19 +9,19 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <unistd.h>
-#include <mutex>
-#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace facyl_cli {
@@ -48,16 +48,18 @@ public:
 
   Arguments(int argc, char** argv, const std::set<std::string>& with_value,
             const std::set<std::string>& switches, const Aliases& aliases = {})
-    : Arguments(std::vector<std::string>(argv + std::min(argc, 1), argv + argc), with_value,
-                switches, aliases)
-  {}
+      : Arguments(std::vector<std::string>(argv + std::min(argc, 1), argv + argc), with_value,
+                  switches, aliases)
+  {
+  }
   /** The same from a list of words (without the program's name). */
   Arguments(const std::vector<std::string>& words, const std::set<std::string>& with_value,
             const std::set<std::string>& switches, const Aliases& aliases = {})
   {
     for (std::size_t i = 0; i < words.size(); ++i) {
       const std::string& a = words[i];
-      if (!(a.size() > 1 && a[0] == '-' && !(std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.'))) {
+      if (!(a.size() > 1 && a[0] == '-' &&
+            !(std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.'))) {
         positional_.push_back(a);
         continue;
       }
@@ -66,8 +68,9 @@ public:
       const auto alias = aliases.find(typed);
       const std::string name = alias == aliases.end() ? typed : alias->second;
       if (spelling_.count(name))
-        throw std::invalid_argument("option " + typed + " given twice" +
-                                    (spelling_[name] != typed ? " (as " + spelling_[name] + ")" : ""));
+        throw std::invalid_argument(
+          "option " + typed + " given twice" +
+          (spelling_[name] != typed ? " (as " + spelling_[name] + ")" : ""));
       if (switches.count(name)) {
         if (eq != std::string::npos)
           throw std::invalid_argument("option " + typed + " takes no value");
@@ -86,34 +89,29 @@ public:
       spelling_[name] = typed;
     }
   }
-  bool
-  has(const std::string& s) const
+  bool has(const std::string& s) const
   {
     return switches_.count(s) > 0 || values_.count(s) > 0;
   }
   /** How the user spelled option \a name (its name when not given). */
-  std::string
-  spelling(const std::string& name) const
+  std::string spelling(const std::string& name) const
   {
     const auto it = spelling_.find(name);
     return it == spelling_.end() ? name : it->second;
   }
-  const std::vector<std::string>&
-  positional() const
+  const std::vector<std::string>& positional() const
   {
     return positional_;
   }
-  std::string
-  text(const std::string& name, const std::string& fallback) const
+  std::string text(const std::string& name, const std::string& fallback) const
   {
     const auto it = values_.find(name);
     return it == values_.end() ? fallback : it->second;
   }
   /** The value of \a name as a finite number in [\a min_value, \a max_value]. */
-  double
-  number(const std::string& name, double fallback,
-         double min_value = -std::numeric_limits<double>::max(),
-         double max_value = std::numeric_limits<double>::max()) const
+  double number(const std::string& name, double fallback,
+                double min_value = -std::numeric_limits<double>::max(),
+                double max_value = std::numeric_limits<double>::max()) const
   {
     const auto it = values_.find(name);
     if (it == values_.end())
@@ -131,9 +129,8 @@ public:
   }
   /** The value of \a name as an integer in [\a min_value, \a max_value]: digits only (an
    * optional minus sign), no wrap-around, no saturation. */
-  long long
-  integer(const std::string& name, long long fallback, long long min_value,
-          long long max_value) const
+  long long integer(const std::string& name, long long fallback, long long min_value,
+                    long long max_value) const
   {
     const auto it = values_.find(name);
     if (it == values_.end())
@@ -151,8 +148,7 @@ public:
                                   "]");
     return v;
   }
-  Eigen::Vector3f
-  vector3(const std::string& name, const Eigen::Vector3f& fallback) const
+  Eigen::Vector3f vector3(const std::string& name, const Eigen::Vector3f& fallback) const
   {
     const auto it = values_.find(name);
     if (it == values_.end())
@@ -168,8 +164,7 @@ public:
   }
 
 private:
-  static std::string
-  shortNumber(double v)
+  static std::string shortNumber(double v)
   {
     std::ostringstream s;
     s << v;
@@ -273,23 +268,24 @@ startTool(int argc, char** argv, const char* tool, PrintHelp help, Parse&& parse
 class Progress {
 public:
   Progress(const char* tool, std::size_t total, bool quiet_stdout = false)
-    : tool_(tool), total_(total),
-      shown_(total > 1 && isatty(fileno(stderr)) != 0 &&
-             (quiet_stdout || isatty(fileno(stdout)) == 0)),
-      start_(std::chrono::steady_clock::now()), last_(start_)
-  {}
+      : tool_(tool)
+      , total_(total)
+      , shown_(total > 1 && isatty(fileno(stderr)) != 0 &&
+               (quiet_stdout || isatty(fileno(stdout)) == 0))
+      , start_(std::chrono::steady_clock::now())
+      , last_(start_)
+  {
+  }
   ~Progress()
   {
     if (shown_ && drawn_)
       std::fprintf(stderr, "\n");
   }
   Progress(const Progress&) = delete;
-  Progress&
-  operator=(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
 
   /** \a n more items done. */
-  void
-  step(std::size_t n = 1)
+  void step(std::size_t n = 1)
   {
     if (!shown_)
       return;
@@ -302,7 +298,7 @@ public:
     drawn_ = true;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double left = done_ ? elapsed / static_cast<double>(done_) *
-                                    static_cast<double>(total_ - std::min(done_, total_))
+                                  static_cast<double>(total_ - std::min(done_, total_))
                               : 0.0;
     std::fprintf(stderr, "\r%s: %zu/%zu, %.0f s, about %.0f s left   ", tool_, done_, total_,
                  elapsed, left);
@@ -386,7 +382,8 @@ checkOutputFolder(const std::string& option, const std::string& dir, IsGenerated
 {
   std::error_code ec;
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
-    throw std::invalid_argument(option + " " + dir + ": is a file, not a folder. Nothing was "
+    throw std::invalid_argument(option + " " + dir +
+                                ": is a file, not a folder. Nothing was "
                                 "written.");
   for (const auto& in : inputs) {
     if (in.empty())
@@ -414,7 +411,11 @@ utf8Length(const std::string& s, std::size_t i)
 {
   const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
   const unsigned char c = byte(i);
-  const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+  const std::size_t n = c < 0x80           ? 1
+                        : (c >> 5) == 0x6  ? 2
+                        : (c >> 4) == 0xe  ? 3
+                        : (c >> 3) == 0x1e ? 4
+                                           : 0;
   if (n == 0 || i + n > s.size() || (n == 2 && c < 0xc2))
     return 0;
   for (std::size_t k = 1; k < n; ++k)

@@ -39,16 +39,15 @@ vector(const Eigen::Vector3f& v, int digits)
 inline std::string
 cylinderJson(const facyl::CylinderModel& m, bool inliers = false, int digits = 6)
 {
-  std::string out = "{\"point_on_axis\":" + vector(m.point_on_axis, digits) +
-                    ",\"axis\":" + vector(m.axis, digits) +
-                    ",\"radius\":" + number(m.radius, digits) +
-                    ",\"height\":" + number(m.height, digits) +
-                    ",\"base\":" + vector(m.base, digits) + ",\"top\":" + vector(m.top, digits) +
-                    ",\"inlier_ratio\":" + number(m.inlier_ratio, digits) +
-                    ",\"n_inliers\":" + std::to_string(m.inliers.size()) +
-                    ",\"confidence\":" + number(m.confidence, digits) +
-                    ",\"rms_error\":" + number(m.rms_error, digits) +
-                    ",\"angular_coverage\":" + number(m.angular_coverage, digits);
+  std::string out =
+    "{\"point_on_axis\":" + vector(m.point_on_axis, digits) +
+    ",\"axis\":" + vector(m.axis, digits) + ",\"radius\":" + number(m.radius, digits) +
+    ",\"height\":" + number(m.height, digits) + ",\"base\":" + vector(m.base, digits) +
+    ",\"top\":" + vector(m.top, digits) + ",\"inlier_ratio\":" + number(m.inlier_ratio, digits) +
+    ",\"n_inliers\":" + std::to_string(m.inliers.size()) +
+    ",\"confidence\":" + number(m.confidence, digits) +
+    ",\"rms_error\":" + number(m.rms_error, digits) +
+    ",\"angular_coverage\":" + number(m.angular_coverage, digits);
   if (inliers) {
     out += ",\"inliers\":[";
     for (std::size_t i = 0; i < m.inliers.size(); ++i)

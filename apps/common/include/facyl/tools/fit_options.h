@@ -54,10 +54,11 @@ struct FitSettings : HoughSettings {
 inline std::set<std::string>
 fitValueOptions()
 {
-  return {"--method",   "--voting",       "--prior",  "--up",        "--orientations",
-          "--accumulators", "--radius-limits", "--radius-min", "--radius-max",
-          "--distance-threshold", "--max-cylinders", "--neighbours", "--seed", "--threads",
-          "--units", "--point-candidates", "--coarse-scale"};
+  return {
+    "--method",           "--voting",        "--prior",      "--up",         "--orientations",
+    "--accumulators",     "--radius-limits", "--radius-min", "--radius-max", "--distance-threshold",
+    "--max-cylinders",    "--neighbours",    "--seed",       "--threads",    "--units",
+    "--point-candidates", "--coarse-scale"};
 }
 
 /** Switches that applyFitOptions reads. */
@@ -79,45 +80,51 @@ fitAliases()
 inline const char*
 fitOptionsHelp()
 {
-  static const std::string help = std::string(
-         "  --radius-limits A,B  radius interval (default 0.01,0.25: cans to buckets, as in\n"
-         "                       every facyl tool); auto: 0 to twice the extent of the data\n"
-         "                       across each candidate axis (pipes, tanks)\n"
-         "  --up x,y,z           gravity's opposite in the cloud's frame (default: unknown)\n"
-         "  --prior P            orientation prior: uniform | vertical | vertical-strong |\n"
-         "                       horizontal, about --up (0,0,1 when not given). Default: vertical\n"
-         "                       when --up is given, else uniform (the tabletop tools know\n"
-         "                       the table: vertical in its frame)\n"
-         "  --voting V           soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
-         "  --method M           facyl (default) | pcl-ransac (pcl::SACSegmentationFromNormals,\n"
-         "                       SACMODEL_CYLINDER on the same normals, for comparison)\n"
-         "  --neighbours K       k of the normal and curvature estimation (default 16; old\n"
-         "                       spelling --k)\n"
-         "  --orientations N     cells per orientation accumulator, N_d (default " +
-    std::to_string(facyl::HoughCylinderParameters{}.orientations) + ")\n"
-         "  --accumulators K     independent accumulators per fit (default " +
-    std::to_string(facyl::HoughCylinderParameters{}.accumulators) + ")\n"
-         "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
-         "                       pcl-ransac: 1% of the bounding-box diagonal)\n"
-         "  --max-cylinders N    cylinders to extract, one after another (default 1)\n"
-         "  --point-candidates N candidates refined and compared on the points (default ") +
-    std::to_string(facyl::HoughCylinderParameters{}.point_candidates) + "; 0:\n"
-         "                       the best alone, refined on its inliers, as facyl 0.1 did)\n"
-         "  --coarse-scale S     at high noise, cues again from neighbours within S radii\n"
-         "                       (default " + compactNumber(facyl::HoughCylinderParameters{}.coarse_scale) + "; 0: never)\n"
-         "  --outward-normals    inliers' normals must point away from the axis (normals\n"
-         "                       towards a sensor outside the cylinder: excludes a cup's inner\n"
-         "                       wall; the tabletop tools' default)\n"
-         "  --any-normal-sign    inliers' normals may point either way (default of a bare fit:\n"
-         "                       pipes seen from inside, normals of unknown orientation)\n"
-         "  --seed S             seed of the accumulator draws and of RANSAC (default 0)\n"
-         "  --threads T          threads for normals (default: all)\n"
-         "  --units U            auto (default: metres; a cloud or radius limits evidently in\n"
-         "                       millimetres are refused) | m (metres, no check) | mm (the\n"
-         "                       cloud, the lengths given and the results in millimetres;\n"
-         "                       converted to metres for the fit and back)\n"
-         "  (old spellings kept for this release: --radius-min R, --radius-max R, --k K,\n"
-         "  --method soft-curvature|soft-normal|rabbani)\n";
+  static const std::string help =
+    std::string(
+      "  --radius-limits A,B  radius interval (default 0.01,0.25: cans to buckets, as in\n"
+      "                       every facyl tool); auto: 0 to twice the extent of the data\n"
+      "                       across each candidate axis (pipes, tanks)\n"
+      "  --up x,y,z           gravity's opposite in the cloud's frame (default: unknown)\n"
+      "  --prior P            orientation prior: uniform | vertical | vertical-strong |\n"
+      "                       horizontal, about --up (0,0,1 when not given). Default: vertical\n"
+      "                       when --up is given, else uniform (the tabletop tools know\n"
+      "                       the table: vertical in its frame)\n"
+      "  --voting V           soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
+      "  --method M           facyl (default) | pcl-ransac (pcl::SACSegmentationFromNormals,\n"
+      "                       SACMODEL_CYLINDER on the same normals, for comparison)\n"
+      "  --neighbours K       k of the normal and curvature estimation (default 16; old\n"
+      "                       spelling --k)\n"
+      "  --orientations N     cells per orientation accumulator, N_d (default " +
+      std::to_string(facyl::HoughCylinderParameters{}.orientations) +
+      ")\n"
+      "  --accumulators K     independent accumulators per fit (default " +
+      std::to_string(facyl::HoughCylinderParameters{}.accumulators) +
+      ")\n"
+      "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
+      "                       pcl-ransac: 1% of the bounding-box diagonal)\n"
+      "  --max-cylinders N    cylinders to extract, one after another (default 1)\n"
+      "  --point-candidates N candidates refined and compared on the points (default ") +
+    std::to_string(facyl::HoughCylinderParameters{}.point_candidates) +
+    "; 0:\n"
+    "                       the best alone, refined on its inliers, as facyl 0.1 did)\n"
+    "  --coarse-scale S     at high noise, cues again from neighbours within S radii\n"
+    "                       (default " +
+    compactNumber(facyl::HoughCylinderParameters{}.coarse_scale) +
+    "; 0: never)\n"
+    "  --outward-normals    inliers' normals must point away from the axis (normals\n"
+    "                       towards a sensor outside the cylinder: excludes a cup's inner\n"
+    "                       wall; the tabletop tools' default)\n"
+    "  --any-normal-sign    inliers' normals may point either way (default of a bare fit:\n"
+    "                       pipes seen from inside, normals of unknown orientation)\n"
+    "  --seed S             seed of the accumulator draws and of RANSAC (default 0)\n"
+    "  --threads T          threads for normals (default: all)\n"
+    "  --units U            auto (default: metres; a cloud or radius limits evidently in\n"
+    "                       millimetres are refused) | m (metres, no check) | mm (the\n"
+    "                       cloud, the lengths given and the results in millimetres;\n"
+    "                       converted to metres for the fit and back)\n"
+    "  (old spellings kept for this release: --radius-min R, --radius-max R, --k K,\n"
+    "  --method soft-curvature|soft-normal|rabbani)\n";
   return help.c_str();
 }
 
@@ -187,11 +194,13 @@ applyFitOptions(const Arguments& args, FitSettings& s)
   }
   r_min = args.number("--radius-min", r_min, 0.0, 1e4);
   r_max = args.number("--radius-max", r_max, 0.0, 1e4);
-  s.radius_given = args.has("--radius-limits") || args.has("--radius-min") || args.has("--radius-max");
+  s.radius_given =
+    args.has("--radius-limits") || args.has("--radius-min") || args.has("--radius-max");
   if (s.units == Units::Auto && std::isfinite(r_max) && r_max > 1.0)
     throw std::invalid_argument(
       "option " + args.spelling(args.has("--radius-limits") ? "--radius-limits" : "--radius-max") +
-      ": radii up to " + args.text(args.has("--radius-limits") ? "--radius-limits" : "--radius-max", "") +
+      ": radii up to " +
+      args.text(args.has("--radius-limits") ? "--radius-limits" : "--radius-max", "") +
       ": facyl works in metres, and radii beyond 1 m look like millimetres. Give the cloud and "
       "the limits in metres, or --units mm (a cloud in millimetres, converted to metres and the "
       "results back), or --units m for cylinders that large");
@@ -200,8 +209,7 @@ applyFitOptions(const Arguments& args, FitSettings& s)
   s.params.radius_max = static_cast<float>(r_max) * scale;
   s.params.distance_threshold =
     static_cast<float>(args.number("--distance-threshold", 0.0, 0.0, 1e4)) * scale;
-  s.params.max_cylinders =
-    static_cast<std::size_t>(args.integer("--max-cylinders", 1, 1, 100));
+  s.params.max_cylinders = static_cast<std::size_t>(args.integer("--max-cylinders", 1, 1, 100));
   s.neighbours = static_cast<int>(args.integer("--neighbours", 16, 3, 1000));
   s.params.seed = static_cast<std::uint64_t>(
     args.integer("--seed", static_cast<long long>(s.params.seed), 0, kMaxSeed));
@@ -209,8 +217,8 @@ applyFitOptions(const Arguments& args, FitSettings& s)
   if (args.has("--outward-normals") && args.has("--any-normal-sign"))
     throw std::invalid_argument("--outward-normals and --any-normal-sign exclude each other");
   s.params.outward_normals = args.has("--outward-normals");
-  s.params.point_candidates = static_cast<std::size_t>(args.integer(
-    "--point-candidates", static_cast<long long>(s.params.point_candidates), 0, 64));
+  s.params.point_candidates = static_cast<std::size_t>(
+    args.integer("--point-candidates", static_cast<long long>(s.params.point_candidates), 0, 64));
   s.params.coarse_scale = static_cast<float>(
     args.number("--coarse-scale", static_cast<double>(s.params.coarse_scale), 0.0, 2.0));
   const std::string why = facyl::validate(s.params);
@@ -261,8 +269,11 @@ unitsProblem(const pcl::PointCloud<PointT>& cloud, Units units,
     return {};
   return "the cloud spans " + std::to_string(static_cast<long long>(std::lround(extent))) +
          " units, far beyond a tabletop's few metres: millimetres? facyl works in metres. "
-         "Convert the cloud to metres, or give " + say_mm + " (converted to metres and the "
-         "results back to millimetres), or " + say_m + " for a cloud that large";
+         "Convert the cloud to metres, or give " +
+         say_mm +
+         " (converted to metres and the "
+         "results back to millimetres), or " +
+         say_m + " for a cloud that large";
 }
 
 /** \a cloud's coordinates times \a scale (in place; in double precision, so that a

@@ -43,8 +43,8 @@ namespace facyl_cli {
 /** One frame of a stream. */
 struct StreamFrame {
   pcl::PointCloud<pcl::PointXYZRGBA>::ConstPtr cloud;
-  std::string name;      ///< the file, or the device
-  std::size_t index{0};  ///< frames handed over before this one
+  std::string name;     ///< the file, or the device
+  std::size_t index{0}; ///< frames handed over before this one
   /** Frames of the source that could not be used just before this one (each with its
    * reason): unreadable files of a PCD stream. */
   std::vector<std::string> skipped;
@@ -78,7 +78,8 @@ pcdFrames(const std::string& source, std::vector<std::string>& rejected)
   else if (std::filesystem::exists(source, ec))
     files.push_back(source);
   else
-    throw std::invalid_argument("--stream " + source + ": no such folder or file (a folder of "
+    throw std::invalid_argument("--stream " + source +
+                                ": no such folder or file (a folder of "
                                 "PCD frames, a PCD file, or openni2[:DEVICE])");
   std::vector<std::string> usable;
   for (const auto& f : files) {
@@ -116,7 +117,9 @@ public:
    * folder at 0, the default: one frame per next(), as fast as they are processed). \a loop:
    * start again after the last file. \throws std::invalid_argument for a source without a
    * usable frame, std::runtime_error when the device cannot be opened or PCL has no OpenNI2. */
-  FrameStream(const std::string& source, float rate, bool loop) : rate_(rate), loop_(loop)
+  FrameStream(const std::string& source, float rate, bool loop)
+      : rate_(rate)
+      , loop_(loop)
   {
     if (!(rate >= 0.f && rate <= 1000.f))
       throw std::invalid_argument("--rate must be in [0, 1000] frames per second");
@@ -140,7 +143,8 @@ public:
       grabber_->start();
       return;
 #else
-      throw std::runtime_error("--stream " + source + ": this PCL was built without OpenNI2; "
+      throw std::runtime_error("--stream " + source +
+                               ": this PCL was built without OpenNI2; "
                                "record the device's frames to a folder of PCD files instead");
 #endif
     }
@@ -190,8 +194,7 @@ public:
 
   /** The next frame, waiting at most \a timeout_s seconds for a live source. \return false at
    * the end of a PCD stream, or when a live source gave nothing in time (timedOut()). */
-  bool
-  next(StreamFrame& frame, double timeout_s = 5.0)
+  bool next(StreamFrame& frame, double timeout_s = 5.0)
   {
     timed_out_ = false;
     std::vector<std::string> skipped;
@@ -233,27 +236,23 @@ public:
   }
 
   /** The files left out before the stream started, each "FILE: reason". */
-  const std::vector<std::string>&
-  rejected() const
+  const std::vector<std::string>& rejected() const
   {
     return rejected_;
   }
   /** Frames a live source delivered while the previous one was still being processed. */
-  std::size_t
-  dropped() const
+  std::size_t dropped() const
   {
     std::lock_guard<std::mutex> lock(mutex_);
     return dropped_;
   }
   /** The last next() returned false because a live source gave nothing in time. */
-  bool
-  timedOut() const
+  bool timedOut() const
   {
     return timed_out_;
   }
   /** "PCD folder DIR (N frames, R fps, looping)" or the device. */
-  std::string
-  description() const
+  std::string description() const
   {
     if (files_.empty())
       return name_;
@@ -265,8 +264,7 @@ public:
   }
 
 private:
-  void
-  deliver(const Cloud::ConstPtr& cloud, const std::string& name)
+  void deliver(const Cloud::ConstPtr& cloud, const std::string& name)
   {
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -19,12 +19,11 @@ struct JsonValue {
   bool boolean{false};
   double number{0.0};
   std::string text;
-  std::vector<JsonValue> items;                            ///< Array
-  std::vector<std::pair<std::string, JsonValue>> fields;   ///< Object, in order
+  std::vector<JsonValue> items;                          ///< Array
+  std::vector<std::pair<std::string, JsonValue>> fields; ///< Object, in order
 
   /** The field \a key of an object; nullptr when absent or not an object. */
-  const JsonValue*
-  get(const std::string& key) const
+  const JsonValue* get(const std::string& key) const
   {
     for (const auto& [k, v] : fields)
       if (k == key)
@@ -36,8 +35,7 @@ struct JsonValue {
 /** Parses one JSON text. \throws std::invalid_argument naming the offset. */
 class JsonReader {
 public:
-  static JsonValue
-  parse(const std::string& text)
+  static JsonValue parse(const std::string& text)
   {
     JsonReader r(text);
     JsonValue v = r.value();
@@ -48,21 +46,21 @@ public:
   }
 
 private:
-  explicit JsonReader(const std::string& s) : s_(s) {}
+  explicit JsonReader(const std::string& s)
+      : s_(s)
+  {
+  }
 
-  [[noreturn]] void
-  fail(const std::string& what) const
+  [[noreturn]] void fail(const std::string& what) const
   {
     throw std::invalid_argument("JSON at offset " + std::to_string(i_) + ": " + what);
   }
-  void
-  space()
+  void space()
   {
     while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_])))
       ++i_;
   }
-  bool
-  eat(char c)
+  bool eat(char c)
   {
     space();
     if (i_ < s_.size() && s_[i_] == c) {
@@ -71,14 +69,12 @@ private:
     }
     return false;
   }
-  void
-  expect(char c)
+  void expect(char c)
   {
     if (!eat(c))
       fail(std::string("expected '") + c + "'");
   }
-  JsonValue
-  value()
+  JsonValue value()
   {
     if (++depth_ > 64)
       fail("nested too deeply");
@@ -107,8 +103,7 @@ private:
     --depth_;
     return v;
   }
-  JsonValue
-  object()
+  JsonValue object()
   {
     JsonValue v;
     v.type = JsonValue::Type::Object;
@@ -126,8 +121,7 @@ private:
     expect('}');
     return v;
   }
-  JsonValue
-  array()
+  JsonValue array()
   {
     JsonValue v;
     v.type = JsonValue::Type::Array;
@@ -140,8 +134,7 @@ private:
     expect(']');
     return v;
   }
-  std::string
-  string()
+  std::string string()
   {
     std::string out;
     ++i_; // opening quote
@@ -158,7 +151,9 @@ private:
           c = '?';
         }
         else
-          c = e == 'n' ? '\n' : (e == 't' ? '\t' : (e == 'r' ? '\r' : (e == 'b' ? '\b' : (e == 'f' ? '\f' : e))));
+          c = e == 'n'
+                ? '\n'
+                : (e == 't' ? '\t' : (e == 'r' ? '\r' : (e == 'b' ? '\b' : (e == 'f' ? '\f' : e))));
       }
       out += c;
     }
@@ -167,8 +162,7 @@ private:
     ++i_;
     return out;
   }
-  JsonValue
-  number()
+  JsonValue number()
   {
     const char* start = s_.c_str() + i_;
     char* end = nullptr;

@@ -40,13 +40,12 @@ struct PcdHeader {
   std::vector<std::uint64_t> size, count;
   std::vector<char> type;
   std::uint64_t width{0}, height{1}, points{0};
-  std::string data;          ///< ascii | binary | binary_compressed
+  std::string data;           ///< ascii | binary | binary_compressed
   std::size_t data_offset{0}; ///< bytes before the data
   bool has_points{false};
 
   /** Bytes per point. */
-  std::uint64_t
-  pointStep() const
+  std::uint64_t pointStep() const
   {
     std::uint64_t step = 0;
     for (std::size_t i = 0; i < size.size(); ++i)
@@ -166,8 +165,8 @@ checkPcdSize(std::istream& in, const PcdHeader& h, std::uint64_t file_size)
            std::to_string(step) + " bytes: more than facyl reads (2 GiB)";
   const std::uint64_t data_bytes = file_size > h.data_offset ? file_size - h.data_offset : 0;
   const std::uint64_t need = h.points * step;
-  const std::string truncated = "the PCD file is truncated: its header claims " +
-                                std::to_string(h.points) + " points, ";
+  const std::string truncated =
+    "the PCD file is truncated: its header claims " + std::to_string(h.points) + " points, ";
   if (h.data == "binary") {
     if (need > data_bytes)
       return truncated + std::to_string(need) + " bytes, the file holds " +
@@ -187,8 +186,8 @@ checkPcdSize(std::istream& in, const PcdHeader& h, std::uint64_t file_size)
     if (!in)
       return "the PCD file is truncated: no compressed data";
     if (sizes[1] != need)
-      return "the PCD file is corrupt: its compressed data unpacks to " +
-             std::to_string(sizes[1]) + " bytes, its header needs " + std::to_string(need);
+      return "the PCD file is corrupt: its compressed data unpacks to " + std::to_string(sizes[1]) +
+             " bytes, its header needs " + std::to_string(need);
     // LZF encodes at most 264 bytes in 3.
     if (sizes[0] > data_bytes || static_cast<std::uint64_t>(sizes[1]) > 90ull * sizes[0] + 1024)
       return "the PCD file is corrupt or truncated: " + std::to_string(sizes[0]) +
@@ -239,8 +238,8 @@ checkPcdHeader(const std::string& file, PcdHeader& h)
     if (h.type[i] != 'F' || h.size[i] != 4 || h.count[i] != 1)
       return std::string("the coordinates are stored as ") +
              (h.type[i] == 'F' ? "float" : (h.type[i] == 'I' ? "signed int" : "unsigned int")) +
-             std::to_string(8 * h.size[i]) + " (field " + axis + ": TYPE " + h.type[i] +
-             ", SIZE " + std::to_string(h.size[i]) + ", COUNT " + std::to_string(h.count[i]) +
+             std::to_string(8 * h.size[i]) + " (field " + axis + ": TYPE " + h.type[i] + ", SIZE " +
+             std::to_string(h.size[i]) + ", COUNT " + std::to_string(h.count[i]) +
              "); facyl reads 4-byte floats (TYPE F, SIZE 4), as PCL's point types hold";
   }
   if (h.points == 0)

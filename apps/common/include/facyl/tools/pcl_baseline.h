@@ -19,7 +19,7 @@
 namespace facyl_cli {
 
 struct PclCylinderOptions {
-  int method{pcl::SAC_RANSAC};  ///< pcl::SAC_RANSAC, pcl::SAC_MLESAC, ...
+  int method{pcl::SAC_RANSAC}; ///< pcl::SAC_RANSAC, pcl::SAC_MLESAC, ...
   float distance_threshold{0.01f};
   float radius_min{0.f};
   float radius_max{1.f};
@@ -27,7 +27,7 @@ struct PclCylinderOptions {
   int max_iterations{10000};          ///< as in the tutorial
   bool use_axis{false};               ///< PCL's way of stating an orientation prior
   Eigen::Vector3f axis{Eigen::Vector3f::UnitZ()};
-  double eps_angle{0.26};             ///< rad, with use_axis
+  double eps_angle{0.26}; ///< rad, with use_axis
   std::size_t max_cylinders{1};
 };
 
@@ -36,8 +36,7 @@ struct PclCylinderOptions {
 template <typename PointT>
 std::vector<facyl::CylinderModel>
 fitPclCylinders(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
-                const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
-                const PclCylinderOptions& o)
+                const pcl::PointCloud<pcl::Normal>::ConstPtr& normals, const PclCylinderOptions& o)
 {
   pcl::SACSegmentationFromNormals<PointT, pcl::Normal> seg;
   seg.setOptimizeCoefficients(true);
@@ -70,8 +69,7 @@ fitPclCylinders(const typename pcl::PointCloud<PointT>::ConstPtr& cloud,
     m.axis = Eigen::Vector3f(c.values[3], c.values[4], c.values[5]).normalized();
     m.radius = c.values[6];
     m.inliers = inliers.indices;
-    m.inlier_ratio =
-        static_cast<float>(inliers.indices.size()) / static_cast<float>(cloud->size());
+    m.inlier_ratio = static_cast<float>(inliers.indices.size()) / static_cast<float>(cloud->size());
     m.distance_threshold = o.distance_threshold;
     Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(inliers.indices.size()));
     for (std::size_t k = 0; k < inliers.indices.size(); ++k)

@@ -19,11 +19,29 @@ namespace facyl_cli {
 inline std::set<std::string>
 recognizerValueOptions()
 {
-  return {"--min-score", "--score", "--max-curvature-ratio", "--min-coverage", "--max-taper",
-          "--prior", "--radius-limits", "--orientations", "--max-fit-points", "--neighbours",
-          "--seed", "--plane-distance", "--height-limits", "--cluster-tolerance",
-          "--cluster-size", "--up", "--clustering", "--support", "--max-cylinders-per-cluster",
-          "--model", "--reject-below", "--min-probability", "--voting",
+  return {"--min-score",
+          "--score",
+          "--max-curvature-ratio",
+          "--min-coverage",
+          "--max-taper",
+          "--prior",
+          "--radius-limits",
+          "--orientations",
+          "--max-fit-points",
+          "--neighbours",
+          "--seed",
+          "--plane-distance",
+          "--height-limits",
+          "--cluster-tolerance",
+          "--cluster-size",
+          "--up",
+          "--clustering",
+          "--support",
+          "--max-cylinders-per-cluster",
+          "--model",
+          "--reject-below",
+          "--min-probability",
+          "--voting",
           "--distance-threshold"};
 }
 
@@ -45,59 +63,62 @@ recognizerAliases()
 inline const char*
 recognizerOptionsHelp()
 {
-  static const std::string help = std::string("Shape classifier (paper III-B; a CNN on each object's view, run by OpenCV DNN):\n"
-         "  --model M              default (the model shipped with facyl) | none | PATH.onnx\n"
-         "                         (with PATH.cfg beside it, see CylinderClassifier)\n"
-         "  --reject-below P       clusters whose network probability is below P are not\n"
-         "                         fitted (default 0.1; 0 fits all)\n"
-         "  --min-probability P    with a model: a cylinder also needs p_cylinder >= P, the\n"
-         "                         network fused with the fit's evidence (default 0.5)\n"
-         "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
-         "angular coverage >= V and taper <= T):\n"
-         "  --score S              surface (default: lateral inliers + points on the end caps\n"
-         "                         and inner wall, over all points) | inlier (paper eq. 4)\n"
-         "  --min-score R          score threshold (default 0.5)\n"
-         "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
-         "                         (default 0.35; 1 turns the check off)\n"
-         "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
-         "  --max-taper T          the radius changes by at most T per unit of length along\n"
-         "                         the axis (default 0.15; 1 turns the check off)\n"
-         "  --no-retry             no second fit with upright/lying priors when the first fails\n"
-         "  --retry-inside         a last retry also fits concave clusters (the inside of an\n"
-         "                         open container; bowls too)\n"
-         "  --outward-normals      inliers' normals must point away from the axis (default:\n"
-         "                         normals face the sensor, a cup's inner wall is no inlier)\n"
-         "  --any-normal-sign      inliers' normals may point at the axis\n"
-         "Fit:\n"
-         "  --prior P              orientation prior in the table frame: uniform | vertical\n"
-         "                         (default) | vertical-strong | horizontal\n"
-         "  --radius-limits A,B    radius interval in m (default 0.01,0.25: objects on a table)\n"
-         "  --voting V             soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
-         "  --distance-threshold D inlier distance in m (default: estimated from the residuals)\n"
-         "  --orientations N       accumulator cells (default ") +
-    std::to_string(facyl::TabletopRecognizerParameters{}.hough.orientations) + ")\n"
-         "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
-         "  --neighbours K         k of the normal/curvature estimation (default 16; old\n"
-         "                         spelling --k)\n"
-         "  --seed S               accumulator seed (default 0)\n"
-         "  --max-cylinders-per-cluster N  cylinders extracted from a cluster the best fit\n"
-         "                         does not explain (touching, stacked objects; default 3;\n"
-         "                         1: off)\n"
-         "Segmentation:\n"
-         "  --up x,y,z             gravity's opposite in the cloud's frame: supports are then\n"
-         "                         the planes within 20 degrees of horizontal (default:\n"
-         "                         unknown; the supports are the planes objects stand on,\n"
-         "                         whatever the camera's roll)\n"
-         "  --support S            standing (default: the planes most objects stand on, each\n"
-         "                         object on the plane under it) | largest (the largest plane)\n"
-         "  --clustering C         edge-aware (default: cut at depth jumps and concave\n"
-         "                         creases, join parts seen around an occluder) | euclidean\n"
-         "  --plane-distance D     support inlier band in m (default 0: measured on each\n"
-         "                         support, 3 sigma of its points' distances by range)\n"
-         "  --height-limits A,B    object points lie A..B m above the support and above its\n"
-         "                         band (default 0,0.5)\n"
-         "  --cluster-tolerance D  Euclidean clustering tolerance in m (default 0.02)\n"
-         "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n";
+  static const std::string help =
+    std::string(
+      "Shape classifier (paper III-B; a CNN on each object's view, run by OpenCV DNN):\n"
+      "  --model M              default (the model shipped with facyl) | none | PATH.onnx\n"
+      "                         (with PATH.cfg beside it, see CylinderClassifier)\n"
+      "  --reject-below P       clusters whose network probability is below P are not\n"
+      "                         fitted (default 0.1; 0 fits all)\n"
+      "  --min-probability P    with a model: a cylinder also needs p_cylinder >= P, the\n"
+      "                         network fused with the fit's evidence (default 0.5)\n"
+      "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"
+      "angular coverage >= V and taper <= T):\n"
+      "  --score S              surface (default: lateral inliers + points on the end caps\n"
+      "                         and inner wall, over all points) | inlier (paper eq. 4)\n"
+      "  --min-score R          score threshold (default 0.5)\n"
+      "  --max-curvature-ratio C  median |k_min| / median |k_max| of the inliers at most C\n"
+      "                         (default 0.35; 1 turns the check off)\n"
+      "  --min-coverage V       inliers cover at least V of the circumference (default 0.2)\n"
+      "  --max-taper T          the radius changes by at most T per unit of length along\n"
+      "                         the axis (default 0.15; 1 turns the check off)\n"
+      "  --no-retry             no second fit with upright/lying priors when the first fails\n"
+      "  --retry-inside         a last retry also fits concave clusters (the inside of an\n"
+      "                         open container; bowls too)\n"
+      "  --outward-normals      inliers' normals must point away from the axis (default:\n"
+      "                         normals face the sensor, a cup's inner wall is no inlier)\n"
+      "  --any-normal-sign      inliers' normals may point at the axis\n"
+      "Fit:\n"
+      "  --prior P              orientation prior in the table frame: uniform | vertical\n"
+      "                         (default) | vertical-strong | horizontal\n"
+      "  --radius-limits A,B    radius interval in m (default 0.01,0.25: objects on a table)\n"
+      "  --voting V             soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
+      "  --distance-threshold D inlier distance in m (default: estimated from the residuals)\n"
+      "  --orientations N       accumulator cells (default ") +
+    std::to_string(facyl::TabletopRecognizerParameters{}.hough.orientations) +
+    ")\n"
+    "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
+    "  --neighbours K         k of the normal/curvature estimation (default 16; old\n"
+    "                         spelling --k)\n"
+    "  --seed S               accumulator seed (default 0)\n"
+    "  --max-cylinders-per-cluster N  cylinders extracted from a cluster the best fit\n"
+    "                         does not explain (touching, stacked objects; default 3;\n"
+    "                         1: off)\n"
+    "Segmentation:\n"
+    "  --up x,y,z             gravity's opposite in the cloud's frame: supports are then\n"
+    "                         the planes within 20 degrees of horizontal (default:\n"
+    "                         unknown; the supports are the planes objects stand on,\n"
+    "                         whatever the camera's roll)\n"
+    "  --support S            standing (default: the planes most objects stand on, each\n"
+    "                         object on the plane under it) | largest (the largest plane)\n"
+    "  --clustering C         edge-aware (default: cut at depth jumps and concave\n"
+    "                         creases, join parts seen around an occluder) | euclidean\n"
+    "  --plane-distance D     support inlier band in m (default 0: measured on each\n"
+    "                         support, 3 sigma of its points' distances by range)\n"
+    "  --height-limits A,B    object points lie A..B m above the support and above its\n"
+    "                         band (default 0,0.5)\n"
+    "  --cluster-tolerance D  Euclidean clustering tolerance in m (default 0.02)\n"
+    "  --cluster-size A,B     cluster size limits in points (default 300,200000)\n";
   return help.c_str();
 }
 
@@ -116,7 +137,8 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
                                : facyl::CylinderDecision::Score::InlierRatio;
   d.max_curvature_ratio =
     static_cast<float>(args.number("--max-curvature-ratio", d.max_curvature_ratio, 1e-6, 1.0));
-  d.min_angular_coverage = static_cast<float>(args.number("--min-coverage", d.min_angular_coverage, 0.0, 1.0));
+  d.min_angular_coverage =
+    static_cast<float>(args.number("--min-coverage", d.min_angular_coverage, 0.0, 1.0));
   d.max_taper = static_cast<float>(args.number("--max-taper", d.max_taper, 1e-6, 1.0));
   p.retry_upright_lying = !args.has("--no-retry");
   p.retry_any_normal_sign = args.has("--retry-inside");
@@ -127,10 +149,9 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
       !facyl::parseVotingMode(args.text("--voting", ""), p.hough.voting_mode))
     throw std::invalid_argument("option --voting: '" + args.text("--voting", "") +
                                 "' is not soft-curvature, soft-normal or rabbani");
-  p.hough.distance_threshold = static_cast<float>(
-    args.number("--distance-threshold", p.hough.distance_threshold, 0.0, 1.0));
-  if (args.has("--prior") &&
-      !facyl::parseOrientationPrior(args.text("--prior", ""), p.hough.prior))
+  p.hough.distance_threshold =
+    static_cast<float>(args.number("--distance-threshold", p.hough.distance_threshold, 0.0, 1.0));
+  if (args.has("--prior") && !facyl::parseOrientationPrior(args.text("--prior", ""), p.hough.prior))
     throw std::invalid_argument("unknown --prior '" + args.text("--prior", "") + "'");
   const auto radii = pairOption(args, "--radius-limits", p.hough.radius_min, p.hough.radius_max);
   if (!(radii.first >= 0 && radii.second <= 10))
@@ -149,13 +170,15 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(
     "--max-cylinders-per-cluster", static_cast<long long>(p.max_cylinders_per_cluster), 1, 20));
   auto& g = p.segmentation;
-  g.plane_distance = static_cast<float>(args.number("--plane-distance", g.plane_distance, 0.0, 1.0));
+  g.plane_distance =
+    static_cast<float>(args.number("--plane-distance", g.plane_distance, 0.0, 1.0));
   const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
   if (!(heights.first >= -10 && heights.second <= 10))
     throw std::invalid_argument("--height-limits: expected -10 <= A < B <= 10 (m)");
   g.min_height = static_cast<float>(heights.first);
   g.max_height = static_cast<float>(heights.second);
-  g.cluster_tolerance = static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance, 1e-4, 1.0));
+  g.cluster_tolerance =
+    static_cast<float>(args.number("--cluster-tolerance", g.cluster_tolerance, 1e-4, 1.0));
   const auto sizes = pairOption(args, "--cluster-size", static_cast<double>(g.min_cluster_size),
                                 static_cast<double>(g.max_cluster_size));
   if (!(sizes.first >= 1 && sizes.second >= sizes.first && sizes.second <= 1e9))
@@ -171,8 +194,9 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   const std::string support = args.text("--support", "standing");
   if (support != "standing" && support != "largest")
     throw std::invalid_argument("--support must be standing or largest");
-  g.support = support == "largest" ? facyl::TabletopSegmentationParameters::Support::LargestPlane
-                                   : facyl::TabletopSegmentationParameters::Support::ObjectsStanding;
+  g.support = support == "largest"
+                ? facyl::TabletopSegmentationParameters::Support::LargestPlane
+                : facyl::TabletopSegmentationParameters::Support::ObjectsStanding;
   p.reject_below = static_cast<float>(args.number("--reject-below", p.reject_below, 0.0, 1.0));
   d.min_probability =
     static_cast<float>(args.number("--min-probability", d.min_probability, 0.0, 1.0));

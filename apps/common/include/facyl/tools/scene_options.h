@@ -26,7 +26,8 @@ sceneImageOptions()
 inline const char*
 sceneImageOptionsHelp()
 {
-  return "  --resolution WxH   image size in pixels, 64..4096 each (default: the sensor's, 640x480);\n"
+  return "  --resolution WxH   image size in pixels, 64..4096 each (default: the sensor's, "
+         "640x480);\n"
          "                     the field of view is kept\n"
          "  --dropout P        share of pixels missing at random, in [0, 0.5] (default: the\n"
          "                     sensor's, 0.002; not with --sensor random)\n";

@@ -81,8 +81,7 @@ trackFieldsJson(const facyl::RecognizedObject& o, const facyl::TrackAssignment& 
 {
   const facyl::CylinderTrack* t = tracker.findTrack(a.track_id);
   std::ostringstream out;
-  out << ",\"is_cylinder_frame\":" << (o.is_cylinder ? "true" : "false")
-      << ",\"cylinder_frame\":"
+  out << ",\"is_cylinder_frame\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder_frame\":"
       << (o.evidence.fitted ? cylinderJson(o.cylinder, false, digits) : std::string("null"))
       << ",\"track_id\":" << (a.track_id >= 0 ? std::to_string(a.track_id) : "null")
       << ",\"role\":\"" << facyl::toString(a.role) << "\",\"merged\":[";
@@ -97,8 +96,8 @@ trackFieldsJson(const facyl::RecognizedObject& o, const facyl::TrackAssignment& 
  * object of this frame it was matched to (null: none), "merged_into", "centroid" and
  * "cylinder" (the tracked estimate in this frame, null without). */
 inline std::string
-streamJson(const facyl::CylinderTracker& tracker, const std::vector<facyl::RecognizedObject>* objects,
-           int digits = 6)
+streamJson(const facyl::CylinderTracker& tracker,
+           const std::vector<facyl::RecognizedObject>* objects, int digits = 6)
 {
   const auto& info = tracker.getFrameInfo();
   std::ostringstream out;
@@ -141,9 +140,8 @@ trackedSceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
   std::vector<facyl::RecognizedObject> shown;
   shown.reserve(objects.size());
   for (std::size_t k = 0; k < objects.size(); ++k)
-    shown.push_back(trackedView(objects[k],
-                                k < assignments.size() ? assignments[k] : facyl::TrackAssignment{},
-                                tracker));
+    shown.push_back(trackedView(
+      objects[k], k < assignments.size() ? assignments[k] : facyl::TrackAssignment{}, tracker));
   // One writer for the scene's fields (sceneJson); each object's text, exactly as it wrote it,
   // gets the tracking fields before its closing brace.
   std::string scene = sceneJson(file, cloud, rec, shown, timing, digits);

@@ -77,7 +77,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::initCompute()
 template <typename PointInT, typename PointOutT>
 Neighbourhoods
 NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
-    const std::vector<int>& surface_queries, bool queries_are_input, int threads) const
+  const std::vector<int>& surface_queries, bool queries_are_input, int threads) const
 {
   const auto& input = *this->input_;
   const auto& surface = *this->surface_;
@@ -96,8 +96,8 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
           this->searchForNeighbors(surface_queries[s], this->search_parameter_, lists[s],
                                    distances);
         else
-          this->searchForNeighbors(surface, surface_queries[s], this->search_parameter_,
-                                   lists[s], distances);
+          this->searchForNeighbors(surface, surface_queries[s], this->search_parameter_, lists[s],
+                                   distances);
       }
     });
     return Neighbourhoods::fromLists(lists);
@@ -105,9 +105,9 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
   for (std::size_t i = 0; i < n; ++i)
     queries.col(static_cast<Eigen::Index>(i)) = query_point(i).getVector3fMap();
-  return this->k_ != 0 ? search_->nearest(queries, this->k_, threads)
-                       : search_->within(queries, static_cast<float>(this->search_radius_),
-                                         threads);
+  return this->k_ != 0
+           ? search_->nearest(queries, this->k_, threads)
+           : search_->within(queries, static_cast<float>(this->search_radius_), threads);
 }
 
 template <typename PointInT, typename PointOutT>
@@ -137,8 +137,8 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
     const int* list = nb.begin(i);
     if (nb.count(i) < 3 ||
         !estimateNormal(
-            nb.count(i), [&](std::size_t j) { return surface[list[j]].getVector3fMap(); },
-            normal, variation))
+          nb.count(i), [&](std::size_t j) { return surface[list[j]].getVector3fMap(); }, normal,
+          variation))
       return false;
     if ((view_point - at).dot(normal) < 0.f)
       normal = -normal;
@@ -198,8 +198,8 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
       parallelFor(missing.size(), threads, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t s = begin; s < end; ++s) {
           float sv;
-          pcaNormal(extra, s, surface[missing[s]].getVector3fMap(),
-                    surface_normals[missing[s]], sv);
+          pcaNormal(extra, s, surface[missing[s]].getVector3fMap(), surface_normals[missing[s]],
+                    sv);
         }
       });
     }
@@ -212,10 +212,10 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
       PointOutT& out = output[s];
       PrincipalCurvatures pc;
       const int* list = nb.begin(s);
-      const bool ok = normals[s].allFinite() &&
-                      principalCurvaturesFromNormals(
-                          normals[s], nb.count(s),
-                          [&](std::size_t j) { return surface_normals[list[j]]; }, pc);
+      const bool ok =
+        normals[s].allFinite() &&
+        principalCurvaturesFromNormals(
+          normals[s], nb.count(s), [&](std::size_t j) { return surface_normals[list[j]]; }, pc);
       if (!ok) {
         out.normal_x = out.normal_y = out.normal_z = nan;
         out.principal_curvature_x = out.principal_curvature_y = out.principal_curvature_z = nan;
@@ -240,5 +240,5 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
 
 } // namespace facyl
 
-#define FACYL_INSTANTIATE_NormalCurvatureEstimation(T, OutT)                                \
+#define FACYL_INSTANTIATE_NormalCurvatureEstimation(T, OutT)                                       \
   template class facyl::NormalCurvatureEstimation<T, OutT>;

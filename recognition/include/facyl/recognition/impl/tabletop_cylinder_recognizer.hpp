@@ -3,8 +3,8 @@
  */
 #pragma once
 
-#include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/recognition/impl/classifier_input.hpp>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
 #include <pcl/common/transforms.h>
 
@@ -18,18 +18,16 @@
 
 namespace facyl {
 
-template <typename PointT>
-struct TabletopCylinderRecognizer<PointT>::FitInput {
-  pcl::Indices subset;                          ///< the cluster's points that are fitted
-  pcl::PointCloud<pcl::PointXYZ>::Ptr points;   ///< the subset's coordinates
-  pcl::PointCloud<NormalCurvature>::Ptr cues;   ///< their normals and curvatures
-  Eigen::Matrix3Xf columns;                     ///< points with a normal, as columns
-  Eigen::Matrix3Xf normals;                     ///< their normals
-  pcl::Indices column_of;                       ///< subset position -> column, -1 without
+template <typename PointT> struct TabletopCylinderRecognizer<PointT>::FitInput {
+  pcl::Indices subset;                        ///< the cluster's points that are fitted
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points; ///< the subset's coordinates
+  pcl::PointCloud<NormalCurvature>::Ptr cues; ///< their normals and curvatures
+  Eigen::Matrix3Xf columns;                   ///< points with a normal, as columns
+  Eigen::Matrix3Xf normals;                   ///< their normals
+  pcl::Indices column_of;                     ///< subset position -> column, -1 without
 };
 
-template <typename PointT>
-struct TabletopCylinderRecognizer<PointT>::Fit {
+template <typename PointT> struct TabletopCylinderRecognizer<PointT>::Fit {
   CylinderModel model; ///< inliers index FitInput::points
   CylinderEvidence evidence;
   bool accepted{false};
@@ -48,8 +46,8 @@ TabletopCylinderRecognizer<PointT>::configure()
   // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
   // face from pulling the axis. Optionally a last try allows any normal sign: the inside of
   // an open container can make a cluster of its own (so can the inside of a bowl).
-  const bool any_sign = params_.retry_upright_lying && params_.hough.outward_normals &&
-                        params_.retry_any_normal_sign;
+  const bool any_sign =
+    params_.retry_upright_lying && params_.hough.outward_normals && params_.retry_any_normal_sign;
   estimators_.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
   const OrientationPrior priors[4] = {params_.hough.prior, OrientationPrior::VerticalStrong,
                                       OrientationPrior::Horizontal, params_.hough.prior};
@@ -131,8 +129,8 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
 
 template <typename PointT>
 bool
-TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
-  std::vector<RecognizedObject>& objects, std::chrono::steady_clock::time_point t0)
+TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<RecognizedObject>& objects,
+                                                           std::chrono::steady_clock::time_point t0)
 {
   using Clock = std::chrono::steady_clock;
   const auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -165,7 +163,8 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(
     if (o.evidence.fitted) {
       const int s = o.cluster.support;
       const Eigen::Vector3f up =
-        s >= 0 ? Eigen::Vector3f(segmentation_.getSupports()[static_cast<std::size_t>(s)].frame.linear().col(2))
+        s >= 0 ? Eigen::Vector3f(
+                   segmentation_.getSupports()[static_cast<std::size_t>(s)].frame.linear().col(2))
                : Eigen::Vector3f(0.f, -1.f, 0.f);
       orientCylinder(o.cylinder, up, viewpoint);
     }
@@ -217,11 +216,13 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     if (u < s || v < s || u + s >= w || v + s >= h)
       return;
     const auto at = [&](int du, int dv) {
-      return Eigen::Vector3f((*input_)[static_cast<std::size_t>((v + dv) * w + u + du)].getVector3fMap());
+      return Eigen::Vector3f(
+        (*input_)[static_cast<std::size_t>((v + dv) * w + u + du)].getVector3fMap());
     };
     const Eigen::Vector3f m = (at(s, 0) - at(-s, 0)).cross(at(0, s) - at(0, -s));
     if (m.allFinite() && m.norm() > 0.f)
-      n = m.dot(viewpoint - p) >= 0.f ? Eigen::Vector3f(m.normalized()) : Eigen::Vector3f(-m.normalized());
+      n = m.dot(viewpoint - p) >= 0.f ? Eigen::Vector3f(m.normalized())
+                                      : Eigen::Vector3f(-m.normalized());
   };
   const auto isInside = [&](const CylinderModel& c, const RecognizedObject& o) {
     const Eigen::Vector3f axis = c.axis.normalized();
@@ -265,8 +266,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
       const Eigen::Vector3f d = (*input_)[idx[k]].getVector3fMap() - c.base;
       const float t = d.dot(axis);
-      near += (d - t * axis).norm() <= kAttachmentReach * c.radius &&
-              t >= -0.2f * c.radius && t <= height + 0.2f * c.radius;
+      near += (d - t * axis).norm() <= kAttachmentReach * c.radius && t >= -0.2f * c.radius &&
+              t <= height + 0.2f * c.radius;
     }
     return n > 0 && static_cast<float>(near) >= kAttached * static_cast<float>(n);
   };
@@ -302,7 +303,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     TabletopCluster& c = o.cluster;
     for (std::size_t b = 0; b < objects.size(); ++b)
       if (host[b] == static_cast<int>(a))
-        c.indices.indices.insert(c.indices.indices.end(), objects[b].cluster.indices.indices.begin(),
+        c.indices.indices.insert(c.indices.indices.end(),
+                                 objects[b].cluster.indices.indices.begin(),
                                  objects[b].cluster.indices.indices.end());
     std::sort(c.indices.indices.begin(), c.indices.indices.end());
     Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.indices.indices.size()));
@@ -463,9 +465,9 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit 
       if (alive[k])
         alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
     std::vector<Explained> why;
-    CylinderEvidence e = localEvidence(fit.model, input.columns, input.normals, alive_columns,
-                                       explainSettings(fit.model), radial_margin, axial_margin,
-                                       margin, &why);
+    CylinderEvidence e =
+      localEvidence(fit.model, input.columns, input.normals, alive_columns,
+                    explainSettings(fit.model), radial_margin, axial_margin, margin, &why);
     e.curvature_ratio = fit.evidence.curvature_ratio;
     std::vector<Eigen::Index> part, rest;
     for (std::size_t k = 0; k < alive.size(); ++k)
@@ -476,8 +478,8 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit 
       break;
     // Objects that touch meet at a concave crease; a part of one object (a box's edge)
     // continues into the rest convexly or smoothly.
-    const float convex = convexJunctionShare(input.columns, input.normals, part, rest,
-                                             junction_distance, 0.1f);
+    const float convex =
+      convexJunctionShare(input.columns, input.normals, part, rest, junction_distance, 0.1f);
     if (convex > 0.5f)
       break;
     for (std::size_t k = 0; k < alive.size(); ++k)
@@ -595,8 +597,10 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     Eigen::Matrix3Xf mp(3, static_cast<Eigen::Index>(mine.size()));
     for (std::size_t k = 0; k < mine.size(); ++k)
       mp.col(static_cast<Eigen::Index>(k)) = (*input_)[mine[k]].getVector3fMap();
-    o.cluster.centroid = mine.empty() ? Eigen::Vector3f::Zero() : Eigen::Vector3f(mp.rowwise().mean());
-    o.cluster.box = input_->isOrganized() ? pixelBox(mine, input_->width) : projectedBox(mp, camera_);
+    o.cluster.centroid =
+      mine.empty() ? Eigen::Vector3f::Zero() : Eigen::Vector3f(mp.rowwise().mean());
+    o.cluster.box =
+      input_->isOrganized() ? pixelBox(mine, input_->width) : projectedBox(mp, camera_);
     o.cluster.indices.indices = std::move(mine);
     return o;
   };
@@ -604,9 +608,9 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
   // can); a small rest is the unexplained part of the cylinders found (a handle, a rim) and
   // stays with the first of them.
   const std::size_t rest = static_cast<std::size_t>(std::count(owner.begin(), owner.end(), -1));
-  const bool rest_is_object =
-    rest >= seg.min_cluster_size &&
-    static_cast<float>(rest) >= (1.f - params_.min_explained_share) * static_cast<float>(idx.size());
+  const bool rest_is_object = rest >= seg.min_cluster_size &&
+                              static_cast<float>(rest) >= (1.f - params_.min_explained_share) *
+                                                            static_cast<float>(idx.size());
   if (!rest_is_object)
     std::replace(owner.begin(), owner.end(), -1, 0);
   for (std::size_t p = 0; p < parts.size(); ++p) {

@@ -40,8 +40,8 @@ HoughCylinderEstimation<PointT, PointNT>::accumulators()
   if (drawn_.empty()) {
     const GaussianMixture mixture = getOrientationMixture();
     for (std::size_t k = 0; k < params_.accumulators; ++k)
-      drawn_.push_back(OrientationAccumulator::sample(mixture, params_.orientations,
-                                                      params_.seed + k, frame_));
+      drawn_.push_back(
+        OrientationAccumulator::sample(mixture, params_.orientations, params_.seed + k, frame_));
   }
   return drawn_;
 }
@@ -99,9 +99,9 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
   using detail::houghFormat;
   const Level level = diagnose_failures_ ? Level::Warn : Level::Debug;
   const std::size_t n = static_cast<std::size_t>(cues.points.cols());
-  const std::size_t min_inliers =
-      params_.min_inliers > 0 ? params_.min_inliers
-                              : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+  const std::size_t min_inliers = params_.min_inliers > 0
+                                    ? params_.min_inliers
+                                    : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
   if (n < min_inliers)
     return fail(HoughFailure::TooFewPoints,
                 houghFormat("too few points: %zu usable of %zu, and a cylinder needs %zu inliers "
@@ -122,8 +122,8 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
     catch (const std::exception&) {
       found.clear();
     }
-    if (!found.empty() && (found.front().radius < params_.radius_min ||
-                           found.front().radius > params_.radius_max))
+    if (!found.empty() &&
+        (found.front().radius < params_.radius_min || found.front().radius > params_.radius_max))
       return fail(HoughFailure::RadiusLimits,
                   houghFormat("the radius limits [%g, %g] exclude every candidate: without them "
                               "the best cylinder has radius %g (%zu inliers)",
@@ -167,8 +167,7 @@ HoughCylinderEstimation<PointT, PointNT>::checkInput()
     if (!getOrientationMixture().isValid(&bad))
       return fail(HoughFailure::InvalidParameters, "invalid orientation prior: " + bad);
     if (!frame_.allFinite() || std::abs(frame_.determinant()) < 1e-6f)
-      return fail(HoughFailure::InvalidParameters,
-                  "the reference frame is singular or not finite");
+      return fail(HoughFailure::InvalidParameters, "the reference frame is singular or not finite");
   }
   else if (std::any_of(user_accumulators_.begin(), user_accumulators_.end(),
                        [](const OrientationAccumulator& a) { return a.size() == 0; })) {
@@ -200,7 +199,7 @@ HoughCylinderEstimation<PointT, PointNT>::gatherCues(CylinderCues& cues,
   cues.points.resize(3, n_max);
   cues.normals.resize(3, n_max);
   const bool given_curvature =
-      params_.voting_mode == VotingMode::SoftCurvature && !curvaturesToEstimate();
+    params_.voting_mode == VotingMode::SoftCurvature && !curvaturesToEstimate();
   if (given_curvature) {
     cues.curvature_directions.resize(3, n_max);
     cues.weights.resize(n_max);
@@ -210,8 +209,8 @@ HoughCylinderEstimation<PointT, PointNT>::gatherCues(CylinderCues& cues,
     if (idx < 0 || static_cast<std::size_t>(idx) >= cloud.size()) {
       this->deinitCompute();
       return fail(HoughFailure::InvalidIndices,
-                  houghFormat("index %d is outside the cloud (%zu points)",
-                              static_cast<int>(idx), cloud.size()));
+                  houghFormat("index %d is outside the cloud (%zu points)", static_cast<int>(idx),
+                              cloud.size()));
     }
     const auto& p = cloud[idx];
     const auto& q = normals[idx];
@@ -247,9 +246,9 @@ HoughCylinderEstimation<PointT, PointNT>::gatherCues(CylinderCues& cues,
   }
   this->deinitCompute();
   if (n == 0)
-    return fail(HoughFailure::NoFinitePoints,
-                houghFormat("none of the %zu points has a finite position and normal",
-                            indices.size()));
+    return fail(
+      HoughFailure::NoFinitePoints,
+      houghFormat("none of the %zu points has a finite position and normal", indices.size()));
   cues.points.conservativeResize(3, n);
   cues.normals.conservativeResize(3, n);
   if (given_curvature) {
@@ -270,8 +269,8 @@ estimateOwnCurvatures(CylinderCues& cues)
 {
   constexpr int kCueNeighbours = 16;
   const Eigen::Index n = cues.points.cols();
-  const PointCues own = estimatePointCues(cues.points, std::numeric_limits<float>::max(),
-                                          kCueNeighbours, cues.normals);
+  const PointCues own =
+    estimatePointCues(cues.points, std::numeric_limits<float>::max(), kCueNeighbours, cues.normals);
   cues.curvature_directions.setZero(3, n);
   cues.weights.setZero(n);
   for (Eigen::Index s = 0; s < n; ++s) {
@@ -321,5 +320,5 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
 
 } // namespace facyl
 
-#define FACYL_INSTANTIATE_HoughCylinderEstimation(T, NT)                                    \
+#define FACYL_INSTANTIATE_HoughCylinderEstimation(T, NT)                                           \
   template class facyl::HoughCylinderEstimation<T, NT>;

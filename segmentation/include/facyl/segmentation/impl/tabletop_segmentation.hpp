@@ -181,9 +181,8 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
                 f, families[f].size(), candidates[families[f].front()].plane[0],
                 candidates[families[f].front()].plane[1], candidates[families[f].front()].plane[2],
                 coarse.supports.size(), coarse.standing_objects, coarse.standing);
-      if (!coarse.supports.empty() &&
-          (tried == 1 || static_cast<float>(coarse.standing_objects) >
-                           kFamilyMargin * static_cast<float>(most)))
+      if (!coarse.supports.empty() && (tried == 1 || static_cast<float>(coarse.standing_objects) >
+                                                       kFamilyMargin * static_cast<float>(most)))
         chosen = f, most = coarse.standing_objects;
     }
   }
@@ -260,14 +259,19 @@ namespace detail {
  * each block's first pixel with depth, and the mean of those with depth near the first's. */
 struct BlockMeans {
   BlockMeans(int step_, int w, int h)
-  : step(step_), cw(static_cast<std::size_t>((w + step_ - 1) / step_)),
-    ch(static_cast<std::size_t>((h + step_ - 1) / step_)), sum(cw * ch, Eigen::Vector3f::Zero()),
-    first(cw * ch, 0.f), count(cw * ch, 0), source(cw * ch, -1)
-  {}
-  void
-  add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
+      : step(step_)
+      , cw(static_cast<std::size_t>((w + step_ - 1) / step_))
+      , ch(static_cast<std::size_t>((h + step_ - 1) / step_))
+      , sum(cw * ch, Eigen::Vector3f::Zero())
+      , first(cw * ch, 0.f)
+      , count(cw * ch, 0)
+      , source(cw * ch, -1)
   {
-    const std::size_t k = static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
+  }
+  void add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
+  {
+    const std::size_t k =
+      static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
     if (count[k] == 0) {
       first[k] = p.z();
       source[k] = idx;
@@ -362,9 +366,8 @@ TabletopSegmentation<PointT>::finishGrid(detail::BlockMeans& blocks, PlaneGrid& 
     const auto kk = static_cast<std::size_t>(k);
     grid.cells.col(k) = small[kk].getVector3fMap();
     grid.cell_normals.col(k) = (*grid.normals)[kk].getNormalVector3fMap();
-    grid.samples.col(k) = source[kk] >= 0
-                            ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
-                            : Eigen::Vector3f::Constant(nan);
+    grid.samples.col(k) = source[kk] >= 0 ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
+                                          : Eigen::Vector3f::Constant(nan);
   }
 }
 
@@ -383,8 +386,8 @@ TabletopSegmentation<PointT>::planeSeeds(const PlaneGrid& grid) const
     pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
     mps.setMinInliers(static_cast<unsigned>(min_cells));
     mps.setAngularThreshold(std::min(0.5f, relax * params_.plane_angle));
-    mps.setDistanceThreshold(relax * (params_.plane_distance > 0.f ? params_.plane_distance
-                                                                   : kSeedDistance));
+    mps.setDistanceThreshold(
+      relax * (params_.plane_distance > 0.f ? params_.plane_distance : kSeedDistance));
     mps.setMaximumCurvature(relax * relax * 0.001);
     mps.setInputNormals(grid.normals);
     mps.setInputCloud(grid.small);
@@ -396,22 +399,17 @@ TabletopSegmentation<PointT>::planeSeeds(const PlaneGrid& grid) const
         }))
       break;
   }
-  std::sort(inliers.begin(), inliers.end(), [](const auto& a, const auto& b) {
-    return a.indices.size() > b.indices.size();
-  });
+  std::sort(inliers.begin(), inliers.end(),
+            [](const auto& a, const auto& b) { return a.indices.size() > b.indices.size(); });
   return inliers;
 }
 
 template <typename PointT>
 bool
-TabletopSegmentation<PointT>::growCandidate(const Eigen::Matrix3Xf& cells,
-                                            const Eigen::Matrix3Xf& normals,
-                                            const Eigen::Matrix3Xf& samples,
-                                            const std::vector<std::uint8_t>& seed,
-                                            const std::vector<pcl::index_t>& source,
-                                            std::size_t cell_points,
-                                            std::vector<std::uint8_t>& taken,
-                                            Candidate& out) const
+TabletopSegmentation<PointT>::growCandidate(
+  const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals, const Eigen::Matrix3Xf& samples,
+  const std::vector<std::uint8_t>& seed, const std::vector<pcl::index_t>& source,
+  std::size_t cell_points, std::vector<std::uint8_t>& taken, Candidate& out) const
 {
   PlaneRegion region;
   if (!refinePlaneRegion(cells, normals, samples, seed, input_->sensor_origin_.head(3),
@@ -453,16 +451,17 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
     else
       planeGrid(step, grid);
     if (step == planeStep()) {
-      focal_ = camera_.valid() ? camera_.fx
-                               : estimateFocalLength(*grid.small) * static_cast<float>(step);
+      focal_ =
+        camera_.valid() ? camera_.fx : estimateFocalLength(*grid.small) * static_cast<float>(step);
       image_down_ = imageDownDirection(*grid.small, input_->sensor_origin_.head(3));
     }
     seeds = planeSeeds(grid);
     PCL_DEBUG("[facyl::TabletopSegmentation] grid of %d pixels: %zu seeds, largest %zu cells\n",
               step, seeds.size(), seeds.empty() ? std::size_t{0} : seeds.front().indices.size());
     const std::size_t cell = static_cast<std::size_t>(step * step);
-    if (std::any_of(seeds.begin(), seeds.end(),
-                    [&](const auto& r) { return r.indices.size() * cell >= params_.min_plane_points; }) ||
+    if (std::any_of(
+          seeds.begin(), seeds.end(),
+          [&](const auto& r) { return r.indices.size() * cell >= params_.min_plane_points; }) ||
         static_cast<int>(input_->width) < 32 * step || static_cast<int>(input_->height) < 32 * step)
       break;
   }
@@ -481,7 +480,8 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
     for (auto& r : planeSeeds(twice)) {
       std::size_t with_depth = 0, without_normal = 0;
       for (const auto k : r.indices) {
-        const std::size_t cu = static_cast<std::size_t>(k) % tw, cv = static_cast<std::size_t>(k) / tw;
+        const std::size_t cu = static_cast<std::size_t>(k) % tw,
+                          cv = static_cast<std::size_t>(k) / tw;
         for (std::size_t dv = 0; dv < 2; ++dv)
           for (std::size_t du = 0; du < 2; ++du) {
             const std::size_t u = 2 * cu + du, v = 2 * cv + dv;
@@ -529,8 +529,8 @@ TabletopSegmentation<PointT>::growCandidates(const PlaneGrid& grid,
     for (const auto k : r.indices)
       seed[static_cast<std::size_t>(k)] = 1;
     Candidate c;
-    if (growCandidate(grid.cells, grid.cell_normals, grid.samples, seed, grid.source, cell,
-                      taken, c))
+    if (growCandidate(grid.cells, grid.cell_normals, grid.samples, seed, grid.source, cell, taken,
+                      c))
       candidates.push_back(std::move(c));
   }
 }
@@ -549,7 +549,8 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   pcl::RandomSample<PointT> sample;
   sample.setInputCloud(input_);
   sample.setIndices(finite);
-  sample.setSample(static_cast<unsigned>(std::min<std::size_t>(params_.plane_samples, finite->size())));
+  sample.setSample(
+    static_cast<unsigned>(std::min<std::size_t>(params_.plane_samples, finite->size())));
   sample.setSeed(1);
   pcl::Indices sampled;
   sample.filter(sampled);
@@ -576,8 +577,9 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   }
   // RANSAC's seed threshold: 2 % of the typical range (the bands are measured afterwards).
   std::nth_element(ranges.begin(), ranges.begin() + n / 2, ranges.end());
-  const float seed_distance =
-    params_.plane_distance > 0.f ? params_.plane_distance : 0.02f * ranges[static_cast<std::size_t>(n / 2)];
+  const float seed_distance = params_.plane_distance > 0.f
+                                ? params_.plane_distance
+                                : 0.02f * ranges[static_cast<std::size_t>(n / 2)];
   // Planes one after another, each seeded on what the previous ones left: RANSAC on positions
   // (cheap), then the inliers whose normal agrees with the plane's.
   pcl::SACSegmentation<PointT> sac;
@@ -737,8 +739,9 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
     Eigen::Vector3f centre = Eigen::Vector3f::Zero();
     for (const auto i : candidates[s].points)
       centre += (*input_)[i].getVector3fMap();
-    all[s].frame = planeFrame(candidates[s].plane,
-                              centre / static_cast<float>(std::max<std::size_t>(1, candidates[s].points.size())));
+    all[s].frame = planeFrame(
+      candidates[s].plane,
+      centre / static_cast<float>(std::max<std::size_t>(1, candidates[s].points.size())));
   }
 }
 
@@ -754,8 +757,8 @@ TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candida
   std::vector<Eigen::Vector4f> normals;
   std::vector<std::size_t> order;
   for (std::size_t s = 0; s < candidates.size(); ++s) {
-    normals.push_back(Eigen::Vector4f(candidates[s].plane[0], candidates[s].plane[1],
-                                      candidates[s].plane[2], 0.f));
+    normals.push_back(
+      Eigen::Vector4f(candidates[s].plane[0], candidates[s].plane[1], candidates[s].plane[2], 0.f));
     order.push_back(s); // largest first
   }
   // Supports are level: a table, the floor under it and a shelf are parallel within degrees.
@@ -793,8 +796,7 @@ typename TabletopSegmentation<PointT>::Trial
 TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
                                         const std::vector<Candidate>& candidates,
                                         std::vector<SupportPlane>& all,
-                                        const std::vector<Above>& above, int stride,
-                                        bool final)
+                                        const std::vector<Above>& above, int stride, bool final)
 {
   const bool largest = params_.support == TabletopSegmentationParameters::Support::LargestPlane;
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
@@ -818,9 +820,9 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
     bool elevated = false;
     for (const std::size_t t : family) {
       const float height = candidates[t].plane[3] - candidates[s].plane[3];
-      elevated = elevated || (t != s && candidates[t].support > candidates[s].support &&
-                              height > candidates[t].band.halfWidth(range) &&
-                              height <= params_.max_height);
+      elevated =
+        elevated || (t != s && candidates[t].support > candidates[s].support &&
+                     height > candidates[t].band.halfWidth(range) && height <= params_.max_height);
     }
     // Its own region must be sizeable too: a small region's infinite plane can cross a
     // table.
@@ -831,9 +833,9 @@ TabletopSegmentation<PointT>::tryFamily(const std::vector<std::size_t>& family,
                 "%.3f, %zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
                 s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
                 all[s].inliers.indices.size(), hull, region, elevated ? ", elevated" : "");
-    const bool large = elevated ? region >= params_.min_shelf_area
-                                : hull >= params_.min_support_area &&
-                                    region >= 0.25f * params_.min_support_area;
+    const bool large =
+      elevated ? region >= params_.min_shelf_area
+               : hull >= params_.min_support_area && region >= 0.25f * params_.min_support_area;
     if (support.polygon.size() < 3 || !(largest || large))
       continue;
     kept |= static_cast<std::uint8_t>(1u << s);
@@ -917,7 +919,8 @@ TabletopSegmentation<PointT>::supportHull(const Eigen::Affine3f& frame, const pc
       return true;
     for (std::size_t e = 0; e < region.size(); ++e) {
       const Eigen::Vector2f a = region[e], b = region[(e + 1) % region.size()];
-      const float t = std::clamp((p - a).dot(b - a) / std::max((b - a).squaredNorm(), 1e-12f), 0.f, 1.f);
+      const float t =
+        std::clamp((p - a).dot(b - a) / std::max((b - a).squaredNorm(), 1e-12f), 0.f, 1.f);
       if ((a + t * (b - a) - p).squaredNorm() <= grow * grow)
         return true;
     }
@@ -960,8 +963,8 @@ TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts) const
   Placement out;
   std::vector<HeightProfile> profiles(supports_.size());
   for (std::size_t s = 0; s < supports_.size(); ++s) {
-    profiles[s] = heightProfile(pts, supports_[s].plane, supports_[s].band, viewpoint,
-                                p.min_height, p.max_height);
+    profiles[s] = heightProfile(pts, supports_[s].plane, supports_[s].band, viewpoint, p.min_height,
+                                p.max_height);
     const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
     std::size_t in_hull = 0;
     for (Eigen::Index k = 0; k < pts.cols(); ++k)
@@ -986,8 +989,8 @@ TabletopSegmentation<PointT>::place(const Eigen::Matrix3Xf& pts) const
     const Eigen::Affine3f to_plane = supports_[s].frame.inverse();
     std::size_t under = 0;
     for (Eigen::Index k = 0; k < pts.cols(); ++k)
-      under += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).template head<2>(),
-                              extents_[s]);
+      under +=
+        pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).template head<2>(), extents_[s]);
     if (2 * under >= static_cast<std::size_t>(pts.cols())) {
       out.support = -1;
       return out;
@@ -1107,8 +1110,8 @@ TabletopSegmentation<PointT>::makeCluster(pcl::Indices indices, int support) con
   for (std::size_t k = 0; k < c.indices.indices.size(); ++k)
     pts.col(static_cast<Eigen::Index>(k)) = (*input_)[c.indices.indices[k]].getVector3fMap();
   c.centroid = pts.rowwise().mean();
-  c.box = input_->isOrganized() ? pixelBox(c.indices.indices, input_->width)
-                                : projectedBox(pts, camera_);
+  c.box =
+    input_->isOrganized() ? pixelBox(c.indices.indices, input_->width) : projectedBox(pts, camera_);
   return c;
 }
 
@@ -1141,8 +1144,7 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   masked->is_dense = false;
   for (const auto i : objects)
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
-  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware &&
-      focal_ > 0.f) {
+  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
     has_depth_.resize(input_->size());
     for (std::size_t i = 0; i < input_->size(); ++i)
       has_depth_[i] = pcl::isFinite((*input_)[i]);
@@ -1189,21 +1191,23 @@ TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int str
       has_depth[static_cast<std::size_t>(v) * cw + u] =
         pcl::isFinite((*input_)[static_cast<std::size_t>(v * stride) * w + u * stride]);
   const auto coarse_index = [&](pcl::index_t i) {
-    return static_cast<std::size_t>((i / w) / stride) * cw + static_cast<std::size_t>((i % w) / stride);
+    return static_cast<std::size_t>((i / w) / stride) * cw +
+           static_cast<std::size_t>((i % w) / stride);
   };
   for (const auto i : objects)
     coarse[coarse_index(i)].getVector3fMap() = (*input_)[i].getVector3fMap();
   std::vector<pcl::Indices> groups;
   if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
     ObjectSegmentationParameters op = params_.objects;
-    op.min_fragment = std::max<std::size_t>(1, op.min_fragment / static_cast<std::size_t>(stride * stride));
+    op.min_fragment =
+      std::max<std::size_t>(1, op.min_fragment / static_cast<std::size_t>(stride * stride));
     op.bridge_occlusions = false; // a count of standing objects needs no joined occluded parts
     // Neighbours are stride pixels apart: the gaps that still connect them grow alike.
     op.min_gap *= static_cast<float>(stride);
     op.max_gap *= static_cast<float>(stride);
-    groups = segmentObjectsOrganized(coarse, has_depth, focal_ / static_cast<float>(stride),
-                                     input_->sensor_origin_.head(3), op,
-                                     has_noise_ ? &noise_ : nullptr);
+    groups =
+      segmentObjectsOrganized(coarse, has_depth, focal_ / static_cast<float>(stride),
+                              input_->sensor_origin_.head(3), op, has_noise_ ? &noise_ : nullptr);
   }
   else {
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(coarse));
@@ -1309,8 +1313,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
     if (box.isEmpty())
       return;
     // At most 1280 x 960 pixels: a wider view gets a coarser grid.
-    const float f = std::min({525.f, 1279.f / std::max(box.sizes().x(), 1e-6f),
-                              959.f / std::max(box.sizes().y(), 1e-6f)});
+    const float f = std::min(
+      {525.f, 1279.f / std::max(box.sizes().x(), 1e-6f), 959.f / std::max(box.sizes().y(), 1e-6f)});
     camera.fx = camera.fy = f;
     camera.cx = -f * box.min().x();
     camera.cy = -f * box.min().y();
@@ -1328,7 +1332,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
     return v * camera.width + u;
   };
   // A depth image of the nearest object point per pixel, and which pixels see any surface.
-  const std::size_t n = static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+  const std::size_t n =
+    static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   pcl::PointCloud<pcl::PointXYZ> image;
   image.width = static_cast<std::uint32_t>(camera.width);
@@ -1357,9 +1362,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
       image[static_cast<std::size_t>(k)].getVector3fMap() = p;
     }
   }
-  const std::vector<pcl::Indices> segments =
-    segmentObjectsOrganized(image, has_depth, camera.fx, origin, params_.objects,
-                            has_noise_ ? &noise_ : nullptr);
+  const std::vector<pcl::Indices> segments = segmentObjectsOrganized(
+    image, has_depth, camera.fx, origin, params_.objects, has_noise_ ? &noise_ : nullptr);
   // Every object point takes the segment of its pixel.
   std::vector<int> segment_of(n, -1);
   for (std::size_t s = 0; s < segments.size(); ++s)
@@ -1368,7 +1372,8 @@ TabletopSegmentation<PointT>::segmentProjected(const pcl::Indices& objects,
   out.assign(segments.size(), pcl::Indices{});
   for (std::size_t j = 0; j < objects.size(); ++j)
     if (pixel[j] >= 0 && segment_of[static_cast<std::size_t>(pixel[j])] >= 0)
-      out[static_cast<std::size_t>(segment_of[static_cast<std::size_t>(pixel[j])])].push_back(objects[j]);
+      out[static_cast<std::size_t>(segment_of[static_cast<std::size_t>(pixel[j])])].push_back(
+        objects[j]);
 }
 
 } // namespace facyl
