@@ -509,6 +509,36 @@ TEST(HoughCylinderEstimation, InvalidInputsAreReported)
   }
 }
 
+TEST(HoughCylinderEstimation, EverySettingHasOneHome)
+{
+  // N_d, the accumulators, the seed and the prior live in HoughCylinderParameters: the setters
+  // and setParameters reach the same fields, and validate() is their one range check.
+  facyl::HoughCylinderParameters p;
+  EXPECT_EQ(p.orientations, 450u); // the paper's N_d
+  p.orientations = 900;
+  p.accumulators = 2;
+  p.seed = 7;
+  p.prior = facyl::OrientationPrior::Horizontal;
+  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> h;
+  h.setParameters(p);
+  EXPECT_EQ(h.getNumberOfOrientations(), 900u);
+  EXPECT_EQ(h.getNumberOfAccumulators(), 2u);
+  EXPECT_EQ(h.getSeed(), 7u);
+  ASSERT_EQ(h.getAccumulators().size(), 2u);
+  EXPECT_EQ(h.getAccumulators()[0].size(), 900u);
+  const auto horizontal = facyl::GaussianMixture::fromPrior(facyl::OrientationPrior::Horizontal);
+  EXPECT_EQ(h.getOrientationMixture().components.size(), horizontal.components.size());
+  h.setSeed(8);
+  EXPECT_EQ(h.getParameters().seed, 8u);
+  for (const std::size_t n : {facyl::kMinOrientations - 1, facyl::kMaxOrientations + 1}) {
+    p.orientations = n;
+    EXPECT_NE(facyl::validate(p).find("[10, 100000]"), std::string::npos) << facyl::validate(p);
+  }
+  p.orientations = 450;
+  p.accumulators = 0;
+  EXPECT_NE(facyl::validate(p).find("accumulators 0"), std::string::npos);
+}
+
 TEST(HoughCylinderEstimation, SearchFailuresSayWhy)
 {
   facyl::CylinderSimulationParameters p;
