@@ -6,6 +6,7 @@
  * scripts/bench_plot.py draws the figure from fits.csv.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/json_writer.h>
 #include <facyl/tools/pcl_baseline.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
@@ -375,10 +376,12 @@ dumpScene(const Options& o)
         (setting == "paper" || setting == "practical" || setting == "random") && !scene.empty()) {
       const Scene s = makeScene(setting, l, std::stoi(scene), o.seed);
       pcl::io::savePCDFileBinary(o.out + "/scene.pcd", *s.cloud);
-      std::printf("{\"file\":%s,\"radius\":%s,\"axis\":%s,\"base\":%s}\n",
-                  facyl_cli::quote(o.out + "/scene.pcd").c_str(),
-                  facyl_cli::number(s.truth.radius).c_str(),
-                  facyl_cli::vector(s.truth.axis).c_str(), facyl_cli::vector(s.truth.base).c_str());
+      facyl_cli::Json line;
+      line["file"] = o.out + "/scene.pcd";
+      line["radius"] = facyl_cli::jsonNumber(s.truth.radius);
+      line["axis"] = facyl_cli::jsonVector(s.truth.axis);
+      line["base"] = facyl_cli::jsonVector(s.truth.base);
+      std::printf("%s\n", facyl_cli::dumpJson(line).c_str());
       return 0;
     }
   std::fprintf(stderr, "facyl_bench: --dump wants SETTING,SWEEP,LEVEL,SCENE as in fits.csv\n");

@@ -278,12 +278,14 @@ processScene(const std::string& file, const std::string& name, const Settings& s
              Stream* stream)
 {
   auto fail = [&](const std::string& why) {
-    out << "{\"file\":" << facyl_cli::quote(file) << ",\"error\":" << facyl_cli::quote(why);
+    facyl_cli::Json line;
+    line["file"] = file;
+    line["error"] = why;
     if (stream) { // the stream goes on: nothing is known of this frame, the tracks are kept
       stream->tracker.skipFrame();
-      out << facyl_cli::streamJson(stream->tracker, nullptr);
+      facyl_cli::addStreamFields(line, stream->tracker, nullptr);
     }
-    out << "}" << std::endl;
+    out << facyl_cli::dumpJson(line) << std::endl;
     return false;
   };
   pcl::PCLPointCloud2 blob;
@@ -323,6 +325,7 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   std::sort(timings.begin(), timings.end(),
             [](const auto& a, const auto& b) { return a.total < b.total; });
   std::string warning, error;
+  facyl_cli::Json line;
   if (stream) {
     // Frames of another size are no error (the tracks are in the table's frame), but worth a
     // word: a stream usually comes from one sensor.
@@ -337,11 +340,11 @@ processScene(const std::string& file, const std::string& name, const Settings& s
                   std::to_string(stream->height) + ": tracked on (the tracks are kept)";
     }
     stream->tracker.update(rec, objects);
-    out << facyl_cli::trackedSceneJson(file, *cloud, rec, objects, timings[timings.size() / 2],
+    line = facyl_cli::trackedSceneJson(file, *cloud, rec, objects, timings[timings.size() / 2],
                                        stream->tracker);
   }
   else
-    out << facyl_cli::sceneJson(file, *cloud, rec, objects, timings[timings.size() / 2]);
+    line = facyl_cli::sceneJson(file, *cloud, rec, objects, timings[timings.size() / 2]);
 
   // Outputs: a warning (no overlay possible) goes to standard error and keeps the status; an
   // output that could not be written is an error of the scene.
@@ -358,13 +361,13 @@ processScene(const std::string& file, const std::string& name, const Settings& s
     error = saveClusters(s.clusters_dir, name, *cloud, has_colour, objects);
   if (!warning.empty()) {
     facyl_cli::warn("facyl_detect", file + ": " + warning);
-    out << ",\"warning\":" << facyl_cli::quote(warning);
+    line["warning"] = warning;
   }
   if (!error.empty()) {
     std::fprintf(stderr, "facyl_detect: %s: %s\n", file.c_str(), error.c_str());
-    out << ",\"error\":" << facyl_cli::quote(error);
+    line["error"] = error;
   }
-  out << "}" << std::endl;
+  out << facyl_cli::dumpJson(line) << std::endl;
   return error.empty();
 }
 
@@ -500,13 +503,14 @@ main(int argc, char** argv)
       ok = processScene(files[k], names[k], s, std::cout, stream.get());
     }
     catch (const std::exception& e) { // e.g. std::bad_alloc: this scene fails, the batch goes on
-      std::cout << "{\"file\":" << facyl_cli::quote(files[k]) << ",\"error\":"
-                << facyl_cli::quote(std::string("unexpected failure: ") + e.what());
+      facyl_cli::Json line;
+      line["file"] = files[k];
+      line["error"] = std::string("unexpected failure: ") + e.what();
       if (stream) {
         stream->tracker.skipFrame();
-        std::cout << facyl_cli::streamJson(stream->tracker, nullptr);
+        facyl_cli::addStreamFields(line, stream->tracker, nullptr);
       }
-      std::cout << "}" << std::endl;
+      std::cout << facyl_cli::dumpJson(line) << std::endl;
     }
     all_ok = ok && all_ok;
     progress.step();

@@ -5,6 +5,7 @@
 #include <facyl/tools/cylinder_fit.h>
 #include <facyl/tools/cylinder_json.h>
 #include <facyl/tools/fit_options.h>
+#include <facyl/tools/json_writer.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/pcl_baseline.h>
 
@@ -71,7 +72,10 @@ fitPclRansac(const Cloud::ConstPtr& cloud, const Cues& cues, const Settings& s)
 std::string
 errorObject(const std::string& file, const std::string& message)
 {
-  return "{\"file\":" + facyl_cli::quote(file) + ",\"error\":" + facyl_cli::quote(message) + "}";
+  facyl_cli::Json line;
+  line["file"] = file;
+  line["error"] = message;
+  return facyl_cli::dumpJson(line);
 }
 
 using facyl_cli::hasField;
@@ -134,27 +138,28 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   if (models.empty() && !why.empty())
     std::fprintf(stderr, "facyl_fit: %s: no cylinder: %s\n", file.c_str(), why.c_str());
 
-  using facyl_cli::number;
-  const char* units_name = s.units == facyl_cli::Units::Millimetres ? "mm" : "m";
-  std::string out =
-    "{\"file\":" + facyl_cli::quote(file) + ",\"method\":" + facyl_cli::quote(s.method) +
-    ",\"voting\":" +
-    facyl_cli::quote(s.method == "pcl-ransac" ? std::string("none")
-                                              : facyl::toString(s.params.voting_mode)) +
-    ",\"units\":\"" + units_name + "\",\"points\":" + std::to_string(cloud->size()) +
-    ",\"cylinders\":[";
-  for (std::size_t i = 0; i < models.size(); ++i) {
-    facyl::CylinderModel m = models[i];
+  using facyl_cli::jsonNumber;
+  facyl_cli::Json out;
+  out["file"] = file;
+  out["method"] = s.method;
+  out["voting"] =
+    s.method == "pcl-ransac" ? std::string("none") : facyl::toString(s.params.voting_mode);
+  out["units"] = s.units == facyl_cli::Units::Millimetres ? "mm" : "m";
+  out["points"] = cloud->size();
+  out["cylinders"] = facyl_cli::Json::array();
+  for (const auto& model : models) {
+    facyl::CylinderModel m = model;
     facyl_cli::scaleModel(m, 1.f / to_metres);
-    out += (i ? "," : "") + facyl_cli::cylinderJson(m, s.inlier_indices);
+    out["cylinders"].push_back(facyl_cli::cylinderObject(m, s.inlier_indices));
   }
-  out += "]";
   if (models.empty() && !why.empty())
-    out += ",\"why_none\":" + facyl_cli::quote(why);
-  out += ",\"timing_ms\":{\"load\":" + number(load_ms) + ",\"normals\":" + number(normals_ms) +
-         ",\"fit\":" + number(fit_ms) + ",\"total\":" + number(total_watch.getTime()) + "}}";
+    out["why_none"] = why;
+  out["timing_ms"]["load"] = jsonNumber(load_ms);
+  out["timing_ms"]["normals"] = jsonNumber(normals_ms);
+  out["timing_ms"]["fit"] = jsonNumber(fit_ms);
+  out["timing_ms"]["total"] = jsonNumber(total_watch.getTime());
   ok = true;
-  return out;
+  return facyl_cli::dumpJson(out);
 }
 
 } // namespace

@@ -3,6 +3,7 @@
  * truth as JSON on stdout.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/json_writer.h>
 
 #include <facyl/simulation/cylinder_simulation.h>
 
@@ -94,12 +95,14 @@ main(int argc, char** argv)
     return 1;
   }
   const auto& t = sim.truth;
-  std::cout << "{\"file\":" << facyl_cli::quote(out)
-            << ",\"radius\":" << facyl_cli::number(t.radius)
-            << ",\"height\":" << facyl_cli::number(t.height)
-            << ",\"axis\":" << facyl_cli::vector(t.axis)
-            << ",\"base\":" << facyl_cli::vector(t.base)
-            << ",\"lateral_points\":" << t.lateral_points << ",\"lid_points\":" << t.lid_points
-            << "}" << std::endl;
+  facyl_cli::Json line;
+  line["file"] = out;
+  line["radius"] = facyl_cli::jsonNumber(t.radius);
+  line["height"] = facyl_cli::jsonNumber(t.height);
+  line["axis"] = facyl_cli::jsonVector(t.axis);
+  line["base"] = facyl_cli::jsonVector(t.base);
+  line["lateral_points"] = t.lateral_points;
+  line["lid_points"] = t.lid_points;
+  std::cout << facyl_cli::dumpJson(line) << std::endl;
   return 0;
 }

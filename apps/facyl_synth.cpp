@@ -8,6 +8,7 @@
  * furniture, robots) has ids 1000+ and class 7.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/json_writer.h>
 #include <facyl/tools/scene_options.h>
 
 #include <facyl/simulation/tabletop_scene.h>
@@ -144,8 +145,12 @@ writeSequence(const std::string& name, const facyl::TabletopSceneParameters& p,
     std::size_t present = 0;
     for (std::size_t i = 0; i < seq.scene.objects.size(); ++i)
       present += seq.present(i, k);
-    std::cout << "{\"file\":" << facyl_cli::quote(name + suffix + ".pcd") << ",\"seed\":" << p.seed
-              << ",\"frame\":" << k << ",\"objects\":" << present << "}" << std::endl;
+    facyl_cli::Json line;
+    line["file"] = name + suffix + ".pcd";
+    line["seed"] = p.seed;
+    line["frame"] = k;
+    line["objects"] = present;
+    std::cout << facyl_cli::dumpJson(line) << std::endl;
   }
   return true;
 }
@@ -234,9 +239,12 @@ main(int argc, char** argv)
     std::size_t cylinders = 0;
     for (const auto& o : scene.scene.objects)
       cylinders += o.cls == facyl::SceneClass::Cylinder;
-    std::cout << "{\"file\":" << facyl_cli::quote(name + ".pcd") << ",\"seed\":" << p.seed
-              << ",\"objects\":" << scene.scene.objects.size() << ",\"cylinders\":" << cylinders
-              << "}" << std::endl;
+    facyl_cli::Json line;
+    line["file"] = name + ".pcd";
+    line["seed"] = p.seed;
+    line["objects"] = scene.scene.objects.size();
+    line["cylinders"] = cylinders;
+    std::cout << facyl_cli::dumpJson(line) << std::endl;
   }
   return 0;
 }

@@ -9,7 +9,7 @@
 #include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_fit.h>
 #include <facyl/tools/frame_stream.h>
-#include <facyl/tools/json_value.h>
+#include <facyl/tools/json_writer.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/pcl_baseline.h>
 #include <facyl/tools/recognizer_options.h>
@@ -216,43 +216,61 @@ detectObjects(const Settings& s, Scene& scene)
   }
 }
 
-Eigen::Vector3f
-jsonVector(const facyl_cli::JsonValue* v)
+using facyl_cli::Json;
+
+/** The field \a key of the object \a j; nullptr when absent or \a j is no object. */
+const Json*
+field(const Json& j, const char* key)
 {
-  if (!v || v->items.size() != 3)
+  if (!j.is_object())
+    return nullptr;
+  const auto it = j.find(key);
+  return it == j.end() ? nullptr : &*it;
+}
+
+/** The number \a v, or \a otherwise when it is absent or no number. */
+double
+numberOr(const Json* v, double otherwise)
+{
+  return v && v->is_number() ? v->get<double>() : otherwise;
+}
+
+Eigen::Vector3f
+vectorOf(const Json* v)
+{
+  if (!v || !v->is_array() || v->size() != 3 ||
+      !std::all_of(v->begin(), v->end(), [](const Json& x) { return x.is_number(); }))
     throw std::runtime_error("a vector of 3 numbers is missing");
-  return Eigen::Vector3f(static_cast<float>(v->items[0].number),
-                         static_cast<float>(v->items[1].number),
-                         static_cast<float>(v->items[2].number));
+  return Eigen::Vector3f((*v)[0].get<float>(), (*v)[1].get<float>(), (*v)[2].get<float>());
 }
 
 /** --detections: the objects of facyl_detect's line for the scene. */
 void
-objectsFromJson(const facyl_cli::JsonValue& line, Scene& scene)
+objectsFromJson(const Json& line, Scene& scene)
 {
-  if (const auto* error = line.get("error"))
-    throw std::runtime_error("the detections say: " + error->text);
-  const auto* objects = line.get("objects");
-  if (!objects)
+  if (const auto* error = field(line, "error"))
+    throw std::runtime_error("the detections say: " +
+                             (error->is_string() ? error->get<std::string>() : error->dump()));
+  const auto* objects = field(line, "objects");
+  if (!objects || !objects->is_array())
     throw std::runtime_error("the detections line has no \"objects\"");
-  for (const auto& j : objects->items) {
+  for (const auto& j : *objects) {
     ViewObject o;
-    o.centroid = jsonVector(j.get("centroid"));
-    const auto* is = j.get("is_cylinder");
-    o.is_cylinder = is && is->boolean;
-    const auto* p = j.get("p_cylinder");
-    if (p && p->type == facyl_cli::JsonValue::Type::Number)
-      o.p_cylinder = static_cast<float>(p->number);
-    const auto* c = j.get("cylinder");
-    if (c && c->type == facyl_cli::JsonValue::Type::Object) {
+    o.centroid = vectorOf(field(j, "centroid"));
+    const auto* is = field(j, "is_cylinder");
+    o.is_cylinder = is && is->is_boolean() && is->get<bool>();
+    if (const auto* p = field(j, "p_cylinder"); p && p->is_number())
+      o.p_cylinder = p->get<float>();
+    const auto* c = field(j, "cylinder");
+    if (c && c->is_object()) {
       o.fitted = true;
-      o.cylinder.point_on_axis = jsonVector(c->get("point_on_axis"));
-      o.cylinder.axis = jsonVector(c->get("axis")).normalized();
-      o.cylinder.radius = static_cast<float>(c->get("radius") ? c->get("radius")->number : 0.0);
-      o.cylinder.height = static_cast<float>(c->get("height") ? c->get("height")->number : 0.0);
-      if (c->get("base") && c->get("top")) { // facyl_detect's JSON since 0.1: the extent
-        o.cylinder.base = jsonVector(c->get("base"));
-        o.cylinder.top = jsonVector(c->get("top"));
+      o.cylinder.point_on_axis = vectorOf(field(*c, "point_on_axis"));
+      o.cylinder.axis = vectorOf(field(*c, "axis")).normalized();
+      o.cylinder.radius = static_cast<float>(numberOr(field(*c, "radius"), 0.0));
+      o.cylinder.height = static_cast<float>(numberOr(field(*c, "height"), 0.0));
+      if (field(*c, "base") && field(*c, "top")) { // facyl_detect's JSON since 0.1: the extent
+        o.cylinder.base = vectorOf(field(*c, "base"));
+        o.cylinder.top = vectorOf(field(*c, "top"));
       }
       else {
         o.cylinder.base = o.cylinder.point_on_axis;
@@ -266,13 +284,13 @@ objectsFromJson(const facyl_cli::JsonValue& line, Scene& scene)
 }
 
 /** The lines of a --detections file, by "file" (and in order). */
-std::vector<facyl_cli::JsonValue>
+std::vector<Json>
 readDetections(const std::string& path)
 {
   std::ifstream in(path);
   if (!in)
     throw std::invalid_argument("--detections: cannot read " + path);
-  std::vector<facyl_cli::JsonValue> lines;
+  std::vector<Json> lines;
   std::string text;
   int number = 0;
   while (std::getline(in, text)) {
@@ -280,9 +298,9 @@ readDetections(const std::string& path)
     if (text.find_first_not_of(" \t\r") == std::string::npos)
       continue;
     try {
-      lines.push_back(facyl_cli::JsonReader::parse(text));
+      lines.push_back(Json::parse(text));
     }
-    catch (const std::invalid_argument& e) {
+    catch (const Json::parse_error& e) {
       throw std::invalid_argument("--detections: " + path + " line " + std::to_string(number) +
                                   ": " + e.what());
     }
@@ -290,11 +308,11 @@ readDetections(const std::string& path)
   return lines;
 }
 
-const facyl_cli::JsonValue*
-detectionFor(const std::vector<facyl_cli::JsonValue>& lines, const std::string& file, std::size_t k)
+const Json*
+detectionFor(const std::vector<Json>& lines, const std::string& file, std::size_t k)
 {
   for (const auto& l : lines)
-    if (const auto* f = l.get("file"); f && f->text == file)
+    if (const auto* f = field(l, "file"); f && f->is_string() && f->get<std::string>() == file)
       return &l;
   return k < lines.size() ? &lines[k] : nullptr;
 }
@@ -641,7 +659,7 @@ private:
       detectObjects(s_, scene);
     return scene;
   }
-  const std::vector<facyl_cli::JsonValue>& detections_() const
+  const std::vector<Json>& detections_() const
   {
     if (!lines_loaded_) {
       lines_ = readDetections(s_.detections);
@@ -739,7 +757,7 @@ private:
   Scene scene_;
   Layers layers_;
   std::size_t current_{0}, focus_{0};
-  mutable std::vector<facyl_cli::JsonValue> lines_;
+  mutable std::vector<Json> lines_;
   mutable bool lines_loaded_{false};
 };
 
@@ -829,20 +847,25 @@ std::string
 streamLine(std::size_t frame, const std::string& file, const facyl::CylinderTracker* tracker,
            std::size_t objects, const std::string& error = {})
 {
-  std::string out = "{\"frame\":" + std::to_string(frame) + ",\"file\":" + facyl_cli::quote(file);
-  if (!error.empty())
-    return out + ",\"error\":" + facyl_cli::quote(error) + "}";
-  out += ",\"objects\":" + std::to_string(objects) + ",\"tracks\":[";
-  bool first = true;
-  for (const auto& t : tracker->getTracks()) {
-    out += std::string(first ? "" : ",") + "{\"track_id\":" + std::to_string(t.id) +
-           ",\"confirmed\":" + (t.confirmed ? "true" : "false") +
-           ",\"is_cylinder\":" + (tracker->isCylinder(t) ? "true" : "false") + ",\"status\":\"" +
-           facyl::toString(t.status) +
-           "\",\"object\":" + (t.object >= 0 ? std::to_string(t.object) : "null") + "}";
-    first = false;
+  Json out;
+  out["frame"] = frame;
+  out["file"] = file;
+  if (!error.empty()) {
+    out["error"] = error;
+    return facyl_cli::dumpJson(out);
   }
-  return out + "]}";
+  out["objects"] = objects;
+  out["tracks"] = Json::array();
+  for (const auto& t : tracker->getTracks()) {
+    Json j;
+    j["track_id"] = t.id;
+    j["confirmed"] = t.confirmed;
+    j["is_cylinder"] = tracker->isCylinder(t);
+    j["status"] = facyl::toString(t.status);
+    j["object"] = t.object >= 0 ? Json(t.object) : Json(nullptr);
+    out["tracks"].push_back(std::move(j));
+  }
+  return facyl_cli::dumpJson(out);
 }
 
 /** --stream: frames from a grabber, recognized and tracked, drawn as they come. */
@@ -937,9 +960,11 @@ runStream(const Settings& s)
   if (!s.screenshot.empty()) {
     viewer.spinOnce(1, true);
     viewer.saveScreenshot(s.screenshot);
-    std::printf("{\"stream\":%s,\"frames\":%zu,\"screenshot\":%s}\n",
-                facyl_cli::quote(s.stream).c_str(), processed,
-                facyl_cli::quote(s.screenshot).c_str());
+    Json line;
+    line["stream"] = s.stream;
+    line["frames"] = processed;
+    line["screenshot"] = s.screenshot;
+    std::printf("%s\n", facyl_cli::dumpJson(line).c_str());
     return 0;
   }
   while (!viewer.wasStopped()) { // the last frame stays on screen
@@ -1057,8 +1082,10 @@ main(int argc, char** argv)
       if (!viewer.show(0))
         return 1;
       viewer.screenshot(s.screenshot);
-      std::printf("{\"file\":%s,\"screenshot\":%s}\n", facyl_cli::quote(s.files[0]).c_str(),
-                  facyl_cli::quote(s.screenshot).c_str());
+      Json line;
+      line["file"] = s.files[0];
+      line["screenshot"] = s.screenshot;
+      std::printf("%s\n", facyl_cli::dumpJson(line).c_str());
       return 0;
     }
     bool any = false;

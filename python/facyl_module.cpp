@@ -469,7 +469,7 @@ detect(const py::object& points, const py::object& colors,
   // facyl_detect's JSON, parsed: the same fields with the same meanings (9 digits: floats
   // exactly).
   py::dict out = py::module_::import("json").attr("loads")(
-    facyl_cli::sceneJson("", *cloud, rec, objects, rec.getTiming(), 9) + "}");
+    facyl_cli::dumpJson(facyl_cli::sceneJson("", *cloud, rec, objects, rec.getTiming(), 9)));
   py::list list = out["objects"];
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const auto& idx = objects[i].cluster.indices.indices;
@@ -560,9 +560,8 @@ public:
       ok = rec_.recognize(objects);
       if (ok) {
         tracker_.update(rec_, objects);
-        json =
-          facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9) +
-          "}";
+        json = facyl_cli::dumpJson(
+          facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9));
         for (const auto& o : objects) {
           sizes.push_back(o.cluster.indices.indices.size());
           flat.insert(flat.end(), o.cluster.indices.indices.begin(),
@@ -606,7 +605,9 @@ public:
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
-      json = "{" + facyl_cli::streamJson(tracker_, nullptr, 9).substr(1) + "}";
+      facyl_cli::Json frame = facyl_cli::Json::object();
+      facyl_cli::addStreamFields(frame, tracker_, nullptr, 9);
+      json = facyl_cli::dumpJson(frame);
     }
     return py::module_::import("json").attr("loads")(json)["tracks"];
   }

@@ -4,7 +4,8 @@ set -euo pipefail
 packages=(g++ make cmake git pkg-config libpcl-dev libeigen3-dev libnanoflann-dev
           libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib
           libopencv-dnn-dev python3-numpy python3-torch python3-onnx python3-opencv
-          python3-dev pybind11-dev python3-pytest python3-open3d xvfb xauth clang-format)
+          python3-dev pybind11-dev python3-pytest python3-open3d xvfb xauth clang-format
+          nlohmann-json3-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -5,6 +5,8 @@
  */
 #include "test_helpers.h"
 #include <facyl/tools/cli.h>
+#include <facyl/tools/detect_json.h>
+#include <facyl/tools/json_writer.h>
 
 #include <facyl/features/parallel.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
@@ -62,21 +64,13 @@ crop(const Cloud& in, int u0, int v0, int w, int h)
   return out;
 }
 
-/** Every field the JSON of facyl_detect reports, to compare runs bit for bit. */
+/** Every field the JSON of facyl_detect reports (but the timing), to compare runs bit for bit. */
 std::string
 fingerprint(const std::vector<facyl::RecognizedObject>& objects)
 {
   std::string s;
-  for (const auto& o : objects) {
-    s += std::to_string(o.cluster.indices.indices.size()) + " " + std::to_string(o.is_cylinder) +
-         " " + facyl_cli::vector(o.cluster.centroid) + " " +
-         facyl_cli::number(o.evidence.surface_ratio) + " " +
-         facyl_cli::number(o.evidence.inlier_ratio);
-    if (o.evidence.fitted)
-      s += " " + facyl_cli::vector(o.cylinder.point_on_axis) + facyl_cli::vector(o.cylinder.axis) +
-           facyl_cli::number(o.cylinder.radius) + facyl_cli::number(o.cylinder.height);
-    s += "\n";
-  }
+  for (std::size_t k = 0; k < objects.size(); ++k)
+    s += facyl_cli::dumpJson(facyl_cli::objectJson(k, objects[k])) + "\n";
   return s;
 }
 
@@ -376,9 +370,14 @@ TEST(Reliability, IntegerOptionsNeitherWrapNorSaturate)
   EXPECT_THROW(parse({"--n", "1e3"}, 0, 10000), std::invalid_argument);
   EXPECT_EQ(parse({"--n", "-3"}, -5, 5), -3);
   // JSON strings stay valid UTF-8 whatever bytes a file name or a corrupt header holds.
-  EXPECT_EQ(facyl_cli::quote("a\xff"
-                             "b"),
+  EXPECT_EQ(facyl_cli::dumpJson(facyl_cli::Json("a\xff"
+                                                "b")),
             "\"a\xef\xbf\xbd"
             "b\"");
-  EXPECT_EQ(facyl_cli::quote("\xc3\xa9"), "\"\xc3\xa9\"");
+  EXPECT_EQ(facyl_cli::dumpJson(facyl_cli::Json("\xc3\xa9")), "\"\xc3\xa9\"");
+  // Numbers read as %g writes them: 6 significant digits, integral ones without a point.
+  EXPECT_EQ(facyl_cli::dumpJson(facyl_cli::Json::array(
+              {facyl_cli::jsonNumber(0.0362165123), facyl_cli::jsonNumber(3.0),
+               facyl_cli::jsonNumber(1.5e-5), facyl_cli::jsonNumber(NAN)})),
+            "[0.0362165,3,1.5e-05,null]");
 }

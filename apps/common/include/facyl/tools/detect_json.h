@@ -1,68 +1,63 @@
 /*
  * facyl: the tabletop recognizer's result as JSON, written by facyl_detect (one line per
  * scene) and returned by the Python module's detect() (the same fields, parsed): one
- * vocabulary for both.
+ * vocabulary for both, one writer (json_writer.h).
  */
 #pragma once
 
-#include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_json.h>
+#include <facyl/tools/json_writer.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <vector>
 
 namespace facyl_cli {
 
 /** One object: id, support (index into "supports"; -1: none under it), centroid, n_points,
- * bbox (pixels; null without), the decision's evidence and "cylinder" (cylinderJson, null when
- * not fitted). */
-inline std::string
+ * bbox (pixels; null without), the decision's evidence and "cylinder" (cylinderObject, null
+ * when not fitted). */
+inline Json
 objectJson(std::size_t id, const facyl::RecognizedObject& o, int digits = 6)
 {
   const auto& b = o.cluster.box;
   const auto& e = o.evidence;
-  const auto num = [digits](float v) { return number(v, digits); };
-  std::ostringstream out;
-  out << "{\"id\":" << id << ",\"support\":" << o.cluster.support
-      << ",\"centroid\":" << vector(o.cluster.centroid, digits)
-      << ",\"n_points\":" << o.cluster.indices.indices.size() << ",\"bbox\":";
-  if (b[0] < 0)
-    out << "null";
-  else
-    out << "[" << b[0] << "," << b[1] << "," << b[2] << "," << b[3] << "]";
-  out << ",\"p_cylinder\":" << num(e.p_cylinder) << ",\"p_network\":" << num(e.p_network)
-      << ",\"inlier_ratio\":" << num(e.inlier_ratio)
-      << ",\"surface_ratio\":" << num(e.surface_ratio)
-      << ",\"curvature_ratio\":" << num(e.curvature_ratio)
-      << ",\"angular_coverage\":" << num(e.angular_coverage) << ",\"taper\":" << num(e.taper)
-      << ",\"arc_gap\":" << num(e.arc_gap)
-      << ",\"is_cylinder\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder\":";
-  if (e.fitted)
-    out << cylinderJson(o.cylinder, false, digits);
-  else
-    out << "null";
-  out << "}";
-  return out.str();
+  const auto num = [digits](float v) { return jsonNumber(v, digits); };
+  Json j;
+  j["id"] = id;
+  j["support"] = o.cluster.support;
+  j["centroid"] = jsonVector(o.cluster.centroid, digits);
+  j["n_points"] = o.cluster.indices.indices.size();
+  j["bbox"] = b[0] < 0 ? Json(nullptr) : Json::array({b[0], b[1], b[2], b[3]});
+  j["p_cylinder"] = num(e.p_cylinder);
+  j["p_network"] = num(e.p_network);
+  j["inlier_ratio"] = num(e.inlier_ratio);
+  j["surface_ratio"] = num(e.surface_ratio);
+  j["curvature_ratio"] = num(e.curvature_ratio);
+  j["angular_coverage"] = num(e.angular_coverage);
+  j["taper"] = num(e.taper);
+  j["arc_gap"] = num(e.arc_gap);
+  j["is_cylinder"] = o.is_cylinder;
+  j["cylinder"] = e.fitted ? cylinderObject(o.cylinder, false, digits) : Json(nullptr);
+  return j;
 }
 
-inline std::string
+/** The plane a x + b y + c z + d = 0 as [a, b, c, d]. */
+inline Json
 planeJson(const Eigen::Vector4f& c, int digits)
 {
-  return "[" + number(c[0], digits) + "," + number(c[1], digits) + "," + number(c[2], digits) +
-         "," + number(c[3], digits) + "]";
+  return Json::array({jsonNumber(c[0], digits), jsonNumber(c[1], digits), jsonNumber(c[2], digits),
+                      jsonNumber(c[3], digits)});
 }
 
-/** The scene's JSON object without its closing brace (more fields may follow): "file" (when
- * \a file is not empty), "organized", "table" {"coefficients": a,b,c,d of the table plane in
- * the cloud's frame, unit normal towards the sensor, or null; "found"}, "supports",
- * "objects", "timing_ms". */
+/** The scene's JSON object: "file" (when \a file is not empty), "organized", "table"
+ * {"coefficients": a,b,c,d of the table plane in the cloud's frame, unit normal towards the
+ * sensor, or null; "found"}, "supports", "objects", "timing_ms"; more fields may be added. */
 template <typename PointT>
-std::string
+Json
 sceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
           const facyl::TabletopCylinderRecognizer<PointT>& rec,
           const std::vector<facyl::RecognizedObject>& objects, const facyl::RecognitionTiming& t,
@@ -70,31 +65,32 @@ sceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
 {
   const auto& supports = rec.getSupports();
   const auto& tc = rec.getTableCoefficients().values;
-  std::ostringstream out;
-  out << "{";
+  Json j;
   if (!file.empty())
-    out << "\"file\":" << quote(file) << ",";
-  out << "\"organized\":" << (cloud.isOrganized() ? "true" : "false")
-      << ",\"table\":{\"coefficients\":"
-      << (tc.size() == 4 ? planeJson(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3]), digits)
-                         : std::string("null"))
-      << ",\"found\":" << (rec.tableFound() ? "true" : "false") << "},\"supports\":[";
+    j["file"] = file;
+  j["organized"] = cloud.isOrganized();
+  j["table"]["coefficients"] =
+    tc.size() == 4 ? planeJson(Eigen::Vector4f(tc[0], tc[1], tc[2], tc[3]), digits) : Json(nullptr);
+  j["table"]["found"] = rec.tableFound();
+  j["supports"] = Json::array();
   for (std::size_t k = 0; k < supports.size(); ++k) {
     // The objects reported on it (the recognizer joins and splits the segmentation's clusters).
     const auto on = std::count_if(objects.begin(), objects.end(), [k](const auto& o) {
       return o.cluster.support == static_cast<int>(k);
     });
-    out << (k ? "," : "") << "{\"coefficients\":" << planeJson(supports[k].plane, digits)
-        << ",\"objects\":" << on << "}";
+    Json support;
+    support["coefficients"] = planeJson(supports[k].plane, digits);
+    support["objects"] = on;
+    j["supports"].push_back(std::move(support));
   }
-  out << "],\"objects\":[";
+  j["objects"] = Json::array();
   for (std::size_t k = 0; k < objects.size(); ++k)
-    out << (k ? "," : "") << objectJson(k, objects[k], digits);
-  out << "],\"timing_ms\":{\"segmentation\":" << number(t.segmentation, digits)
-      << ",\"classification\":" << number(t.classification, digits)
-      << ",\"fitting\":" << number(t.fitting, digits) << ",\"total\":" << number(t.total, digits)
-      << "}";
-  return out.str();
+    j["objects"].push_back(objectJson(k, objects[k], digits));
+  j["timing_ms"]["segmentation"] = jsonNumber(t.segmentation, digits);
+  j["timing_ms"]["classification"] = jsonNumber(t.classification, digits);
+  j["timing_ms"]["fitting"] = jsonNumber(t.fitting, digits);
+  j["timing_ms"]["total"] = jsonNumber(t.total, digits);
+  return j;
 }
 
 } // namespace facyl_cli

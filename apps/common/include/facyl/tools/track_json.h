@@ -6,13 +6,12 @@
  */
 #pragma once
 
-#include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_json.h>
 #include <facyl/tools/detect_json.h>
+#include <facyl/tools/json_writer.h>
 
 #include <facyl/tracking/cylinder_tracker.h>
 
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -38,15 +37,18 @@ trackedCylinder(const facyl::CylinderTracker& tracker, const facyl::CylinderTrac
 }
 
 /** "track":{...}: the track's state. */
-inline std::string
+inline Json
 trackStateJson(const facyl::CylinderTracker& tracker, const facyl::CylinderTrack& t, int digits)
 {
-  std::ostringstream out;
-  out << "{\"confirmed\":" << (t.confirmed ? "true" : "false") << ",\"status\":\""
-      << facyl::toString(t.status) << "\",\"age\":" << t.age << ",\"hits\":" << t.hits
-      << ",\"misses\":" << t.misses << ",\"p_cylinder\":" << number(t.pCylinder(), digits)
-      << ",\"is_cylinder\":" << (tracker.isCylinder(t) ? "true" : "false") << "}";
-  return out.str();
+  Json j;
+  j["confirmed"] = t.confirmed;
+  j["status"] = facyl::toString(t.status);
+  j["age"] = t.age;
+  j["hits"] = t.hits;
+  j["misses"] = t.misses;
+  j["p_cylinder"] = jsonNumber(t.pCylinder(), digits);
+  j["is_cylinder"] = tracker.isCylinder(t);
+  return j;
 }
 
 /** The object as the tracked frame shows it: "is_cylinder" the track's decision (a confirmed
@@ -70,66 +72,65 @@ trackedView(const facyl::RecognizedObject& o, const facyl::TrackAssignment& a,
   return shown;
 }
 
-/** The fields a tracked object adds after objectJson's (of trackedView): "is_cylinder_frame"
- * and "cylinder_frame" (the frame's own decision and fit), "track_id" (null for an object the
- * tracker could not use), "role" (matched, started, fragment: a piece of an object matched in
- * the same frame; ignored), "merged" (ids of tracks whose place lies inside this object) and
- * "track" (trackStateJson). */
-inline std::string
-trackFieldsJson(const facyl::RecognizedObject& o, const facyl::TrackAssignment& a,
-                const facyl::CylinderTracker& tracker, int digits = 6)
+/** The fields a tracked object adds to \a object (objectJson of trackedView):
+ * "is_cylinder_frame" and "cylinder_frame" (the frame's own decision and fit), "track_id" (null
+ * for an object the tracker could not use), "role" (matched, started, fragment: a piece of an
+ * object matched in the same frame; ignored), "merged" (ids of tracks whose place lies inside
+ * this object) and "track" (trackStateJson). */
+inline void
+addTrackFields(Json& object, const facyl::RecognizedObject& o, const facyl::TrackAssignment& a,
+               const facyl::CylinderTracker& tracker, int digits = 6)
 {
   const facyl::CylinderTrack* t = tracker.findTrack(a.track_id);
-  std::ostringstream out;
-  out << ",\"is_cylinder_frame\":" << (o.is_cylinder ? "true" : "false") << ",\"cylinder_frame\":"
-      << (o.evidence.fitted ? cylinderJson(o.cylinder, false, digits) : std::string("null"))
-      << ",\"track_id\":" << (a.track_id >= 0 ? std::to_string(a.track_id) : "null")
-      << ",\"role\":\"" << facyl::toString(a.role) << "\",\"merged\":[";
-  for (std::size_t k = 0; k < a.merged.size(); ++k)
-    out << (k ? "," : "") << a.merged[k];
-  out << "],\"track\":" << (t ? trackStateJson(tracker, *t, digits) : std::string("null"));
-  return out.str();
+  object["is_cylinder_frame"] = o.is_cylinder;
+  object["cylinder_frame"] =
+    o.evidence.fitted ? cylinderObject(o.cylinder, false, digits) : Json(nullptr);
+  object["track_id"] = a.track_id >= 0 ? Json(a.track_id) : Json(nullptr);
+  object["role"] = facyl::toString(a.role);
+  object["merged"] = a.merged;
+  object["track"] = t ? trackStateJson(tracker, *t, digits) : Json(nullptr);
 }
 
-/** ,"stream":{frame, scene, anchored, new_scene, skipped, registered},"tracks":[...]: where the
- * frame was and every live track (tentative ones too), each with "track_id", its state, the
- * object of this frame it was matched to (null: none), "merged_into", "centroid" and
- * "cylinder" (the tracked estimate in this frame, null without). */
-inline std::string
-streamJson(const facyl::CylinderTracker& tracker,
-           const std::vector<facyl::RecognizedObject>* objects, int digits = 6)
+/** Adds "stream":{frame, scene, anchored, new_scene, skipped, registered} and "tracks":[...] to
+ * \a frame: where the frame was and every live track (tentative ones too), each with
+ * "track_id", its state, the object of this frame it was matched to (null: none),
+ * "merged_into", "centroid" and "cylinder" (the tracked estimate in this frame, null
+ * without). */
+inline void
+addStreamFields(Json& frame, const facyl::CylinderTracker& tracker,
+                const std::vector<facyl::RecognizedObject>* objects, int digits = 6)
 {
   const auto& info = tracker.getFrameInfo();
-  std::ostringstream out;
-  out << ",\"stream\":{\"frame\":" << info.frame - 1 << ",\"scene\":" << info.scene
-      << ",\"anchored\":" << (info.anchored ? "true" : "false")
-      << ",\"new_scene\":" << (info.new_scene ? "true" : "false")
-      << ",\"skipped\":" << (info.skipped ? "true" : "false")
-      << ",\"registered\":" << info.registered << "},\"tracks\":[";
-  bool first = true;
+  Json& stream = frame["stream"];
+  stream["frame"] = info.frame - 1;
+  stream["scene"] = info.scene;
+  stream["anchored"] = info.anchored;
+  stream["new_scene"] = info.new_scene;
+  stream["skipped"] = info.skipped;
+  stream["registered"] = info.registered;
+  Json& tracks = frame["tracks"] = Json::array();
   for (const auto& t : tracker.getTracks()) {
     const facyl::RecognizedObject* seen =
       objects && t.object >= 0 && static_cast<std::size_t>(t.object) < objects->size()
         ? &(*objects)[static_cast<std::size_t>(t.object)]
         : nullptr;
-    out << (first ? "" : ",") << "{\"track_id\":" << t.id
-        << ",\"object\":" << (t.object >= 0 ? std::to_string(t.object) : "null")
-        << ",\"merged_into\":" << (t.merged_into >= 0 ? std::to_string(t.merged_into) : "null")
-        << ",\"state\":" << trackStateJson(tracker, t, digits)
-        << ",\"centroid\":" << vector(tracker.centroidInFrame(t), digits) << ",\"cylinder\":"
-        << (t.has_cylinder ? cylinderJson(trackedCylinder(tracker, t, seen), false, digits)
-                           : std::string("null"))
-        << "}";
-    first = false;
+    Json j;
+    j["track_id"] = t.id;
+    j["object"] = t.object >= 0 ? Json(t.object) : Json(nullptr);
+    j["merged_into"] = t.merged_into >= 0 ? Json(t.merged_into) : Json(nullptr);
+    j["state"] = trackStateJson(tracker, t, digits);
+    j["centroid"] = jsonVector(tracker.centroidInFrame(t), digits);
+    j["cylinder"] = t.has_cylinder
+                      ? cylinderObject(trackedCylinder(tracker, t, seen), false, digits)
+                      : Json(nullptr);
+    tracks.push_back(std::move(j));
   }
-  out << "]";
-  return out.str();
 }
 
-/** The tracked frame's JSON object without its closing brace: sceneJson's fields of the
- * objects as trackedView shows them, each with trackFieldsJson's fields, then streamJson. */
+/** The tracked frame's JSON object: sceneJson of the objects as trackedView shows them, each
+ * with addTrackFields' fields, then addStreamFields'. */
 template <typename PointT>
-std::string
+Json
 trackedSceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
                  const facyl::TabletopCylinderRecognizer<PointT>& rec,
                  const std::vector<facyl::RecognizedObject>& objects,
@@ -137,27 +138,18 @@ trackedSceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
                  int digits = 6)
 {
   const auto& assignments = tracker.getAssignments();
+  const auto assignment = [&](std::size_t k) {
+    return k < assignments.size() ? assignments[k] : facyl::TrackAssignment{};
+  };
   std::vector<facyl::RecognizedObject> shown;
   shown.reserve(objects.size());
   for (std::size_t k = 0; k < objects.size(); ++k)
-    shown.push_back(trackedView(
-      objects[k], k < assignments.size() ? assignments[k] : facyl::TrackAssignment{}, tracker));
-  // One writer for the scene's fields (sceneJson); each object's text, exactly as it wrote it,
-  // gets the tracking fields before its closing brace.
-  std::string scene = sceneJson(file, cloud, rec, shown, timing, digits);
-  std::size_t from = scene.find("\"objects\":[");
-  for (std::size_t k = 0; k < objects.size() && from != std::string::npos; ++k) {
-    const std::string text = objectJson(k, shown[k], digits);
-    const std::size_t at = scene.find(text, from);
-    if (at == std::string::npos)
-      break;
-    const std::string extra = trackFieldsJson(
-      objects[k], k < assignments.size() ? assignments[k] : facyl::TrackAssignment{}, tracker,
-      digits);
-    scene.insert(at + text.size() - 1, extra);
-    from = at + text.size() + extra.size();
-  }
-  return scene + streamJson(tracker, &objects, digits);
+    shown.push_back(trackedView(objects[k], assignment(k), tracker));
+  Json scene = sceneJson(file, cloud, rec, shown, timing, digits);
+  for (std::size_t k = 0; k < objects.size(); ++k)
+    addTrackFields(scene["objects"][k], objects[k], assignment(k), tracker, digits);
+  addStreamFields(scene, tracker, &objects, digits);
+  return scene;
 }
 
 } // namespace facyl_cli
