@@ -7,6 +7,6 @@
 #include <pcl/impl/instantiate.hpp>
 
 FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointXYZ, facyl::NormalCurvature)
-  FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointXYZRGB, facyl::NormalCurvature)
-    FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointXYZRGBA, facyl::NormalCurvature)
-      FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointNormal, facyl::NormalCurvature)
+FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointXYZRGB, facyl::NormalCurvature)
+FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointXYZRGBA, facyl::NormalCurvature)
+FACYL_INSTANTIATE_NormalCurvatureEstimation(pcl::PointNormal, facyl::NormalCurvature)

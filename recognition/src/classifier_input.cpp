@@ -170,5 +170,6 @@ classifierImage(const ObjectView& view, const ClassifierInputSpec& spec)
 
 } // namespace facyl
 
-FACYL_INSTANTIATE_objectView(pcl::PointXYZ) FACYL_INSTANTIATE_objectView(pcl::PointXYZRGB)
-  FACYL_INSTANTIATE_objectView(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_objectView(pcl::PointXYZ)
+FACYL_INSTANTIATE_objectView(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_objectView(pcl::PointXYZRGBA)

@@ -83,5 +83,5 @@ pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride)
 } // namespace facyl
 
 FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZ)
-  FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGB)
-    FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZRGBA)

@@ -6,8 +6,8 @@
 
 #define FACYL_HOUGH_FOR_NORMALS(T)                                                                 \
   FACYL_INSTANTIATE_HoughCylinderEstimation(T, pcl::Normal)                                        \
-    FACYL_INSTANTIATE_HoughCylinderEstimation(T, pcl::PointNormal)                                 \
-      FACYL_INSTANTIATE_HoughCylinderEstimation(T, facyl::NormalCurvature)
+  FACYL_INSTANTIATE_HoughCylinderEstimation(T, pcl::PointNormal)                                   \
+  FACYL_INSTANTIATE_HoughCylinderEstimation(T, facyl::NormalCurvature)
 
 FACYL_HOUGH_FOR_NORMALS(pcl::PointXYZ)
 FACYL_HOUGH_FOR_NORMALS(pcl::PointXYZRGB)

@@ -52,5 +52,5 @@ validate(const TabletopSegmentationParameters& p)
 } // namespace facyl
 
 FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZ)
-  FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGB)
-    FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_TabletopSegmentation(pcl::PointXYZRGBA)

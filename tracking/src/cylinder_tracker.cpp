@@ -979,5 +979,6 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
 
 } // namespace facyl
 
-FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZ) FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGB)
-  FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGBA)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZ)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGB)
+FACYL_INSTANTIATE_trackerViewOf(pcl::PointXYZRGBA)

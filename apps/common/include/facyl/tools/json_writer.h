@@ -40,8 +40,8 @@ jsonNumber(double v, int digits = 6)
 inline Json
 jsonVector(const Eigen::Vector3f& v, int digits = 6)
 {
-  return Json::array({jsonNumber(v.x(), digits), jsonNumber(v.y(), digits),
-                      jsonNumber(v.z(), digits)});
+  return Json::array(
+    {jsonNumber(v.x(), digits), jsonNumber(v.y(), digits), jsonNumber(v.z(), digits)});
 }
 
 /** \a j as one compact line; bytes of strings that are not UTF-8 (a corrupt file's name)
