@@ -52,7 +52,7 @@ main(int argc, char** argv)
   facyl::CylinderSimulationParameters p;
   std::string out;
   bool normals = false;
-  const int rc = facyl_cli::startTool(argc, argv, "facyl_simulate", printHelp, [&] {
+  const int status = facyl_cli::startTool(argc, argv, "facyl_simulate", printHelp, [&] {
     const facyl_cli::Arguments args(argc, argv,
                                     {"--radius", "--height", "--axis", "--base", "--points",
                                      "--lids", "--noise", "--occlusion", "--seed"},
@@ -78,8 +78,8 @@ main(int argc, char** argv)
     if (!why.empty())
       throw std::invalid_argument(why);
   });
-  if (rc >= 0)
-    return rc;
+  if (status >= 0)
+    return status;
   const auto sim = facyl::simulateCylinder(p);
   int rc;
   if (normals)
