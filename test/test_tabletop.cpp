@@ -5,6 +5,7 @@
 
 #include <facyl/features/polygon.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/plane_search.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 #include <facyl/simulation/tabletop_scene.h>
 
@@ -194,6 +195,62 @@ TEST(TabletopGeometry, EvenSubsampleAndCapPoints)
 }
 
 // ---------------------------------------------------------------- simulator
+
+TEST(PlaneSearch, GridAndSeedsOfAPlane)
+{
+  // A 160 x 120 frame of a plane z = 1 (a few pixels without depth): the grid of 4-pixel blocks
+  // holds the block means, and one seed region covers most of the cells.
+  pcl::PointCloud<pcl::PointXYZ> frame(160, 120);
+  facyl::BlockMeans blocks(4, 160, 120);
+  for (int v = 0; v < 120; ++v)
+    for (int u = 0; u < 160; ++u) {
+      const Eigen::Vector3f p((u - 80) / 160.f, (v - 60) / 160.f, 1.f);
+      if ((u * 7 + v * 13) % 50 != 0)
+        blocks.add(u, v, v * 160 + u, p);
+    }
+  facyl::PlaneGrid grid;
+  facyl::finishPlaneGrid(blocks, 160, grid);
+  ASSERT_EQ(grid.small->width, 40u);
+  ASSERT_EQ(grid.small->height, 30u);
+  EXPECT_NEAR((*grid.small)(10, 10).z, 1.f, 1e-6f);
+  EXPECT_TRUE(grid.samples.col(0).allFinite());
+  const auto seeds = facyl::planeSeeds(grid, 1000, 0.05f, 0.015f);
+  ASSERT_FALSE(seeds.empty());
+  EXPECT_GT(seeds.front().indices.size(), 40u * 30u * 8u / 10u);
+}
+
+TEST(PlaneSearch, FamiliesFacingUpComeFirst)
+{
+  // A wall (normal along the image's down direction: it faces the side) with more points than
+  // the table (normal against image down) and a floor parallel to the table.
+  const Eigen::Vector3f down(0.f, 1.f, 0.f);
+  const std::vector<Eigen::Vector4f> planes = {{0.f, 0.f, -1.f, 3.f},   // wall, facing the camera
+                                               {0.f, -1.f, 0.f, 0.5f},  // table
+                                               {0.f, -1.f, 0.f, 1.2f}}; // floor
+  const std::vector<std::size_t> points = {50000, 20000, 10000};
+  const auto families = facyl::rankSupportFamilies(planes, points, false, down);
+  ASSERT_EQ(families.size(), 2u);
+  EXPECT_EQ(families[0], (std::vector<std::size_t>{1, 2}));
+  EXPECT_EQ(families[1], (std::vector<std::size_t>{0}));
+  // With a known up every family may be a support: most points first.
+  EXPECT_EQ(facyl::rankSupportFamilies(planes, points, true, down)[0],
+            (std::vector<std::size_t>{0}));
+}
+
+TEST(PlaneSearch, VoxelEuclideanClusters)
+{
+  // Two blobs 10 cm apart, 2 cm tolerance: two clusters, the larger first, every point in one.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 0.03f);
+  Eigen::Matrix3Xf points(3, 300);
+  for (int k = 0; k < 300; ++k)
+    points.col(k) = Eigen::Vector3f(u(rng) + (k < 100 ? 0.13f : 0.f), u(rng), u(rng) + 1.f);
+  const auto groups = facyl::voxelEuclideanClusters(points, 0.02f);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].size(), 200u);
+  EXPECT_EQ(groups[1].size(), 100u);
+  EXPECT_EQ(groups[1].front(), 0u);
+}
 
 TEST(TabletopScene, DeterministicAndConsistentWithItsGroundTruth)
 {

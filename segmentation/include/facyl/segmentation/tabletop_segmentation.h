@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/segmentation/object_segmentation.h>
+#include <facyl/segmentation/plane_search.h>
 #include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 
@@ -21,10 +22,6 @@
 #include <vector>
 
 namespace facyl {
-
-namespace detail {
-struct BlockMeans;
-} // namespace detail
 
 /** \brief Settings of TabletopSegmentation (lengths in cloud units, metres for sensors). */
 struct TabletopSegmentationParameters {
@@ -368,28 +365,18 @@ private:
   bool searchedAsImage() const;
   /** segment() on a cloud in the sensor's frame (identity sensor pose). */
   bool segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
-  /** The plane-search grid of an organized input at one block size. */
-  struct PlaneGrid {
-    int step{1};                                   ///< block size (pixels)
-    pcl::PointCloud<pcl::PointXYZ>::Ptr small;     ///< the cells, organized
-    std::vector<pcl::index_t> source;              ///< each cell's first pixel (-1: none)
-    pcl::PointCloud<pcl::Normal>::Ptr normals;     ///< the cells' normals
-    Eigen::Matrix3Xf cells, cell_normals, samples; ///< as columns; samples: the first pixels
-  };
   /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
    * depth near the first one's, its normal, and its first pixel; with \a twice, also the grid
    * of 2 \a step pixels, from the same pass over the image. */
   void planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice = nullptr) const;
-  /** \a grid from the block means of one step (normals, columns); empties \a blocks. */
-  void finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const;
-  /** The seed regions of the plane search on \a grid (cells), largest first. */
-  std::vector<pcl::PointIndices> planeSeeds(const PlaneGrid& grid) const;
   void findPlanesOrganized(std::vector<Candidate>& candidates);
   /** Grows \a seeds of \a grid into candidates (growCandidate), skipping the seeds mostly on
    * the cells of \a candidates found before; appends them. */
   void growCandidates(const PlaneGrid& grid, const std::vector<pcl::PointIndices>& seeds,
                       std::vector<Candidate>& candidates) const;
   void findPlanesUnorganized(std::vector<Candidate>& candidates);
+  /** The seed threshold of the plane search: plane_distance, or kSeedDistance. */
+  float seedDistance() const;
   /** How seeds grow into planes: the band measured, or plane_distance. */
   PlaneRegionSettings regionSettings() const;
   /** Grows \a seed (cells of \a cells) into a candidate; cells already \a taken by earlier

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/features/polygon.h>
+#include <facyl/segmentation/plane_search.h>
 #include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 
@@ -11,17 +12,7 @@
 
 #include <pcl/common/io.h>
 #include <pcl/common/point_tests.h>
-#include <pcl/features/integral_image_normal.h>
-#include <pcl/features/normal_3d.h>
 #include <pcl/filters/random_sample.h>
-#include <pcl/sample_consensus/method_types.h>
-#include <pcl/sample_consensus/model_types.h>
-#include <pcl/search/kdtree.h>
-#include <pcl/segmentation/euclidean_cluster_comparator.h>
-#include <pcl/segmentation/extract_clusters.h>
-#include <pcl/segmentation/organized_connected_component_segmentation.h>
-#include <pcl/segmentation/organized_multi_plane_segmentation.h>
-#include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
 #include <chrono>
@@ -254,42 +245,6 @@ TabletopSegmentation<PointT>::regionSettings() const
   return s;
 }
 
-namespace detail {
-/** Means of the pixels of the blocks of one plane grid, filled pixel by pixel in row order:
- * each block's first pixel with depth, and the mean of those with depth near the first's. */
-struct BlockMeans {
-  BlockMeans(int step_, int w, int h)
-      : step(step_)
-      , cw(static_cast<std::size_t>((w + step_ - 1) / step_))
-      , ch(static_cast<std::size_t>((h + step_ - 1) / step_))
-      , sum(cw * ch, Eigen::Vector3f::Zero())
-      , first(cw * ch, 0.f)
-      , count(cw * ch, 0)
-      , source(cw * ch, -1)
-  {
-  }
-  void add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
-  {
-    const std::size_t k =
-      static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
-    if (count[k] == 0) {
-      first[k] = p.z();
-      source[k] = idx;
-    }
-    else if (std::abs(p.z() - first[k]) > 0.02f * std::abs(first[k]))
-      return;
-    sum[k] += p;
-    ++count[k];
-  }
-  int step;
-  std::size_t cw, ch;
-  std::vector<Eigen::Vector3f> sum;
-  std::vector<float> first;
-  std::vector<int> count;
-  std::vector<pcl::index_t> source;
-};
-} // namespace detail
-
 template <typename PointT>
 void
 TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* twice) const
@@ -307,8 +262,8 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
   // step^2 pixels is less so); the depth test keeps objects' edges sharp. One pass over the
   // image in row order (a block's first pixel in row order is its first valid one) fills the
   // grid and, when asked, the one of twice the step.
-  detail::BlockMeans fine(step, w, h);
-  std::optional<detail::BlockMeans> coarse;
+  BlockMeans fine(step, w, h);
+  std::optional<BlockMeans> coarse;
   if (twice)
     coarse.emplace(2 * step, w, h);
   for (int v = 0; v < h; ++v) {
@@ -323,85 +278,9 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
         coarse->add(u, v, static_cast<pcl::index_t>(idx), p.getVector3fMap());
     }
   }
-  finishGrid(fine, grid);
+  finishPlaneGrid(fine, w, grid);
   if (twice)
-    finishGrid(*coarse, *twice);
-}
-
-template <typename PointT>
-void
-TabletopSegmentation<PointT>::finishGrid(detail::BlockMeans& blocks, PlaneGrid& grid) const
-{
-  const int step = blocks.step;
-  const int w = static_cast<int>(input_->width);
-  grid.step = step;
-  grid.small.reset(new pcl::PointCloud<pcl::PointXYZ>);
-  auto& small = *grid.small;
-  small.width = static_cast<std::uint32_t>(blocks.cw);
-  small.height = static_cast<std::uint32_t>(blocks.ch);
-  small.is_dense = false;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  small.points.assign(blocks.cw * blocks.ch, pcl::PointXYZ(nan, nan, nan));
-  for (std::size_t k = 0; k < small.size(); ++k)
-    if (blocks.count[k] > 0)
-      small[k].getVector3fMap() = blocks.sum[k] / static_cast<float>(blocks.count[k]);
-  grid.source = std::move(blocks.source);
-  const auto& source = grid.source;
-  // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
-  // (for the bands).
-  grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
-  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-  ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
-  // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
-  // to their angular spacing at other resolutions.
-  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f / static_cast<float>(w));
-  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
-  ne.setInputCloud(grid.small);
-  ne.compute(*grid.normals);
-  const auto n = static_cast<Eigen::Index>(small.size());
-  grid.cells.resize(3, n);
-  grid.cell_normals.resize(3, n);
-  grid.samples.resize(3, n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    grid.cells.col(k) = small[kk].getVector3fMap();
-    grid.cell_normals.col(k) = (*grid.normals)[kk].getNormalVector3fMap();
-    grid.samples.col(k) = source[kk] >= 0 ? Eigen::Vector3f((*input_)[source[kk]].getVector3fMap())
-                                          : Eigen::Vector3f::Constant(nan);
-  }
-}
-
-template <typename PointT>
-std::vector<pcl::PointIndices>
-TabletopSegmentation<PointT>::planeSeeds(const PlaneGrid& grid) const
-{
-  // pcl::OrganizedMultiPlaneSegmentation's regions, largest first. Its thresholds only make
-  // seeds (the band of each plane is measured afterwards); on a frame too noisy for any seed of
-  // the least plane size they are relaxed, twice at most.
-  const std::size_t cell = static_cast<std::size_t>(grid.step * grid.step);
-  const std::size_t min_cells = std::max<std::size_t>(10, params_.min_plane_points / cell / 4);
-  std::vector<pcl::PointIndices> inliers;
-  float relax = 1.f;
-  for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
-    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
-    mps.setMinInliers(static_cast<unsigned>(min_cells));
-    mps.setAngularThreshold(std::min(0.5f, relax * params_.plane_angle));
-    mps.setDistanceThreshold(
-      relax * (params_.plane_distance > 0.f ? params_.plane_distance : kSeedDistance));
-    mps.setMaximumCurvature(relax * relax * 0.001);
-    mps.setInputNormals(grid.normals);
-    mps.setInputCloud(grid.small);
-    std::vector<pcl::ModelCoefficients> coefficients;
-    inliers.clear();
-    mps.segment(coefficients, inliers);
-    if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
-          return r.indices.size() * cell >= params_.min_plane_points;
-        }))
-      break;
-  }
-  std::sort(inliers.begin(), inliers.end(),
-            [](const auto& a, const auto& b) { return a.indices.size() > b.indices.size(); });
-  return inliers;
+    finishPlaneGrid(*coarse, w, *twice);
 }
 
 template <typename PointT>
@@ -455,7 +334,7 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
         camera_.valid() ? camera_.fx : estimateFocalLength(*grid.small) * static_cast<float>(step);
       image_down_ = imageDownDirection(*grid.small, input_->sensor_origin_.head(3));
     }
-    seeds = planeSeeds(grid);
+    seeds = planeSeeds(grid, params_.min_plane_points, params_.plane_angle, seedDistance());
     PCL_DEBUG("[facyl::TabletopSegmentation] grid of %d pixels: %zu seeds, largest %zu cells\n",
               step, seeds.size(), seeds.empty() ? std::size_t{0} : seeds.front().indices.size());
     const std::size_t cell = static_cast<std::size_t>(step * step);
@@ -477,7 +356,8 @@ TabletopSegmentation<PointT>::findPlanesOrganized(std::vector<Candidate>& candid
     const auto fw = static_cast<std::size_t>(grid.small->width);
     const auto fh = static_cast<std::size_t>(grid.small->height);
     const auto tw = static_cast<std::size_t>(twice.small->width);
-    for (auto& r : planeSeeds(twice)) {
+    for (auto& r :
+         planeSeeds(twice, params_.min_plane_points, params_.plane_angle, seedDistance())) {
       std::size_t with_depth = 0, without_normal = 0;
       for (const auto k : r.indices) {
         const std::size_t cu = static_cast<std::size_t>(k) % tw,
@@ -556,71 +436,24 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   sample.filter(sampled);
   if (sampled.size() < 10)
     return;
-  typename PointCloud::Ptr coarse(new PointCloud);
-  pcl::copyPointCloud(*input_, sampled, *coarse);
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  typename pcl::search::KdTree<PointT>::Ptr tree(new pcl::search::KdTree<PointT>);
-  pcl::NormalEstimation<PointT, pcl::Normal> ne;
-  ne.setInputCloud(coarse);
-  ne.setSearchMethod(tree);
-  ne.setKSearch(12);
-  ne.compute(*normals);
-  const auto n = static_cast<Eigen::Index>(sampled.size());
-  Eigen::Matrix3Xf cells(3, n), cell_normals(3, n);
-  std::vector<float> ranges(sampled.size());
-  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    cells.col(k) = (*coarse)[kk].getVector3fMap();
-    cell_normals.col(k) = (*normals)[kk].getNormalVector3fMap();
-    ranges[kk] = (cells.col(k) - viewpoint).norm();
-  }
-  // RANSAC's seed threshold: 2 % of the typical range (the bands are measured afterwards).
-  std::nth_element(ranges.begin(), ranges.begin() + n / 2, ranges.end());
-  const float seed_distance = params_.plane_distance > 0.f
-                                ? params_.plane_distance
-                                : 0.02f * ranges[static_cast<std::size_t>(n / 2)];
-  // Planes one after another, each seeded on what the previous ones left: RANSAC on positions
-  // (cheap), then the inliers whose normal agrees with the plane's.
-  pcl::SACSegmentation<PointT> sac;
-  sac.setOptimizeCoefficients(true);
-  sac.setModelType(pcl::SACMODEL_PLANE);
-  sac.setMethodType(pcl::SAC_RANSAC);
-  sac.setDistanceThreshold(seed_distance);
-  sac.setMaxIterations(200);
-  sac.setInputCloud(coarse);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr sample(new pcl::PointCloud<pcl::PointXYZ>);
+  sample->resize(sampled.size());
+  for (std::size_t k = 0; k < sampled.size(); ++k)
+    (*sample)[k].getVector3fMap() = (*input_)[sampled[k]].getVector3fMap();
+  const SampledPlaneCues cues =
+    sampledPlaneCues(sample, input_->sensor_origin_.head(3), params_.plane_distance);
   const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
-  const float cos_normal = std::cos(0.3f);
+  const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
   std::vector<std::uint8_t> taken(sampled.size(), 0);
-  for (std::size_t k = 0; k < params_.max_planes; ++k) {
-    pcl::IndicesPtr remaining(new pcl::Indices);
-    for (std::size_t i = 0; i < sampled.size(); ++i)
-      if (!taken[i])
-        remaining->push_back(static_cast<pcl::index_t>(i));
-    if (remaining->size() < 10)
-      break;
-    sac.setIndices(remaining);
-    pcl::PointIndices inliers;
-    pcl::ModelCoefficients coefficients;
-    sac.segment(inliers, coefficients);
-    if (coefficients.values.size() != 4)
-      break;
-    const auto& c = coefficients.values;
-    const Eigen::Vector3f normal = Eigen::Vector3f(c[0], c[1], c[2]).normalized();
-    std::vector<std::uint8_t> seed(sampled.size(), 0);
-    std::size_t seeded = 0;
-    for (const auto i : inliers.indices)
-      if (std::abs(cell_normals.col(i).dot(normal)) >= cos_normal)
-        seed[static_cast<std::size_t>(i)] = 1, ++seeded;
-    if (static_cast<double>(seeded) * scale < static_cast<double>(params_.min_plane_points))
-      break;
-    const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
-    Candidate cand;
-    if (growCandidate(cells, cell_normals, cells, seed, sampled, cell_points, taken, cand))
-      candidates.push_back(std::move(cand));
-    for (const auto i : inliers.indices) // the next search looks elsewhere
-      taken[static_cast<std::size_t>(i)] = 1;
-  }
+  ransacPlaneSeeds(
+    cues, params_.max_planes, scale, params_.min_plane_points,
+    [&](const std::vector<std::uint8_t>& seed) {
+      Candidate cand;
+      if (growCandidate(cues.points, cues.normals, cues.points, seed, sampled, cell_points, taken,
+                        cand))
+        candidates.push_back(std::move(cand));
+    },
+    taken);
 }
 
 template <typename PointT>
@@ -754,34 +587,20 @@ TabletopSegmentation<PointT>::rankFamilies(const std::vector<Candidate>& candida
     return {};
   if (params_.support == TabletopSegmentationParameters::Support::LargestPlane)
     return {{0}};
-  std::vector<Eigen::Vector4f> normals;
-  std::vector<std::size_t> order;
+  std::vector<Eigen::Vector4f> planes;
+  std::vector<std::size_t> points;
   for (std::size_t s = 0; s < candidates.size(); ++s) {
-    normals.push_back(
-      Eigen::Vector4f(candidates[s].plane[0], candidates[s].plane[1], candidates[s].plane[2], 0.f));
-    order.push_back(s); // largest first
+    planes.push_back(candidates[s].plane);
+    points.push_back(all[s].inliers.indices.size());
   }
-  // Supports are level: a table, the floor under it and a shelf are parallel within degrees.
-  auto families = groupCoplanar(normals, order, 0.1f, std::numeric_limits<float>::infinity());
-  // An upright camera's supports face the top of the image (their normal points against the
-  // image's down direction, measured on organized clouds); walls and ceilings do not. Those
-  // come first (the order breaks ties), then the family with most points.
-  const auto faces_up = [&](const std::vector<std::size_t>& f) {
-    return !up_.isZero() ||
-           candidates[f.front()].plane.template head<3>().dot(image_down_) <= -0.1f;
-  };
-  const auto points = [&](const std::vector<std::size_t>& f) {
-    std::size_t sum = 0;
-    for (const std::size_t s : f)
-      sum += all[s].inliers.indices.size();
-    return sum;
-  };
-  // An upright camera's choice first.
-  std::stable_sort(families.begin(), families.end(), [&](const auto& a, const auto& b) {
-    const bool ua = faces_up(a), ub = faces_up(b);
-    return ua != ub ? ua : points(a) > points(b);
-  });
-  return families;
+  return rankSupportFamilies(planes, points, !up_.isZero(), image_down_);
+}
+
+template <typename PointT>
+float
+TabletopSegmentation<PointT>::seedDistance() const
+{
+  return params_.plane_distance > 0.f ? params_.plane_distance : kSeedDistance;
 }
 
 template <typename PointT>
@@ -1152,18 +971,7 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
                                   params_.objects, has_noise_ ? &noise_ : nullptr);
     return;
   }
-  pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
-    new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
-  comparator->setInputCloud(masked);
-  comparator->setDistanceThreshold(params_.cluster_tolerance, false);
-  pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
-  components.setInputCloud(masked);
-  labels_.clear(); // PCL's segment() resizes without resetting: start empty (capacity stays)
-  std::vector<pcl::PointIndices> groups;
-  components.segment(labels_, groups);
-  out.clear();
-  for (auto& g : groups)
-    out.push_back(std::move(g.indices));
+  out = organizedEuclideanClusters(masked, params_.cluster_tolerance, labels_);
 }
 
 template <typename PointT>
@@ -1211,17 +1019,9 @@ TabletopSegmentation<PointT>::clusterCoarse(const pcl::Indices& objects, int str
   }
   else {
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(coarse));
-    pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
-      new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
-    comparator->setInputCloud(cloud);
-    comparator->setDistanceThreshold(static_cast<float>(stride) * params_.cluster_tolerance, false);
-    pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
-    components.setInputCloud(cloud);
     pcl::PointCloud<pcl::Label> labels;
-    std::vector<pcl::PointIndices> found;
-    components.segment(labels, found);
-    for (auto& g : found)
-      groups.push_back(std::move(g.indices));
+    groups = organizedEuclideanClusters(
+      cloud, static_cast<float>(stride) * params_.cluster_tolerance, labels);
   }
   out.clear();
   for (const auto& g : groups) {
@@ -1245,43 +1045,16 @@ TabletopSegmentation<PointT>::clusterUnorganized(const pcl::Indices& objects,
     segmentProjected(objects, out);
     return;
   }
-  // Euclidean clusters of one representative per voxel of a quarter of the tolerance (any two
-  // points of neighbouring voxels are closer than the tolerance), then every point joins its
-  // voxel's cluster: on dense sensor clouds the radius searches then return few neighbours.
-  const float leaf = 0.25f * params_.cluster_tolerance;
-  std::unordered_map<std::uint64_t, std::size_t> voxel_of_key;
-  pcl::IndicesPtr representatives(new pcl::Indices);
-  std::vector<std::size_t> voxel(objects.size());
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    const Eigen::Vector3f p = (*input_)[objects[k]].getVector3fMap() / leaf;
-    const auto cell = [](float v) {
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v)) + (1 << 20)) &
-             0x1fffffULL;
-    };
-    const std::uint64_t key = cell(p.x()) | (cell(p.y()) << 21) | (cell(p.z()) << 42);
-    const auto it = voxel_of_key.emplace(key, representatives->size());
-    if (it.second)
-      representatives->push_back(objects[k]);
-    voxel[k] = it.first->second;
-  }
-  typename pcl::search::KdTree<PointT>::Ptr tree(new pcl::search::KdTree<PointT>);
-  tree->setInputCloud(input_, representatives);
-  pcl::EuclideanClusterExtraction<PointT> ec;
-  ec.setClusterTolerance(params_.cluster_tolerance);
-  ec.setMinClusterSize(1);
-  ec.setMaxClusterSize(std::numeric_limits<pcl::uindex_t>::max());
-  ec.setSearchMethod(tree);
-  ec.setInputCloud(input_);
-  ec.setIndices(representatives);
-  std::vector<pcl::PointIndices> groups;
-  ec.extract(groups);
-  std::unordered_map<pcl::index_t, std::size_t> group_of;
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (const auto i : groups[g].indices)
-      group_of[i] = g;
-  out.assign(groups.size(), pcl::Indices{});
+  Eigen::Matrix3Xf points(3, static_cast<Eigen::Index>(objects.size()));
   for (std::size_t k = 0; k < objects.size(); ++k)
-    out[group_of.at((*representatives)[voxel[k]])].push_back(objects[k]);
+    points.col(static_cast<Eigen::Index>(k)) = (*input_)[objects[k]].getVector3fMap();
+  const auto groups = voxelEuclideanClusters(points, params_.cluster_tolerance);
+  out.assign(groups.size(), pcl::Indices{});
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    out[g].reserve(groups[g].size());
+    for (const std::size_t k : groups[g])
+      out[g].push_back(objects[k]);
+  }
 }
 
 template <typename PointT>

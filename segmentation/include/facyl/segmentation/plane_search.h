@@ -1,0 +1,129 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * The point-type-independent steps of TabletopSegmentation, as free functions on Eigen data
+ * and PointXYZ clouds (compiled once, in src/plane_search.cpp): the plane-search grid of an
+ * organized frame and its seeds, the plane seeds of a point sample, the ranking of families of
+ * parallel supports, and Euclidean clusters.
+ */
+#pragma once
+
+#include <pcl/PointIndices.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace facyl {
+
+/** \brief The plane-search grid of an organized frame at one block size. */
+struct PlaneGrid {
+  int step{1};                                   ///< block size (pixels)
+  pcl::PointCloud<pcl::PointXYZ>::Ptr small;     ///< the cells, organized
+  std::vector<pcl::index_t> source;              ///< each cell's first pixel (-1: none)
+  pcl::PointCloud<pcl::Normal>::Ptr normals;     ///< the cells' normals
+  Eigen::Matrix3Xf cells, cell_normals, samples; ///< as columns; samples: the first pixels
+};
+
+/** \brief Means of the pixels of the blocks of one plane grid, filled pixel by pixel in row
+ * order: each block's first pixel with depth, and the mean of those with depth near the
+ * first's (within 2 %). */
+struct BlockMeans {
+  BlockMeans(int step_, int w, int h)
+    : step(step_)
+    , cw(static_cast<std::size_t>((w + step_ - 1) / step_))
+    , ch(static_cast<std::size_t>((h + step_ - 1) / step_))
+    , sum(cw * ch, Eigen::Vector3f::Zero())
+    , first(cw * ch, Eigen::Vector3f::Zero())
+    , count(cw * ch, 0)
+    , source(cw * ch, -1)
+  {}
+  /** The pixel (\a u, \a v), input index \a idx, with the finite point \a p. */
+  void add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
+  {
+    const std::size_t k =
+      static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
+    if (count[k] == 0) {
+      first[k] = p;
+      source[k] = idx;
+    }
+    else if (std::abs(p.z() - first[k].z()) > 0.02f * std::abs(first[k].z()))
+      return;
+    sum[k] += p;
+    ++count[k];
+  }
+  int step;
+  std::size_t cw, ch;
+  std::vector<Eigen::Vector3f> sum;
+  std::vector<Eigen::Vector3f> first; ///< each block's first pixel
+  std::vector<int> count;
+  std::vector<pcl::index_t> source;
+};
+
+/** \brief The grid of \a blocks (of a frame \a image_width pixels wide): the cells (block
+ * means; NaN without depth), their normals (integral images, depth changes scaled to the
+ * grid's angular spacing), the columns and each cell's first pixel. Empties \a blocks. */
+void
+finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid);
+
+/** \brief The seed regions (cells) of the plane search on \a grid, largest first:
+ * pcl::OrganizedMultiPlaneSegmentation's regions of \a min_plane_points (in pixels) at \a
+ * plane_angle (rad) and \a seed_distance (m). Its thresholds only make seeds (the band of each plane is measured afterwards); on a frame too noisy for any seed
+ * of the least plane size they are relaxed, twice at most. */
+std::vector<pcl::PointIndices>
+planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angle,
+           float seed_distance);
+
+/** \brief What the plane search of a point sample works on: the points, their normals (12
+ * nearest neighbours) and RANSAC's seed threshold (\a plane_distance, or 2 % of the median
+ * range from \a viewpoint). */
+struct SampledPlaneCues {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  Eigen::Matrix3Xf points, normals;
+  float seed_distance{0.f};
+};
+
+/** \brief SampledPlaneCues of \a sample. */
+SampledPlaneCues
+sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample, const Eigen::Vector3f& viewpoint,
+                 float plane_distance);
+
+/** \brief Plane seeds of a point sample, one after another on what the previous ones left
+ * (RANSAC on positions, 200 iterations, then the inliers whose normal is within 0.3 rad of the
+ * plane's): each seed of at least \a min_plane_points (each sample standing for \a scale
+ * points) goes to \a grow, which may mark samples \a taken; the RANSAC inliers are taken after
+ * it. At most \a max_planes seeds; stops at the first too small. */
+void
+ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double scale,
+                 std::size_t min_plane_points,
+                 const std::function<void(const std::vector<std::uint8_t>&)>& grow,
+                 std::vector<std::uint8_t>& taken);
+
+/** \brief The families of parallel \a planes (unit normals within 0.1 rad), those an upright
+ * camera would see facing up first (\a up_known: all of them; else the normal points against
+ * \a image_down, the image's down direction), then by their \a points. \a planes are largest
+ * first (the order breaks ties). */
+std::vector<std::vector<std::size_t>>
+rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
+                    const std::vector<std::size_t>& points, bool up_known,
+                    const Eigen::Vector3f& image_down);
+
+/** \brief Connected components of the organized \a cloud, neighbours closer than \a
+ * tolerance (pcl::EuclideanClusterComparator); \a labels is a buffer kept between calls. */
+std::vector<pcl::Indices>
+organizedEuclideanClusters(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud, float tolerance,
+                           pcl::PointCloud<pcl::Label>& labels);
+
+/** \brief Euclidean clusters (neighbours closer than \a tolerance) of \a points (columns), as
+ * lists of columns, largest first: clusters of one representative per voxel of a quarter of the
+ * tolerance (any two points of neighbouring voxels are closer than it), then every point joins
+ * its voxel's cluster: on dense sensor clouds the radius searches return few neighbours. */
+std::vector<std::vector<std::size_t>>
+voxelEuclideanClusters(const Eigen::Matrix3Xf& points, float tolerance);
+
+} // namespace facyl

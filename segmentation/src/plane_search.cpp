@@ -1,0 +1,268 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * The point-type-independent steps of TabletopSegmentation (see plane_search.h).
+ */
+#include <facyl/segmentation/plane_search.h>
+#include <facyl/segmentation/support_planes.h>
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/features/integral_image_normal.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/euclidean_cluster_comparator.h>
+#include <pcl/segmentation/extract_clusters.h>
+#include <pcl/segmentation/organized_connected_component_segmentation.h>
+#include <pcl/segmentation/organized_multi_plane_segmentation.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <algorithm>
+#include <limits>
+#include <unordered_map>
+
+namespace facyl {
+
+void
+finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid)
+{
+  const int step = blocks.step;
+  grid.step = step;
+  grid.small.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  auto& small = *grid.small;
+  small.width = static_cast<std::uint32_t>(blocks.cw);
+  small.height = static_cast<std::uint32_t>(blocks.ch);
+  small.is_dense = false;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  small.points.assign(blocks.cw * blocks.ch, pcl::PointXYZ(nan, nan, nan));
+  for (std::size_t k = 0; k < small.size(); ++k)
+    if (blocks.count[k] > 0)
+      small[k].getVector3fMap() = blocks.sum[k] / static_cast<float>(blocks.count[k]);
+  grid.source = std::move(blocks.source);
+  const auto& source = grid.source;
+  // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
+  // (for the bands).
+  grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
+  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
+  // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
+  // to their angular spacing at other resolutions.
+  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f /
+                             static_cast<float>(image_width));
+  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
+  ne.setInputCloud(grid.small);
+  ne.compute(*grid.normals);
+  const auto n = static_cast<Eigen::Index>(small.size());
+  grid.cells.resize(3, n);
+  grid.cell_normals.resize(3, n);
+  grid.samples.resize(3, n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    grid.cells.col(k) = small[kk].getVector3fMap();
+    grid.cell_normals.col(k) = (*grid.normals)[kk].getNormalVector3fMap();
+    grid.samples.col(k) = source[kk] >= 0 ? blocks.first[kk] : Eigen::Vector3f::Constant(nan);
+  }
+  blocks.sum.clear();
+  blocks.first.clear();
+  blocks.count.clear();
+}
+
+std::vector<pcl::PointIndices>
+planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angle,
+           float seed_distance)
+{
+  const std::size_t cell = static_cast<std::size_t>(grid.step * grid.step);
+  const std::size_t min_cells = std::max<std::size_t>(10, min_plane_points / cell / 4);
+  std::vector<pcl::PointIndices> inliers;
+  float relax = 1.f;
+  for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
+    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
+    mps.setMinInliers(static_cast<unsigned>(min_cells));
+    mps.setAngularThreshold(std::min(0.5f, relax * plane_angle));
+    mps.setDistanceThreshold(relax * seed_distance);
+    mps.setMaximumCurvature(relax * relax * 0.001);
+    mps.setInputNormals(grid.normals);
+    mps.setInputCloud(grid.small);
+    std::vector<pcl::ModelCoefficients> coefficients;
+    inliers.clear();
+    mps.segment(coefficients, inliers);
+    if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
+          return r.indices.size() * cell >= min_plane_points;
+        }))
+      break;
+  }
+  std::sort(inliers.begin(), inliers.end(),
+            [](const auto& a, const auto& b) { return a.indices.size() > b.indices.size(); });
+  return inliers;
+}
+
+SampledPlaneCues
+sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample, const Eigen::Vector3f& viewpoint,
+                 float plane_distance)
+{
+  SampledPlaneCues c;
+  c.cloud = sample;
+  pcl::PointCloud<pcl::Normal> normals;
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setInputCloud(sample);
+  ne.setSearchMethod(tree);
+  ne.setKSearch(12);
+  ne.compute(normals);
+  const auto n = static_cast<Eigen::Index>(sample->size());
+  c.points.resize(3, n);
+  c.normals.resize(3, n);
+  std::vector<float> ranges(sample->size());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    c.points.col(k) = (*sample)[kk].getVector3fMap();
+    c.normals.col(k) = normals[kk].getNormalVector3fMap();
+    ranges[kk] = (c.points.col(k) - viewpoint).norm();
+  }
+  // RANSAC's seed threshold: 2 % of the typical range (the bands are measured afterwards).
+  std::nth_element(ranges.begin(), ranges.begin() + n / 2, ranges.end());
+  c.seed_distance =
+    plane_distance > 0.f ? plane_distance : 0.02f * ranges[static_cast<std::size_t>(n / 2)];
+  return c;
+}
+
+void
+ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double scale,
+                 std::size_t min_plane_points,
+                 const std::function<void(const std::vector<std::uint8_t>&)>& grow,
+                 std::vector<std::uint8_t>& taken)
+{
+  // Planes one after another, each seeded on what the previous ones left: RANSAC on positions
+  // (cheap), then the inliers whose normal agrees with the plane's.
+  const std::size_t n = cues.cloud->size();
+  pcl::SACSegmentation<pcl::PointXYZ> sac;
+  sac.setOptimizeCoefficients(true);
+  sac.setModelType(pcl::SACMODEL_PLANE);
+  sac.setMethodType(pcl::SAC_RANSAC);
+  sac.setDistanceThreshold(cues.seed_distance);
+  sac.setMaxIterations(200);
+  sac.setInputCloud(cues.cloud);
+  const float cos_normal = std::cos(0.3f);
+  for (std::size_t k = 0; k < max_planes; ++k) {
+    pcl::IndicesPtr remaining(new pcl::Indices);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!taken[i])
+        remaining->push_back(static_cast<pcl::index_t>(i));
+    if (remaining->size() < 10)
+      break;
+    sac.setIndices(remaining);
+    pcl::PointIndices inliers;
+    pcl::ModelCoefficients coefficients;
+    sac.segment(inliers, coefficients);
+    if (coefficients.values.size() != 4)
+      break;
+    const auto& c = coefficients.values;
+    const Eigen::Vector3f normal = Eigen::Vector3f(c[0], c[1], c[2]).normalized();
+    std::vector<std::uint8_t> seed(n, 0);
+    std::size_t seeded = 0;
+    for (const auto i : inliers.indices)
+      if (std::abs(cues.normals.col(i).dot(normal)) >= cos_normal)
+        seed[static_cast<std::size_t>(i)] = 1, ++seeded;
+    if (static_cast<double>(seeded) * scale < static_cast<double>(min_plane_points))
+      break;
+    grow(seed);
+    for (const auto i : inliers.indices) // the next search looks elsewhere
+      taken[static_cast<std::size_t>(i)] = 1;
+  }
+}
+
+std::vector<std::vector<std::size_t>>
+rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
+                    const std::vector<std::size_t>& points, bool up_known,
+                    const Eigen::Vector3f& image_down)
+{
+  std::vector<Eigen::Vector4f> normals;
+  std::vector<std::size_t> order;
+  for (std::size_t s = 0; s < planes.size(); ++s) {
+    normals.push_back(Eigen::Vector4f(planes[s][0], planes[s][1], planes[s][2], 0.f));
+    order.push_back(s); // largest first
+  }
+  // Supports are level: a table, the floor under it and a shelf are parallel within degrees.
+  auto families = groupCoplanar(normals, order, 0.1f, std::numeric_limits<float>::infinity());
+  // An upright camera's supports face the top of the image (their normal points against the
+  // image's down direction, measured on organized clouds); walls and ceilings do not. Those
+  // come first (the order breaks ties), then the family with most points.
+  const auto faces_up = [&](const std::vector<std::size_t>& f) {
+    return up_known || planes[f.front()].head<3>().dot(image_down) <= -0.1f;
+  };
+  const auto sum = [&](const std::vector<std::size_t>& f) {
+    std::size_t total = 0;
+    for (const std::size_t s : f)
+      total += points[s];
+    return total;
+  };
+  std::stable_sort(families.begin(), families.end(), [&](const auto& a, const auto& b) {
+    const bool ua = faces_up(a), ub = faces_up(b);
+    return ua != ub ? ua : sum(a) > sum(b);
+  });
+  return families;
+}
+
+std::vector<pcl::Indices>
+organizedEuclideanClusters(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud, float tolerance,
+                           pcl::PointCloud<pcl::Label>& labels)
+{
+  pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>::Ptr comparator(
+    new pcl::EuclideanClusterComparator<pcl::PointXYZ, pcl::Label>);
+  comparator->setInputCloud(cloud);
+  comparator->setDistanceThreshold(tolerance, false);
+  pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> components(comparator);
+  components.setInputCloud(cloud);
+  labels.clear(); // PCL's segment() resizes without resetting: start empty (capacity stays)
+  std::vector<pcl::PointIndices> groups;
+  components.segment(labels, groups);
+  std::vector<pcl::Indices> out;
+  out.reserve(groups.size());
+  for (auto& g : groups)
+    out.push_back(std::move(g.indices));
+  return out;
+}
+
+std::vector<std::vector<std::size_t>>
+voxelEuclideanClusters(const Eigen::Matrix3Xf& points, float tolerance)
+{
+  const float leaf = 0.25f * tolerance;
+  std::unordered_map<std::uint64_t, std::size_t> voxel_of_key;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr representatives(new pcl::PointCloud<pcl::PointXYZ>);
+  std::vector<std::size_t> voxel(static_cast<std::size_t>(points.cols()));
+  for (Eigen::Index k = 0; k < points.cols(); ++k) {
+    const Eigen::Vector3f p = points.col(k) / leaf;
+    const auto cell = [](float v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v)) + (1 << 20)) &
+             0x1fffffULL;
+    };
+    const std::uint64_t key = cell(p.x()) | (cell(p.y()) << 21) | (cell(p.z()) << 42);
+    const auto it = voxel_of_key.emplace(key, representatives->size());
+    if (it.second) {
+      pcl::PointXYZ q;
+      q.getVector3fMap() = points.col(k);
+      representatives->push_back(q);
+    }
+    voxel[static_cast<std::size_t>(k)] = it.first->second;
+  }
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  tree->setInputCloud(representatives);
+  pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+  ec.setClusterTolerance(tolerance);
+  ec.setMinClusterSize(1);
+  ec.setMaxClusterSize(std::numeric_limits<pcl::uindex_t>::max());
+  ec.setSearchMethod(tree);
+  ec.setInputCloud(representatives);
+  std::vector<pcl::PointIndices> groups;
+  ec.extract(groups);
+  std::vector<std::size_t> group_of(representatives->size());
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const auto i : groups[g].indices)
+      group_of[static_cast<std::size_t>(i)] = g;
+  std::vector<std::vector<std::size_t>> out(groups.size());
+  for (std::size_t k = 0; k < voxel.size(); ++k)
+    out[group_of[voxel[k]]].push_back(k);
+  return out;
+}
+
+} // namespace facyl
