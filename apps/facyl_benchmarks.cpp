@@ -1,8 +1,14 @@
 /*
- * facyl_benchmarks: speed of the estimator and of the per-point cues (Google Benchmark).
+ * facyl_benchmarks: speed of the estimator, of the per-point cues and of whole frames
+ * (Google Benchmark).
  * Run: ./build/apps/facyl_benchmarks [--benchmark_filter=REGEX]
+ * BM_Frame runs the tabletop recognizer with the shipped classifier on the bundled scene and,
+ * when the shared data is there (FACYL_REAL_DATA, default ../shared/data/real beside the
+ * sources), on every 4th mOSD learn frame; counters: the stages in ms per frame.
  */
 #include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 #include <facyl/simulation/cylinder_simulation.h>
@@ -12,6 +18,7 @@
 #include <pcl/common/io.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/features/principal_curvatures.h>
+#include <pcl/io/pcd_io.h>
 #include <pcl/sample_consensus/method_types.h>
 #include <pcl/sample_consensus/model_types.h>
 #include <pcl/segmentation/sac_segmentation.h>
@@ -19,6 +26,9 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
 #include <string>
 
 namespace {
@@ -250,6 +260,58 @@ BM_TrackerUpdate(benchmark::State& state)
 }
 BENCHMARK(BM_TrackerUpdate)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMicrosecond);
 
+/** One frame through the recognizer, with the shipped classifier, as facyl_detect runs it
+ * (buffers kept between frames as a stream would). */
+void
+BM_Frame(benchmark::State& state, const std::string& file)
+{
+  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGBA>);
+  if (pcl::io::loadPCDFile(file, *cloud) < 0) {
+    state.SkipWithError(("cannot read " + file).c_str());
+    return;
+  }
+  auto classifier = std::make_shared<facyl::CylinderClassifier>();
+  classifier->load(facyl::CylinderClassifier::defaultModelPath());
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  rec.setClassifier(classifier);
+  rec.setInputCloud(cloud);
+  std::vector<facyl::RecognizedObject> objects;
+  facyl::RecognitionTiming sum;
+  for (auto _ : state) {
+    if (!rec.recognize(objects)) {
+      state.SkipWithError("recognition failed");
+      return;
+    }
+    const auto& t = rec.getTiming();
+    sum.segmentation += t.segmentation;
+    sum.classification += t.classification;
+    sum.fitting += t.fitting;
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["segmentation_ms"] = sum.segmentation / n;
+  state.counters["classification_ms"] = sum.classification / n;
+  state.counters["fitting_ms"] = sum.fitting / n;
+  state.counters["objects"] = static_cast<double>(objects.size());
+}
+
+/** BM_Frame on the bundled scene and, when present, every 4th mOSD learn frame. */
+void
+registerFrames()
+{
+  const std::string scene = std::string(FACYL_SOURCE_DIR) + "/data/default_scene.pcd";
+  benchmark::RegisterBenchmark("BM_Frame/default_scene", BM_Frame, scene)
+    ->Unit(benchmark::kMillisecond);
+  const char* env = std::getenv("FACYL_REAL_DATA");
+  const std::string real = env ? env : std::string(FACYL_SOURCE_DIR) + "/../shared/data/real";
+  for (int k = 0; k <= 44; k += 4) {
+    const std::string file = real + "/mosd/learn" + std::to_string(k) + ".pcd";
+    if (std::filesystem::exists(file))
+      benchmark::RegisterBenchmark(("BM_Frame/mosd_learn" + std::to_string(k)).c_str(), BM_Frame,
+                                   file)
+        ->Unit(benchmark::kMillisecond);
+  }
+}
+
 } // namespace
 
 // Google Benchmark's main, plus --version as every facyl tool answers it (-h lists
@@ -262,6 +324,7 @@ main(int argc, char** argv)
       std::printf("facyl_benchmarks (facyl) %s\n", FACYL_VERSION);
       return 0;
     }
+  registerFrames();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv))
     return 1;

@@ -97,8 +97,8 @@ planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angl
 }
 
 SampledPlaneCues
-sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample, const Eigen::Vector3f& viewpoint,
-                 float plane_distance)
+sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample,
+                 const Eigen::Vector3f& viewpoint, float plane_distance)
 {
   SampledPlaneCues c;
   c.cloud = sample;

@@ -35,14 +35,15 @@ struct PlaneGrid {
  * first's (within 2 %). */
 struct BlockMeans {
   BlockMeans(int step_, int w, int h)
-    : step(step_)
-    , cw(static_cast<std::size_t>((w + step_ - 1) / step_))
-    , ch(static_cast<std::size_t>((h + step_ - 1) / step_))
-    , sum(cw * ch, Eigen::Vector3f::Zero())
-    , first(cw * ch, Eigen::Vector3f::Zero())
-    , count(cw * ch, 0)
-    , source(cw * ch, -1)
-  {}
+      : step(step_)
+      , cw(static_cast<std::size_t>((w + step_ - 1) / step_))
+      , ch(static_cast<std::size_t>((h + step_ - 1) / step_))
+      , sum(cw * ch, Eigen::Vector3f::Zero())
+      , first(cw * ch, Eigen::Vector3f::Zero())
+      , count(cw * ch, 0)
+      , source(cw * ch, -1)
+  {
+  }
   /** The pixel (\a u, \a v), input index \a idx, with the finite point \a p. */
   void add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
   {
@@ -68,16 +69,15 @@ struct BlockMeans {
 /** \brief The grid of \a blocks (of a frame \a image_width pixels wide): the cells (block
  * means; NaN without depth), their normals (integral images, depth changes scaled to the
  * grid's angular spacing), the columns and each cell's first pixel. Empties \a blocks. */
-void
-finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid);
+void finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid);
 
 /** \brief The seed regions (cells) of the plane search on \a grid, largest first:
  * pcl::OrganizedMultiPlaneSegmentation's regions of \a min_plane_points (in pixels) at \a
- * plane_angle (rad) and \a seed_distance (m). Its thresholds only make seeds (the band of each plane is measured afterwards); on a frame too noisy for any seed
- * of the least plane size they are relaxed, twice at most. */
-std::vector<pcl::PointIndices>
-planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angle,
-           float seed_distance);
+ * plane_angle (rad) and \a seed_distance (m). Its thresholds only make seeds (the band of each
+ * plane is measured afterwards); on a frame too noisy for any seed of the least plane size they are
+ * relaxed, twice at most. */
+std::vector<pcl::PointIndices> planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points,
+                                          float plane_angle, float seed_distance);
 
 /** \brief What the plane search of a point sample works on: the points, their normals (12
  * nearest neighbours) and RANSAC's seed threshold (\a plane_distance, or 2 % of the median
@@ -89,20 +89,18 @@ struct SampledPlaneCues {
 };
 
 /** \brief SampledPlaneCues of \a sample. */
-SampledPlaneCues
-sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample, const Eigen::Vector3f& viewpoint,
-                 float plane_distance);
+SampledPlaneCues sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample,
+                                  const Eigen::Vector3f& viewpoint, float plane_distance);
 
 /** \brief Plane seeds of a point sample, one after another on what the previous ones left
  * (RANSAC on positions, 200 iterations, then the inliers whose normal is within 0.3 rad of the
  * plane's): each seed of at least \a min_plane_points (each sample standing for \a scale
  * points) goes to \a grow, which may mark samples \a taken; the RANSAC inliers are taken after
  * it. At most \a max_planes seeds; stops at the first too small. */
-void
-ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double scale,
-                 std::size_t min_plane_points,
-                 const std::function<void(const std::vector<std::uint8_t>&)>& grow,
-                 std::vector<std::uint8_t>& taken);
+void ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double scale,
+                      std::size_t min_plane_points,
+                      const std::function<void(const std::vector<std::uint8_t>&)>& grow,
+                      std::vector<std::uint8_t>& taken);
 
 /** \brief The families of parallel \a planes (unit normals within 0.1 rad), those an upright
  * camera would see facing up first (\a up_known: all of them; else the normal points against
@@ -123,7 +121,7 @@ organizedEuclideanClusters(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud
  * lists of columns, largest first: clusters of one representative per voxel of a quarter of the
  * tolerance (any two points of neighbouring voxels are closer than it), then every point joins
  * its voxel's cluster: on dense sensor clouds the radius searches return few neighbours. */
-std::vector<std::vector<std::size_t>>
-voxelEuclideanClusters(const Eigen::Matrix3Xf& points, float tolerance);
+std::vector<std::vector<std::size_t>> voxelEuclideanClusters(const Eigen::Matrix3Xf& points,
+                                                             float tolerance);
 
 } // namespace facyl
