@@ -339,7 +339,6 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray, co
                   "largest output object is; an output object matching no object "
                   "and called a cylinder is a false positive):",
                   opt.params.decision);
-  const auto& d = opt.params.decision;
   std::map<std::string, std::pair<std::size_t, std::size_t>> fp_by; // kind: (called, total)
   for (const Row& r : all)
     if (!r.positive) {

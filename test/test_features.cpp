@@ -25,6 +25,7 @@ cylinderXYZ(float noise, std::uint64_t seed)
   facyl::CylinderSimulationParameters p;
   p.radius = 0.1f;
   p.height = 0.4f;
+  p.base = Eigen::Vector3f::Zero(); // the checks below are about the origin
   p.lateral_points = 2000;
   p.noise = noise;
   p.seed = seed;

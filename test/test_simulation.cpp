@@ -35,6 +35,7 @@ TEST(CylinderSimulation, LidsFollowEquation5)
 {
   CylinderSimulationParameters p;
   p.lid_ratio = 3.f;
+  p.base = Eigen::Vector3f::Zero(); // lids at z = 0 and z = height
   const auto sim = facyl::simulateCylinder(p);
   // eq. 5: outliers = total / |P| - 1
   EXPECT_NEAR(static_cast<float>(sim.cloud.size()) / 900.f - 1.f, 3.f, 1e-6f);
