@@ -436,12 +436,14 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   sample.filter(sampled);
   if (sampled.size() < 10)
     return;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr sample(new pcl::PointCloud<pcl::PointXYZ>);
-  sample->resize(sampled.size());
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
+  points->resize(sampled.size());
+  points->sensor_origin_ = input_->sensor_origin_; // normals face it, as on the input
+  points->sensor_orientation_ = input_->sensor_orientation_;
   for (std::size_t k = 0; k < sampled.size(); ++k)
-    (*sample)[k].getVector3fMap() = (*input_)[sampled[k]].getVector3fMap();
+    (*points)[k].getVector3fMap() = (*input_)[sampled[k]].getVector3fMap();
   const SampledPlaneCues cues =
-    sampledPlaneCues(sample, input_->sensor_origin_.head(3), params_.plane_distance);
+    sampledPlaneCues(points, input_->sensor_origin_.head(3), params_.plane_distance);
   const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
   const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
   std::vector<std::uint8_t> taken(sampled.size(), 0);
