@@ -101,13 +101,17 @@ public:
     v_.reserve(valid);
     range_.reserve(valid);
     gap2_.reserve(valid);
-    for (std::size_t i = 0; i < cloud.size(); ++i)
-      if (finite(cloud[i])) {
-        slot_[i] = static_cast<int>(pixel_.size());
-        pixel_.push_back(i);
-        xyz_.push_back(cloud[i].getVector3fMap());
-        u_.push_back(static_cast<int>(i % static_cast<std::size_t>(w_)));
-        v_.push_back(static_cast<int>(i / static_cast<std::size_t>(w_)));
+    // Row by row: the pixel's column and row without a division per pixel.
+    for (int v = 0, i = 0; v < h_; ++v)
+      for (int u = 0; u < w_; ++u, ++i) {
+        const auto& q = cloud[static_cast<std::size_t>(i)];
+        if (!finite(q))
+          continue;
+        slot_[static_cast<std::size_t>(i)] = static_cast<int>(pixel_.size());
+        pixel_.push_back(static_cast<std::size_t>(i));
+        xyz_.push_back(q.getVector3fMap());
+        u_.push_back(u);
+        v_.push_back(v);
         const float r = (xyz_.back() - viewpoint).norm();
         range_.push_back(r);
         float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);

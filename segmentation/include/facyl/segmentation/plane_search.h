@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -42,13 +43,24 @@ struct BlockMeans {
       , first(cw * ch, Eigen::Vector3f::Zero())
       , count(cw * ch, 0)
       , source(cw * ch, -1)
+      , column_block(static_cast<std::size_t>(std::max(w, 0)))
   {
+    for (std::size_t u = 0; u < column_block.size(); ++u)
+      column_block[u] = static_cast<std::uint32_t>(u / static_cast<std::size_t>(step_));
+  }
+  /** The first block of the row of blocks that holds pixel row \a v. */
+  std::size_t rowBase(int v) const
+  {
+    return static_cast<std::size_t>(v / step) * cw;
   }
   /** The pixel (\a u, \a v), input index \a idx, with the finite point \a p. */
   void add(int u, int v, pcl::index_t idx, const Eigen::Vector3f& p)
   {
-    const std::size_t k =
-      static_cast<std::size_t>(v / step) * cw + static_cast<std::size_t>(u / step);
+    addTo(rowBase(v) + column_block[static_cast<std::size_t>(u)], idx, p);
+  }
+  /** add() into block \a k (rowBase(v) + column_block[u]: no division per pixel). */
+  void addTo(std::size_t k, pcl::index_t idx, const Eigen::Vector3f& p)
+  {
     if (count[k] == 0) {
       first[k] = p;
       source[k] = idx;
@@ -64,6 +76,7 @@ struct BlockMeans {
   std::vector<Eigen::Vector3f> first; ///< each block's first pixel
   std::vector<int> count;
   std::vector<pcl::index_t> source;
+  std::vector<std::uint32_t> column_block; ///< u / step for each pixel column u
 };
 
 /** \brief The grid of \a blocks (of a frame \a image_width pixels wide): the cells (block

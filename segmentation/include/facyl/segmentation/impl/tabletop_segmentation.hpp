@@ -266,16 +266,21 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
   std::optional<BlockMeans> coarse;
   if (twice)
     coarse.emplace(2 * step, w, h);
+  const PointT* points = input_->points.data();
   for (int v = 0; v < h; ++v) {
     const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
+    const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
     for (int u = 0; u < w; ++u) {
       const std::size_t idx = base + static_cast<std::size_t>(u);
-      const auto& p = (*input_)[idx];
+      const PointT& p = points[idx];
       if (!std::isfinite(p.z) || !(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
         continue;
-      fine.add(u, v, static_cast<pcl::index_t>(idx), p.getVector3fMap());
+      const auto uu = static_cast<std::size_t>(u);
+      fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx),
+                 p.getVector3fMap());
       if (coarse)
-        coarse->add(u, v, static_cast<pcl::index_t>(idx), p.getVector3fMap());
+        coarse->addTo(coarse_row + coarse->column_block[uu], static_cast<pcl::index_t>(idx),
+                      p.getVector3fMap());
     }
   }
   finishPlaneGrid(fine, w, grid);
