@@ -77,15 +77,20 @@ private:
  * ranges and the connection test between neighbours. */
 class Grid {
 public:
+  /** The finite pixels of \a cloud: \a finite (ascending) when given, else all of them. */
   Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
-       const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr)
+       const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr,
+       const pcl::Indices* finite_pixels = nullptr)
       : w_(static_cast<int>(cloud.width))
       , h_(static_cast<int>(cloud.height))
       , slot_(cloud.size(), -1)
   {
     std::size_t valid = 0;
-    for (const auto& q : cloud)
-      valid += finite(q);
+    if (finite_pixels)
+      valid = finite_pixels->size();
+    else
+      for (const auto& q : cloud)
+        valid += finite(q);
     // The noise's half-width by range, every 5 mm up to 12 m.
     constexpr float kBin = 0.005f;
     constexpr std::size_t kBins = 2400;
@@ -101,24 +106,33 @@ public:
     v_.reserve(valid);
     range_.reserve(valid);
     gap2_.reserve(valid);
+    const auto add = [&](std::size_t i, int u, int v) {
+      slot_[i] = static_cast<int>(pixel_.size());
+      pixel_.push_back(i);
+      xyz_.push_back(cloud[i].getVector3fMap());
+      u_.push_back(u);
+      v_.push_back(v);
+      const float r = (xyz_.back() - viewpoint).norm();
+      range_.push_back(r);
+      float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
+      if (noise) // neighbours on one surface differ by the sensor's noise: never a jump
+        gap = std::max(gap, noise_half[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
+      gap2_.push_back(gap * gap);
+    };
+    if (finite_pixels) {
+      for (const auto idx : *finite_pixels) {
+        const auto i = static_cast<std::size_t>(idx);
+        if (finite(cloud[i]))
+          add(i, static_cast<int>(i % static_cast<std::size_t>(w_)),
+              static_cast<int>(i / static_cast<std::size_t>(w_)));
+      }
+      return;
+    }
     // Row by row: the pixel's column and row without a division per pixel.
     for (int v = 0, i = 0; v < h_; ++v)
-      for (int u = 0; u < w_; ++u, ++i) {
-        const auto& q = cloud[static_cast<std::size_t>(i)];
-        if (!finite(q))
-          continue;
-        slot_[static_cast<std::size_t>(i)] = static_cast<int>(pixel_.size());
-        pixel_.push_back(static_cast<std::size_t>(i));
-        xyz_.push_back(q.getVector3fMap());
-        u_.push_back(u);
-        v_.push_back(v);
-        const float r = (xyz_.back() - viewpoint).norm();
-        range_.push_back(r);
-        float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
-        if (noise) // neighbours on one surface differ by the sensor's noise: never a jump
-          gap = std::max(gap, noise_half[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
-        gap2_.push_back(gap * gap);
-      }
+      for (int u = 0; u < w_; ++u, ++i)
+        if (finite(cloud[static_cast<std::size_t>(i)]))
+          add(static_cast<std::size_t>(i), u, v);
   }
   int width() const
   {
@@ -668,11 +682,14 @@ std::vector<pcl::Indices>
 segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                         const std::vector<std::uint8_t>& has_depth, float focal,
                         const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-                        const DepthBand* noise)
+                        const DepthBand* noise, const pcl::Indices* finite)
 {
   if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
     return {};
-  const Grid grid(cloud, focal, viewpoint, p, noise);
+  if (finite && std::adjacent_find(finite->begin(), finite->end(),
+                                   [](auto a, auto b) { return a >= b; }) != finite->end())
+    finite = nullptr; // not strictly ascending: the grid's order is the image's, so scan
+  const Grid grid(cloud, focal, viewpoint, p, noise, finite);
   if (grid.size() == 0)
     return {};
   const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);

@@ -82,11 +82,14 @@ std::vector<std::uint8_t> concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& c
  * \param noise the sensor's noise and bias by range (a support's band), when known: a depth
  *        discontinuity is then at least its half-width (3 sigma), so that a noisy sensor's
  *        surfaces do not shatter into fragments.
+ * \param finite the indices of the finite points of \a cloud, ascending, when the caller knows
+ *        them (nullptr: the cloud is scanned for them); a VGA frame is then not read whole.
  * \return the segments' point indices, ascending, in no particular order of segments. */
 std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                                                   const std::vector<std::uint8_t>& has_depth,
                                                   float focal, const Eigen::Vector3f& viewpoint,
                                                   const ObjectSegmentationParameters& params,
-                                                  const DepthBand* noise = nullptr);
+                                                  const DepthBand* noise = nullptr,
+                                                  const pcl::Indices* finite = nullptr);
 
 } // namespace facyl

@@ -468,6 +468,7 @@ private:
   const Eigen::Affine3f identity_{Eigen::Affine3f::Identity()};
   const pcl::PointIndices no_indices_{};
   mutable pcl::PointCloud<pcl::PointXYZ>::Ptr masked_; ///< buffers of clusterOrganized
+  mutable pcl::Indices masked_written_;                ///< the finite pixels of masked_
   mutable std::vector<std::uint8_t> has_depth_;
   mutable pcl::PointCloud<pcl::Label> labels_;
 };

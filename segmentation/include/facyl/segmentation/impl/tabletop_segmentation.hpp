@@ -959,23 +959,30 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
 {
   // A sparse copy with only the object points finite: the components then never visit the
   // rest of the image. (Buffers kept between calls: fresh VGA-sized allocations cost more in
-  // page faults than the work done on them.)
+  // page faults than the work done on them; only the pixels written last time are cleared.)
   if (!masked_)
     masked_.reset(new pcl::PointCloud<pcl::PointXYZ>);
   const auto& masked = masked_;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  masked->points.assign(input_->size(), pcl::PointXYZ(nan, nan, nan));
+  if (masked->size() != input_->size()) {
+    masked->points.assign(input_->size(), pcl::PointXYZ(nan, nan, nan));
+    masked_written_.clear();
+  }
+  for (const auto i : masked_written_)
+    (*masked)[i].getVector3fMap().setConstant(nan);
   masked->width = input_->width;
   masked->height = input_->height;
   masked->is_dense = false;
   for (const auto i : objects)
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
+  masked_written_ = objects;
   if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
     has_depth_.resize(input_->size());
     for (std::size_t i = 0; i < input_->size(); ++i)
       has_depth_[i] = pcl::isFinite((*input_)[i]);
+    // The grid is built from the object points themselves: the masked frame is not scanned.
     out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
-                                  params_.objects, has_noise_ ? &noise_ : nullptr);
+                                  params_.objects, has_noise_ ? &noise_ : nullptr, &objects);
     return;
   }
   out = organizedEuclideanClusters(masked, params_.cluster_tolerance, labels_);
