@@ -469,7 +469,8 @@ private:
   const pcl::PointIndices no_indices_{};
   mutable pcl::PointCloud<pcl::PointXYZ>::Ptr masked_; ///< buffers of clusterOrganized
   mutable pcl::Indices masked_written_;                ///< the finite pixels of masked_
-  mutable std::vector<std::uint8_t> has_depth_;
+  mutable std::vector<std::uint8_t> has_depth_;        ///< per pixel of the input: finite
+  mutable bool has_depth_known_{false}; ///< has_depth_ is this run's (planeGrid fills it)
   mutable pcl::PointCloud<pcl::Label> labels_;
 };
 

@@ -41,6 +41,7 @@ TabletopSegmentation<PointT>::reset()
   image_down_.setZero();
   table_coefficients_.values.clear();
   hull_->clear();
+  has_depth_known_ = false;
 }
 
 template <typename PointT>
@@ -267,13 +268,17 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
   if (twice)
     coarse.emplace(2 * step, w, h);
   const PointT* points = input_->points.data();
+  // The same pass records which pixels have depth (the object segmentation's occlusion test).
+  has_depth_.resize(input_->size());
   for (int v = 0; v < h; ++v) {
     const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
     const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
     for (int u = 0; u < w; ++u) {
       const std::size_t idx = base + static_cast<std::size_t>(u);
       const PointT& p = points[idx];
-      if (!std::isfinite(p.z) || !(fake_indices_ || allowed[idx]) || !pcl::isFinite(p))
+      const bool finite = std::isfinite(p.z) && pcl::isFinite(p);
+      has_depth_[idx] = finite;
+      if (!finite || !(fake_indices_ || allowed[idx]))
         continue;
       const auto uu = static_cast<std::size_t>(u);
       fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx),
@@ -283,6 +288,7 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
                       p.getVector3fMap());
     }
   }
+  has_depth_known_ = true;
   finishPlaneGrid(fine, w, grid);
   if (twice)
     finishPlaneGrid(*coarse, w, *twice);
@@ -977,9 +983,12 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
   masked_written_ = objects;
   if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
-    has_depth_.resize(input_->size());
-    for (std::size_t i = 0; i < input_->size(); ++i)
-      has_depth_[i] = pcl::isFinite((*input_)[i]);
+    if (!has_depth_known_ || has_depth_.size() != input_->size()) { // else from planeGrid
+      has_depth_.resize(input_->size());
+      for (std::size_t i = 0; i < input_->size(); ++i)
+        has_depth_[i] = pcl::isFinite((*input_)[i]);
+      has_depth_known_ = true;
+    }
     // The grid is built from the object points themselves: the masked frame is not scanned.
     out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
                                   params_.objects, has_noise_ ? &noise_ : nullptr, &objects);
