@@ -153,16 +153,6 @@ called(const Row& r)
   return r.found && r.is_cylinder;
 }
 
-/** What the recognizer's rule (acceptCylinder) says of the row's object at decision \a d, other
- * than the recognizer's own \a base: the rows of a threshold sweep. At \a base, its decision. */
-bool
-calledAt(const Row& r, const facyl::CylinderDecision& d, const facyl::CylinderDecision& base)
-{
-  if (d.score == base.score && d.min_score == base.min_score)
-    return called(r);
-  return r.found && facyl::acceptCylinder(r.evidence, d);
-}
-
 /** Precision and recall over rows (ground-truth objects) and stray objects, for both scores
  * at several thresholds (the other settings of \a base). */
 void
@@ -178,18 +168,18 @@ reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
       facyl::CylinderDecision d = base;
       d.score = score;
       d.min_score = t;
+      // At the recognizer's own threshold, its decisions; at the others, what its rule
+      // (acceptCylinder) would say.
+      const bool is_default = score == base.score && std::abs(t - base.min_score) < 1e-6f;
       std::size_t tp = 0, fp = 0, fn = 0;
       for (const Row& r : rows) {
-        const bool yes = calledAt(r, d, base);
+        const bool yes = is_default ? called(r) : r.found && facyl::acceptCylinder(r.evidence, d);
         tp += r.positive && yes;
         fn += r.positive && !yes;
         fp += !r.positive && yes;
       }
       for (const Stray& e : stray)
-        fp += d.score == base.score && d.min_score == base.min_score
-                ? e.is_cylinder
-                : facyl::acceptCylinder(e.evidence, d);
-      const bool is_default = score == base.score && std::abs(t - base.min_score) < 1e-6f;
+        fp += is_default ? e.is_cylinder : facyl::acceptCylinder(e.evidence, d);
       std::printf("| %s | %.1f%s | %zu | %zu | %zu | %.3f | %.3f |\n",
                   score == facyl::CylinderDecision::Score::SurfaceRatio ? "surface ratio"
                                                                         : "inlier ratio (eq. 4)",

@@ -268,8 +268,11 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
   if (twice)
     coarse.emplace(2 * step, w, h);
   const PointT* points = input_->points.data();
-  // The same pass records which pixels have depth (the object segmentation's occlusion test).
-  has_depth_.resize(input_->size());
+  // The first pass of a run also records which pixels have depth (the object segmentation's
+  // occlusion test); the coarser grids of a noisy frame do not record them again.
+  const bool record = !has_depth_known_;
+  if (record)
+    has_depth_.resize(input_->size());
   for (int v = 0; v < h; ++v) {
     const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
     const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
@@ -277,7 +280,8 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
       const std::size_t idx = base + static_cast<std::size_t>(u);
       const PointT& p = points[idx];
       const bool finite = std::isfinite(p.z) && pcl::isFinite(p);
-      has_depth_[idx] = finite;
+      if (record)
+        has_depth_[idx] = finite;
       if (!finite || !(fake_indices_ || allowed[idx]))
         continue;
       const auto uu = static_cast<std::size_t>(u);
