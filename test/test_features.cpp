@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -68,6 +69,44 @@ TEST(NeighbourSearch, MatchesBruteForce)
   }
   EXPECT_THROW(search.nearest(pts, 0), std::invalid_argument);
   EXPECT_THROW(search.within(pts, -1.f), std::invalid_argument);
+}
+
+TEST(NeighbourSearch, NearestWithinIsNearestCutAtTheRadius)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  Eigen::Matrix3Xf pts(3, 800);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i)
+    pts.col(i) = Eigen::Vector3f(u(rng), u(rng), u(rng));
+  pts.col(3).setConstant(std::numeric_limits<float>::quiet_NaN());
+  const facyl::NeighbourSearch search(pts);
+  const int k = 24;
+  const float radius = 0.4f;
+  const auto knn = search.nearest(pts, k, 2);
+  const auto cut = search.nearestWithin(pts, k, radius, 2);
+  ASSERT_EQ(cut.size(), 800u);
+  EXPECT_EQ(cut.count(3), 0u);
+  std::size_t short_lists = 0, full_lists = 0;
+  for (std::size_t i = 0; i < cut.size(); ++i) {
+    std::size_t expected = 0;
+    while (expected < knn.count(i) &&
+           (pts.col(knn.begin(i)[expected]) - pts.col(static_cast<Eigen::Index>(i))).norm() <
+             radius)
+      ++expected;
+    ASSERT_EQ(cut.count(i), expected) << "query " << i;
+    for (std::size_t j = 0; j < expected; ++j)
+      EXPECT_EQ(cut.begin(i)[j], knn.begin(i)[j]);
+    short_lists += expected > 0 && expected < static_cast<std::size_t>(k);
+    full_lists += expected == static_cast<std::size_t>(k);
+  }
+  EXPECT_GT(short_lists, 50u); // both cases occur: the radius cuts some lists, k others
+  EXPECT_GT(full_lists, 50u);
+  // An infinite radius is nearest().
+  const auto all = search.nearestWithin(pts, k, std::numeric_limits<float>::infinity(), 1);
+  EXPECT_EQ(all.indices, knn.indices);
+  EXPECT_THROW(search.nearestWithin(pts, 0, radius), std::invalid_argument);
+  EXPECT_THROW(search.nearestWithin(pts, k, 0.f), std::invalid_argument);
+  EXPECT_THROW(search.nearestWithin(pts, k, std::nanf("")), std::invalid_argument);
 }
 
 TEST(NormalCurvatureEstimation, CylinderNormalsAreRadialAndCurvatureCircumferential)

@@ -78,6 +78,17 @@ NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) co
 {
   if (k < 1)
     throw std::invalid_argument("facyl::NeighbourSearch::nearest: k must be at least 1");
+  return nearestWithin(queries, k, std::numeric_limits<float>::infinity(), threads);
+}
+
+Neighbourhoods
+NeighbourSearch::nearestWithin(const Eigen::Matrix3Xf& queries, int k, float radius,
+                               int threads) const
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::NeighbourSearch::nearestWithin: k must be at least 1");
+  if (!(radius > 0.f))
+    throw std::invalid_argument("facyl::NeighbourSearch::nearestWithin: radius must be positive");
   const auto& data = impl_->data;
   const auto& tree = impl_->tree;
   const std::size_t n = static_cast<std::size_t>(queries.cols());
@@ -86,6 +97,10 @@ NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) co
   const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), data.columns.size());
   if (kk == 0)
     return out;
+  // The result set's worst distance starts at the radius instead of the largest float: the
+  // search then prunes every branch beyond it.
+  const float reach = radius * radius;
+  const float worst = std::isfinite(reach) ? reach : std::numeric_limits<float>::max();
   std::vector<std::uint32_t> found(n * kk);
   std::vector<std::uint32_t> counts(n, 0);
   parallelFor(n, threads, kQueryGrain, [&](std::size_t begin, std::size_t end) {
@@ -94,8 +109,11 @@ NeighbourSearch::nearest(const Eigen::Matrix3Xf& queries, int k, int threads) co
       const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
       if (!q.allFinite())
         continue;
-      std::uint32_t* out = found.data() + i * kk;
-      counts[i] = static_cast<std::uint32_t>(tree.knnSearch(q.data(), kk, out, distances.data()));
+      nanoflann::KNNResultSet<float, std::uint32_t> result(kk);
+      result.init(found.data() + i * kk, distances.data());
+      distances[kk - 1] = worst;
+      tree.findNeighbors(result, q.data(), nanoflann::SearchParams());
+      counts[i] = static_cast<std::uint32_t>(result.size());
     }
   });
   for (std::size_t i = 0; i < n; ++i)

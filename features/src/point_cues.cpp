@@ -31,21 +31,11 @@ estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbou
   out.weights.setZero(n);
   if (n == 0)
     return out;
-  // The k nearest, cut at the radius: the cost stays that of k neighbours where the points
-  // are dense.
+  // The k nearest within the radius: the cost stays that of k neighbours where the points
+  // are dense, and that of the few within the radius where they are sparse.
   const NeighbourSearch search(points);
-  const Neighbourhoods nb = search.nearest(points, max_neighbours, 1);
-  const float radius2 = radius * radius;
-  std::vector<std::size_t> counts(static_cast<std::size_t>(n), 0);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const int* list = nb.begin(static_cast<std::size_t>(i));
-    std::size_t k = 0;
-    while (k < nb.count(static_cast<std::size_t>(i)) &&
-           (points.col(list[k]) - points.col(i)).squaredNorm() <= radius2)
-      ++k;
-    counts[static_cast<std::size_t>(i)] = k;
-  }
-  const auto count = [&](Eigen::Index i) { return counts[static_cast<std::size_t>(i)]; };
+  const Neighbourhoods nb = search.nearestWithin(points, max_neighbours, radius, 1);
+  const auto count = [&](Eigen::Index i) { return nb.count(static_cast<std::size_t>(i)); };
   const bool oriented = reference.cols() == n;
   for (Eigen::Index i = 0; i < n; ++i) {
     const int* list = nb.begin(static_cast<std::size_t>(i));

@@ -65,6 +65,13 @@ public:
    * \throws std::invalid_argument if k < 1. */
   Neighbourhoods nearest(const Eigen::Matrix3Xf& queries, int k, int threads = 0) const;
 
+  /** \brief The k nearest surface points of every query column that lie within \a radius of
+   * it, nearest first: nearest() cut at the radius, at the cost of the points within it (the
+   * search prunes at the radius from the start, so sparse neighbourhoods stay cheap).
+   * \throws std::invalid_argument if k < 1 or radius is not positive (infinity: nearest()). */
+  Neighbourhoods nearestWithin(const Eigen::Matrix3Xf& queries, int k, float radius,
+                               int threads = 0) const;
+
   /** \brief Every surface point within \a radius of each query column, nearest first.
    * \throws std::invalid_argument if radius is not positive and finite. */
   Neighbourhoods within(const Eigen::Matrix3Xf& queries, float radius, int threads = 0) const;
