@@ -26,9 +26,11 @@ void
 surfaceDistances(const Eigen::Matrix3Xf& points, const Eigen::Vector3f& p, const Eigen::Vector3f& a,
                  float r, Eigen::ArrayXf& e)
 {
-  const Eigen::Matrix3Xf w = points.colwise() - p;
-  const Eigen::RowVectorXf along = a.transpose() * w;
-  e = ((w - a * along).colwise().norm().array() - r).transpose();
+  e.resize(points.cols());
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - p;
+    e(i) = (w - w.dot(a) * a).norm() - r;
+  }
 }
 
 /** 1.4826 MAD of the distances within \a window of the surface; \a fallback if none is. */
@@ -44,8 +46,8 @@ robustScale(const Eigen::ArrayXf& e, float window, float fallback)
 }
 
 /** One reweighted Gauss-Newton step on \a points (Tukey weights at \a cutoff; with
- * \a normals, only the points that pass \a gate): updates (p, a, r). Array arithmetic over
- * the points (vectorised), the 5 x 5 system in double.
+ * \a normals, only the points that pass \a gate): updates (p, a, r). One pass over the points
+ * accumulates the normal equations (no per-point temporaries); the 5 x 5 system in double.
  * \return the sum of the weights, or -1 if the system is degenerate. */
 double
 reweightedStep(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
@@ -54,39 +56,48 @@ reweightedStep(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
 {
   const Eigen::Vector3f af = a.cast<float>(), pf = p.cast<float>();
   const Eigen::Vector3f u = af.unitOrthogonal(), v = af.cross(u);
-  const Eigen::Matrix3Xf w = points.colwise() - pf;
-  const Eigen::ArrayXf along = (af.transpose() * w).transpose().array();
-  const Eigen::ArrayXf wu = (u.transpose() * w).transpose().array();
-  const Eigen::ArrayXf wv = (v.transpose() * w).transpose().array();
-  const Eigen::ArrayXf rho = (wu.square() + wv.square()).sqrt();
-  const Eigen::ArrayXf e = rho - static_cast<float>(r);
-  const Eigen::ArrayXf t = (e / static_cast<float>(cutoff)).square();
-  Eigen::ArrayXf weight = (t < 1.f && rho > 0.f).select((1.f - t).square(), 0.f);
-  if (normals.cols() == points.cols()) {
-    // n . (d / rho) with d = wu u + wv v.
-    const Eigen::ArrayXf nu = (u.transpose() * normals).transpose().array();
-    const Eigen::ArrayXf nv = (v.transpose() * normals).transpose().array();
-    const Eigen::ArrayXf agree = nu * wu + nv * wv;
-    const float cos_normal = std::cos(gate.max_angle);
-    weight = ((gate.outward ? agree : agree.abs()) >= cos_normal * rho).select(weight, 0.f);
+  const bool gated = normals.cols() == points.cols();
+  const float cos_normal = std::cos(gate.max_angle);
+  const float rf = static_cast<float>(r);
+  const float inv_cutoff2 = static_cast<float>(1.0 / (cutoff * cutoff));
+  // Jacobian of e in (p_u, p_v, a_u, a_v, r): -(du, dv, along du, along dv, 1); the sums of
+  // w j j^T and w j e (upper triangle), accumulated in double.
+  Eigen::Matrix<double, 5, 5> jtj = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> jte = Eigen::Matrix<double, 5, 1>::Zero();
+  double support = 0.0;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - pf;
+    const float wu = u.dot(w), wv = v.dot(w);
+    const float rho = std::sqrt(wu * wu + wv * wv);
+    if (!(rho > 0.f))
+      continue;
+    const float e = rho - rf;
+    const float t = e * e * inv_cutoff2;
+    if (!(t < 1.f))
+      continue;
+    if (gated) {
+      const float agree = normals.col(i).dot(u) * wu + normals.col(i).dot(v) * wv;
+      if ((gate.outward ? agree : std::abs(agree)) < cos_normal * rho)
+        continue;
+    }
+    const double weight = static_cast<double>((1.f - t) * (1.f - t));
+    const float along = af.dot(w);
+    const float du = wu / rho, dv = wv / rho;
+    const double j[5] = {du, dv, along * du, along * dv, 1.0};
+    for (int row = 0; row < 5; ++row) {
+      const double wj = weight * j[row];
+      for (int col = row; col < 5; ++col)
+        jtj(row, col) += wj * j[col];
+      jte(row) += wj * static_cast<double>(e);
+    }
+    support += weight;
   }
-  const double support = weight.cast<double>().sum();
   if (support < 5.0)
     return -1.0;
-  // Jacobian of e in (p_u, p_v, a_u, a_v, r): -(du, dv, along du, along dv, 1).
-  const Eigen::ArrayXf inv = (rho > 0.f).select(rho.inverse(), 0.f);
-  const Eigen::ArrayXf du = wu * inv, dv = wv * inv;
-  Eigen::Matrix<float, Eigen::Dynamic, 5> j(points.cols(), 5);
-  j.col(0) = du.matrix();
-  j.col(1) = dv.matrix();
-  j.col(2) = (along * du).matrix();
-  j.col(3) = (along * dv).matrix();
-  j.col(4).setOnes();
-  const Eigen::Matrix<float, Eigen::Dynamic, 5> wj = j.array().colwise() * weight;
-  Eigen::Matrix<double, 5, 5> jtj = (wj.transpose() * j).cast<double>();
-  const Eigen::Matrix<double, 5, 1> jte = -(wj.transpose() * e.matrix()).cast<double>();
-  const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(jtj);
-  const Eigen::Matrix<double, 5, 1> delta = -ldlt.solve(jte);
+  const Eigen::Matrix<double, 5, 5> full = jtj.selfadjointView<Eigen::Upper>();
+  const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(full);
+  // e(x + delta) ~ e - j^T delta: the step solves (J^T W J) delta = J^T W e.
+  const Eigen::Matrix<double, 5, 1> delta = ldlt.solve(jte);
   if (ldlt.info() != Eigen::Success || !delta.allFinite() ||
       !(ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff()))
     return -1.0;
