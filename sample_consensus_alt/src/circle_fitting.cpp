@@ -118,6 +118,40 @@ houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, flo
 }
 
 bool
+fitCircleAlgebraic(const Eigen::Matrix2Xf& points, Circle& circle)
+{
+  const Eigen::Index n = points.cols();
+  if (n < 3)
+    return false;
+  // About the centroid, in units of the spread (conditioning): u^2 + v^2 + D u + E v + F = 0.
+  const Eigen::Vector2d mean = points.cast<double>().rowwise().mean();
+  const Eigen::Matrix2Xd centred = points.cast<double>().colwise() - mean;
+  const double spread = std::sqrt(centred.squaredNorm() / static_cast<double>(n));
+  if (!(spread > 0.0) || !std::isfinite(spread))
+    return false;
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector2d p = centred.col(i) / spread;
+    const Eigen::Vector3d row(p.x(), p.y(), 1.0);
+    ata.noalias() += row * row.transpose();
+    atb.noalias() -= row * p.squaredNorm();
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata);
+  const Eigen::Vector3d def = ldlt.solve(atb);
+  if (ldlt.info() != Eigen::Success || !def.allFinite() ||
+      !(ldlt.vectorD().cwiseAbs().minCoeff() > 1e-9 * ldlt.vectorD().cwiseAbs().maxCoeff()))
+    return false;
+  const Eigen::Vector2d centre = -0.5 * def.head<2>();
+  const double r2 = centre.squaredNorm() - def(2);
+  if (!(r2 > 0.0))
+    return false;
+  circle.center = (mean + spread * centre).cast<float>();
+  circle.radius = static_cast<float>(spread * std::sqrt(r2));
+  return circle.center.allFinite() && std::isfinite(circle.radius);
+}
+
+bool
 fitCircle(const Eigen::Matrix2Xf& points, float threshold, Circle& circle, int iterations)
 {
   const Eigen::Index n = points.cols();

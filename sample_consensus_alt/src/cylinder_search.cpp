@@ -155,67 +155,57 @@ supporters(const CylinderCues& cues, const std::vector<int>& active, const Eigen
   return support;
 }
 
-/** Step 2 for one axis: circle Hough on the supporters, circle and cylinder least squares. */
-std::optional<Candidate>
-fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eigen::Vector3f& axis,
-            const HoughCylinderParameters& params)
+/** The supporters of one axis projected on the plane orthogonal to it (q), with their unit
+ * projected normals (qm) and the normals' projected lengths. */
+struct Section {
+  Eigen::Matrix2Xf q, qm;
+  Eigen::RowVectorXf m_len;
+  float extent{0.f}; ///< diagonal of the projected points' bounding box
+};
+
+/** The indices of the \a section points that agree with circle \a c: within \a band of it, with
+ * a normal along its radius (params.normal_angle_threshold). Other structure that shares the
+ * axis direction (a table under a lying can) drops out here. */
+std::vector<Eigen::Index>
+agreeing(const Eigen::Matrix2Xf& pts, const Eigen::Matrix2Xf& nrm, const Circle& c, float band,
+         const HoughCylinderParameters& params)
 {
-  Eigen::Vector3f u, v;
-  basisFor(axis, u, v);
-  const std::vector<int> support = supporters(cues, active, axis, params);
-  if (support.size() < 5)
-    return std::nullopt;
+  const float cos_n = std::cos(params.normal_angle_threshold);
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < pts.cols(); ++i) {
+    const Eigen::Vector2f w = pts.col(i) - c.center;
+    const float d = w.norm();
+    const float along = nrm.col(i).dot(w);
+    if (std::abs(d - c.radius) < band &&
+        (params.outward_normals ? along : std::abs(along)) >= cos_n * d)
+      keep.push_back(i);
+  }
+  return keep;
+}
 
-  // The supporters projected on the plane orthogonal to the axis, with their normals.
-  Eigen::Matrix<float, 2, 3> project;
-  project << u.transpose(), v.transpose();
-  const Eigen::Matrix3Xf support_points = cues.points(Eigen::all, support);
-  const Eigen::Matrix3Xf support_normals = cues.normals(Eigen::all, support);
-  const Eigen::Matrix2Xf q = project * support_points;
-  const Eigen::Matrix2Xf m = project * support_normals;
-  const Eigen::RowVectorXf m_len = m.colwise().norm();
-  const Eigen::Matrix2Xf qm = m.array().rowwise() / m_len.array();
-  const float extent = (q.rowwise().maxCoeff() - q.rowwise().minCoeff()).norm();
-  const float r_max = std::min(params.radius_max, 2.f * extent);
-  if (!(r_max > params.radius_min))
-    return std::nullopt;
-
-  // Circle Hough voters: an even subset of the supporters whose normal is not along the axis.
+/** The circle Hough of a section (an even subset of at most 300 supporters whose normal is not
+ * along the axis votes); coarse to fine: with a wide radius range the first grid's cells can
+ * exceed the radius, so the agreeing points vote again over a range around the first estimate.
+ * \a cell: the final grid's cell. */
+std::optional<Circle>
+voteCircle(const Section& section, float r_max, const HoughCylinderParameters& params, float& cell)
+{
   std::vector<Eigen::Index> voters;
-  const auto n_support = static_cast<Eigen::Index>(support.size());
+  const auto n_support = section.q.cols();
   const Eigen::Index n_voters = std::min<Eigen::Index>(n_support, 300);
   for (Eigen::Index k = 0; k < n_voters; ++k) {
     const Eigen::Index i = k * n_support / n_voters;
-    if (m_len(i) > 0.3f)
+    if (section.m_len(i) > 0.3f)
       voters.push_back(i);
   }
-  const Eigen::Matrix2Xf vq = q(Eigen::all, voters);
-  const Eigen::Matrix2Xf vm = qm(Eigen::all, voters);
+  const Eigen::Matrix2Xf vq = section.q(Eigen::all, voters);
+  const Eigen::Matrix2Xf vm = section.qm(Eigen::all, voters);
   Circle circle;
   if (!houghCircle(vq, vm, params.radius_min, r_max, params.circle_grid, circle))
     return std::nullopt;
-  float cell = (extent + 2.f * r_max) / static_cast<float>(params.circle_grid);
-
-  // The points that agree with a circle: near it, with a normal along its radius. Other
-  // structure that shares the axis direction (a table under a lying can) drops out here.
-  const float cos_n = std::cos(params.normal_angle_threshold);
-  const auto agreeing = [&](const Eigen::Matrix2Xf& pts, const Eigen::Matrix2Xf& nrm,
-                            const Circle& c, float band) {
-    std::vector<Eigen::Index> keep;
-    for (Eigen::Index i = 0; i < pts.cols(); ++i) {
-      const Eigen::Vector2f w = pts.col(i) - c.center;
-      const float d = w.norm();
-      const float along = nrm.col(i).dot(w);
-      if (std::abs(d - c.radius) < band &&
-          (params.outward_normals ? along : std::abs(along)) >= cos_n * d)
-        keep.push_back(i);
-    }
-    return keep;
-  };
-  // Coarse to fine: with a wide radius range the first grid's cells can exceed the radius;
-  // vote again on the agreeing points over a range around the first estimate.
+  cell = (section.extent + 2.f * r_max) / static_cast<float>(params.circle_grid);
   if (cell > 0.1f * circle.radius) {
-    const auto keep = agreeing(vq, vm, circle, std::max(0.5f * circle.radius, 2.f * cell));
+    const auto keep = agreeing(vq, vm, circle, std::max(0.5f * circle.radius, 2.f * cell), params);
     if (keep.size() >= 5) {
       const float lo = std::max(params.radius_min, 0.5f * circle.radius - cell);
       const float hi = std::min(r_max, 1.5f * circle.radius + cell);
@@ -229,17 +219,100 @@ fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eige
       }
     }
   }
-  const auto keep = agreeing(q, qm, circle, std::max(0.3f * circle.radius, 3.f * cell));
-  if (keep.size() < 5 ||
-      !fitCircle(q(Eigen::all, keep), std::max(0.3f * circle.radius, 3.f * cell), circle))
+  return circle;
+}
+
+/** \a start refined on the section points that agree with it (fitCircle), if at least 5 do
+ * and the result keeps within [params.radius_min, r_max]. */
+std::optional<Circle>
+settleCircle(const Section& section, Circle start, float cell, float r_max,
+             const HoughCylinderParameters& params)
+{
+  const float band = std::max(0.3f * start.radius, 3.f * cell);
+  const auto keep = agreeing(section.q, section.qm, start, band, params);
+  if (keep.size() < 5 || !fitCircle(section.q(Eigen::all, keep), band, start))
     return std::nullopt;
-  if (circle.radius < params.radius_min || circle.radius > r_max)
+  if (start.radius < params.radius_min || start.radius > r_max)
+    return std::nullopt;
+  return start;
+}
+
+/** A section at least this many times longer along its axis than across is a sliver. */
+constexpr float kSliverElongation = 3.f;
+
+/** The circle of the section's points alone: the algebraic circle (fitCircleAlgebraic) settled
+ * (settleCircle), if at least half the points agree with it. */
+std::optional<Circle>
+pointsCircle(const Section& section, float cell, float r_max, const HoughCylinderParameters& params)
+{
+  Circle start;
+  if (!fitCircleAlgebraic(section.q, start))
+    return std::nullopt;
+  const float band = std::max(0.3f * start.radius, 3.f * cell);
+  if (2 * agreeing(section.q, section.qm, start, band, params).size() <
+      static_cast<std::size_t>(section.q.cols()))
+    return std::nullopt;
+  return settleCircle(section, start, cell, r_max, params);
+}
+
+/** Whether the \a support points reach along \a axis kSliverElongation times the \a extent
+ * of their section. */
+bool
+isSliver(const CylinderCues& cues, const std::vector<int>& support, const Eigen::Vector3f& axis,
+         float extent)
+{
+  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+  for (const int s : support) {
+    const float t = axis.dot(cues.points.col(s));
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  return hi - lo > kSliverElongation * extent;
+}
+
+/** Step 2 for one axis: circle Hough on the supporters (voteCircle), circle least squares
+ * (settleCircle). A sliver's normals may not place the centre: a tall cylinder seen over a
+ * narrow arc (mostly occluded) and sampled sparsely gets normals from neighbourhoods that span
+ * the whole arc, so they point nearly one way and the vote may find nothing. There the
+ * circle of the points alone (pointsCircle) is the start instead. Elsewhere (lids, clutter) a
+ * circle the normals do not see is not proposed. */
+std::optional<Candidate>
+fitPosition(const CylinderCues& cues, const std::vector<int>& active, const Eigen::Vector3f& axis,
+            const HoughCylinderParameters& params)
+{
+  Eigen::Vector3f u, v;
+  basisFor(axis, u, v);
+  const std::vector<int> support = supporters(cues, active, axis, params);
+  if (support.size() < 5)
+    return std::nullopt;
+  Eigen::Matrix<float, 2, 3> project;
+  project << u.transpose(), v.transpose();
+  // The supporters gathered first: a product with an indexed view copies far more.
+  const Eigen::Matrix3Xf support_points = cues.points(Eigen::all, support);
+  const Eigen::Matrix3Xf support_normals = cues.normals(Eigen::all, support);
+  Section section;
+  section.q = project * support_points;
+  const Eigen::Matrix2Xf m = project * support_normals;
+  section.m_len = m.colwise().norm();
+  section.qm = m.array().rowwise() / section.m_len.array();
+  section.extent = (section.q.rowwise().maxCoeff() - section.q.rowwise().minCoeff()).norm();
+  const float r_max = std::min(params.radius_max, 2.f * section.extent);
+  if (!(r_max > params.radius_min))
+    return std::nullopt;
+
+  float cell = (section.extent + 2.f * r_max) / static_cast<float>(params.circle_grid);
+  const std::optional<Circle> voted = voteCircle(section, r_max, params, cell);
+  std::optional<Circle> circle =
+    voted ? settleCircle(section, *voted, cell, r_max, params) : std::nullopt;
+  if (!circle && isSliver(cues, support, axis, section.extent))
+    circle = pointsCircle(section, cell, r_max, params);
+  if (!circle)
     return std::nullopt;
 
   Candidate c;
   c.axis = axis;
-  c.point_on_axis = circle.center.x() * u + circle.center.y() * v;
-  c.radius = circle.radius;
+  c.point_on_axis = circle->center.x() * u + circle->center.y() * v;
+  c.radius = circle->radius;
   c.radius_limit = r_max;
   const bool auto_threshold = params.distance_threshold <= 0.f;
   c.threshold = auto_threshold ? estimateThreshold(cues, support, c) : params.distance_threshold;

@@ -93,6 +93,13 @@ struct Circle {
 bool houghCircle(const Eigen::Matrix2Xf& points, const Eigen::Matrix2Xf& normals, float r_min,
                  float r_max, int grid, Circle& circle);
 
+/** \brief Algebraic circle fit (Kasa): the least squares of x^2 + y^2 + D x + E y + F = 0 over
+ * \a points, without normals. A start for fitCircle where the normals cannot place the centre
+ * (an arc whose normals come from neighbourhoods spanning all of it). Slightly short on a short,
+ * noisy arc; exact on exact points.
+ * \return false if fewer than 3 points or they are collinear. */
+bool fitCircleAlgebraic(const Eigen::Matrix2Xf& points, Circle& circle);
+
 /** \brief Geometric circle fit (Gauss-Newton on sum (|p - c| - r)^2), robust: the points within
  * \a threshold of the current circle are refitted, the threshold shrinking to 3 robust sigmas.
  * \return false if fewer than 3 points support the circle. */
