@@ -201,9 +201,10 @@ struct HoughCylinderParameters {
   bool refine{true};                     ///< sub-cell axis + 5-dof least squares
   /** With refine: how many candidates (the best by their normals' score) are refined on the
    * points (refineCylinderRobust) and then compared on the points they explain at one scale
-   * (pointSupport). Points stay informative where normals turn to noise (sigma above ~10% of
-   * the radius with k = 16 neighbours). 0: only the best candidate is refined, by least
-   * squares on its inliers (facyl 0.1). */
+   * (pointSupport), per unit of their own robust scale (a fit that bends to take in a table
+   * beside the cylinder spreads wider than the points' noise). Points stay informative where
+   * normals turn to noise (sigma above ~10% of the radius with k = 16 neighbours). 0: only the best
+   * candidate is refined, by least squares on its inliers (facyl 0.1). */
   std::size_t point_candidates{3};
   /** With point_candidates: above this noise (robust sigma of the points' distances to the
    * settled winner's surface, as a share of its radius; > 0) the given per-point cues count
