@@ -222,15 +222,16 @@ voteCircle(const Section& section, float r_max, const HoughCylinderParameters& p
   return circle;
 }
 
-/** \a start refined on the section points that agree with it (fitCircle), if at least 5 do
- * and the result keeps within [params.radius_min, r_max]. */
+/** \a start refined on the section points that agree with it (fitCircle), if at least 5 (and
+ * \a min_agreeing) do and the result keeps within [params.radius_min, r_max]. */
 std::optional<Circle>
 settleCircle(const Section& section, Circle start, float cell, float r_max,
-             const HoughCylinderParameters& params)
+             const HoughCylinderParameters& params, std::size_t min_agreeing = 5)
 {
   const float band = std::max(0.3f * start.radius, 3.f * cell);
   const auto keep = agreeing(section.q, section.qm, start, band, params);
-  if (keep.size() < 5 || !fitCircle(section.q(Eigen::all, keep), band, start))
+  if (keep.size() < std::max<std::size_t>(5, min_agreeing) ||
+      !fitCircle(section.q(Eigen::all, keep), band, start))
     return std::nullopt;
   if (start.radius < params.radius_min || start.radius > r_max)
     return std::nullopt;
@@ -248,11 +249,8 @@ pointsCircle(const Section& section, float cell, float r_max, const HoughCylinde
   Circle start;
   if (!fitCircleAlgebraic(section.q, start))
     return std::nullopt;
-  const float band = std::max(0.3f * start.radius, 3.f * cell);
-  if (2 * agreeing(section.q, section.qm, start, band, params).size() <
-      static_cast<std::size_t>(section.q.cols()))
-    return std::nullopt;
-  return settleCircle(section, start, cell, r_max, params);
+  const auto half = (static_cast<std::size_t>(section.q.cols()) + 1) / 2;
+  return settleCircle(section, start, cell, r_max, params, half);
 }
 
 /** Whether the \a support points reach along \a axis kSliverElongation times the \a extent
