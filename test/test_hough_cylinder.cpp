@@ -767,6 +767,43 @@ TEST(CylinderFitting, NormalRotationSlopeTellsCylindersFromPlanes)
   EXPECT_LT(facyl::normalRotationSlope(strip, strip_n, origin, z), 0.05f);
 }
 
+TEST(CylinderFitting, NormalRotationSlopeOfTwoLidsAndAnArcIsThePlanes)
+{
+  // A wide cylinder about z fitted to two parallel planes (two lids, x = 1 and x = -1) takes
+  // a strip of each, their centres not quite opposite, and a few points of a true arc between
+  // them whose normals turn: most inliers say "plane", and the slope must say so too. Pooled
+  // about one mean, the offset between the strips and the arc's leverage made this 0.5.
+  const Eigen::Index n_strip = 400, n_arc = 40;
+  Eigen::Matrix3Xf pts(3, 2 * n_strip + n_arc), nrm(3, 2 * n_strip + n_arc);
+  for (Eigen::Index i = 0; i < n_strip; ++i) {
+    const float t = -0.45f + 0.9f * static_cast<float>(i) / static_cast<float>(n_strip - 1);
+    const float z = 0.01f * static_cast<float>(i % 10);
+    pts.col(i) = Eigen::Vector3f(1.f, std::sin(t) + 0.15f, z);
+    nrm.col(i) = Eigen::Vector3f::UnitX();
+    pts.col(n_strip + i) = Eigen::Vector3f(-1.f, std::sin(t) - 0.1f, z);
+    nrm.col(n_strip + i) = -Eigen::Vector3f::UnitX();
+  }
+  for (Eigen::Index i = 0; i < n_arc; ++i) {
+    // The arc of a small cylinder about (0, 1.2), its normals radial to that axis.
+    const float t = -1.2f + 2.4f * static_cast<float>(i) / static_cast<float>(n_arc - 1);
+    const Eigen::Vector3f radial(std::sin(t), -std::cos(t), 0.f);
+    pts.col(2 * n_strip + i) = Eigen::Vector3f(0.f, 1.2f, 0.05f) + 0.3f * radial;
+    nrm.col(2 * n_strip + i) = radial;
+  }
+  const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
+  EXPECT_LT(facyl::normalRotationSlope(pts, nrm, origin, z), 0.05f);
+  // A true 80-degree arc with a few plane points (a lid's rim) still turns.
+  Eigen::Matrix3Xf arc(3, n_strip + n_arc), arc_n(3, n_strip + n_arc);
+  for (Eigen::Index i = 0; i < n_strip; ++i) {
+    const float t = -0.7f + 1.4f * static_cast<float>(i) / static_cast<float>(n_strip - 1);
+    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.01f * static_cast<float>(i % 10));
+    arc_n.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.f);
+  }
+  arc.rightCols(n_arc) = pts.leftCols(n_arc);
+  arc_n.rightCols(n_arc) = nrm.leftCols(n_arc);
+  EXPECT_GT(facyl::normalRotationSlope(arc, arc_n, origin, z), 0.9f);
+}
+
 TEST(CylinderFitting, VotesPeakAtTheAxis)
 {
   // Normals and c_max of an ideal cylinder about z: every mode peaks at z.

@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <array>
 
 #include <algorithm>
 #include <cmath>
@@ -245,6 +246,68 @@ refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
   return true;
 }
 
+namespace {
+
+/** The turn of normals about an axis, as normalRotationSlope measures it: per inlier, its
+ * position angle (modulo pi, about the mean direction), the side of the axis it lies on, and
+ * the angle of its normal from the radial direction. */
+struct Turn {
+  std::vector<double> phi, eps;
+  std::vector<int> side;
+};
+
+/** The weighted least-squares line eps = alpha_side + beta phi of \a t: a common slope, an
+ * intercept per side (two strips on opposite sides pool their slopes, not the offset between
+ * them). */
+struct TurnLine {
+  std::array<double, 2> phi{}, eps{}; ///< weighted means per side
+  double beta{0.0}, var{0.0}, cov{0.0}, var_eps{0.0}, weight{0.0};
+  double residual(const Turn& t, std::size_t k) const
+  {
+    const auto g = static_cast<std::size_t>(t.side[k]);
+    return (t.eps[k] - eps[g]) - beta * (t.phi[k] - phi[g]);
+  }
+};
+
+TurnLine
+fitTurnLine(const Turn& t, const std::vector<double>& w)
+{
+  TurnLine line;
+  std::array<double, 2> weight{};
+  for (std::size_t k = 0; k < t.phi.size(); ++k) {
+    const auto g = static_cast<std::size_t>(t.side[k]);
+    weight[g] += w[k];
+    line.phi[g] += w[k] * t.phi[k];
+    line.eps[g] += w[k] * t.eps[k];
+  }
+  for (std::size_t g = 0; g < 2; ++g)
+    if (weight[g] > 0.0) {
+      line.phi[g] /= weight[g];
+      line.eps[g] /= weight[g];
+    }
+  for (std::size_t k = 0; k < t.phi.size(); ++k) {
+    const auto g = static_cast<std::size_t>(t.side[k]);
+    const double dp = t.phi[k] - line.phi[g], de = t.eps[k] - line.eps[g];
+    line.var += w[k] * dp * dp;
+    line.cov += w[k] * dp * de;
+    line.var_eps += w[k] * de * de;
+  }
+  line.weight = weight[0] + weight[1];
+  if (line.weight > 0.0) {
+    line.var /= line.weight;
+    line.cov /= line.weight;
+    line.var_eps /= line.weight;
+  }
+  line.beta = line.var > 0.0 ? line.cov / line.var : 0.0;
+  return line;
+}
+
+/** Rounds of Tukey-reweighted least squares of the turn: the points that most inliers agree
+ * on decide, not a few far-off ones (a cylinder's arc caught by a fit to its two lids). */
+constexpr int kTurnRounds = 4;
+
+} // namespace
+
 float
 normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
                     const Eigen::Vector3f& point_on_axis, const Eigen::Vector3f& axis)
@@ -254,9 +317,9 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
     return 1.f;
   const Eigen::Vector3f a = axis.normalized();
   const Eigen::Vector3f u = a.unitOrthogonal(), v = a.cross(u);
-  std::vector<double> phi, eps;
-  phi.reserve(static_cast<std::size_t>(n));
-  eps.reserve(static_cast<std::size_t>(n));
+  Turn t;
+  t.phi.reserve(static_cast<std::size_t>(n));
+  t.eps.reserve(static_cast<std::size_t>(n));
   double sum_sin = 0.0, sum_cos = 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Vector3f w = points.col(i) - point_on_axis;
@@ -267,42 +330,49 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
     if (m.dot(d) < 0.0)
       m = -m;
     const double angle = std::atan2(d.y(), d.x());
-    phi.push_back(angle);
-    eps.push_back(std::atan2(d.x() * m.y() - d.y() * m.x(), d.dot(m)));
+    t.phi.push_back(angle);
+    t.eps.push_back(std::atan2(d.x() * m.y() - d.y() * m.x(), d.dot(m)));
     sum_sin += std::sin(2.0 * angle); // angles modulo pi: opposite strips (two lids) pool
     sum_cos += std::cos(2.0 * angle);
   }
-  if (phi.size() < 3)
+  const std::size_t count = t.phi.size();
+  if (count < 3)
     return 1.f;
   const double mean_phi = 0.5 * std::atan2(sum_sin, sum_cos);
-  double var = 0.0, cov = 0.0, var_eps = 0.0, mean_eps = 0.0, mean_c = 0.0;
-  for (std::size_t k = 0; k < phi.size(); ++k) {
-    phi[k] = std::remainder(phi[k] - mean_phi, M_PI);
-    mean_c += phi[k];
-    mean_eps += eps[k];
+  t.side.resize(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    t.side[k] = std::cos(t.phi[k] - mean_phi) < 0.0 ? 1 : 0;
+    t.phi[k] = std::remainder(t.phi[k] - mean_phi, M_PI);
   }
-  const double count = static_cast<double>(phi.size());
-  mean_c /= count;
-  mean_eps /= count;
-  for (std::size_t k = 0; k < phi.size(); ++k) {
-    var += (phi[k] - mean_c) * (phi[k] - mean_c);
-    cov += (phi[k] - mean_c) * (eps[k] - mean_eps);
-    var_eps += (eps[k] - mean_eps) * (eps[k] - mean_eps);
-  }
-  var /= count;
-  cov /= count;
-  var_eps /= count;
+  std::vector<double> w(count, 1.0);
+  TurnLine line = fitTurnLine(t, w);
   // A uniform arc of width W has variance W^2 / 12: past a quarter turn (modulo pi), no plane
   // strip fits.
-  if (var > M_PI * M_PI / 48.0)
+  if (line.var > M_PI * M_PI / 48.0)
     return 1.f;
-  if (!(var > 0.0))
+  std::vector<double> residual(count);
+  for (int round = 0; round < kTurnRounds && line.var > 0.0; ++round) {
+    for (std::size_t k = 0; k < count; ++k)
+      residual[k] = std::abs(line.residual(t, k));
+    std::vector<double> sorted = residual;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(count / 2),
+                     sorted.end());
+    const double cut = 4.685 * 1.4826 * sorted[count / 2];
+    if (!(cut > 0.0))
+      break;
+    for (std::size_t k = 0; k < count; ++k) {
+      const double x = residual[k] / cut;
+      w[k] = x < 1.0 ? (1.0 - x * x) * (1.0 - x * x) : 0.0;
+    }
+    line = fitTurnLine(t, w);
+  }
+  if (!(line.var > 0.0))
     return 0.f;
   // The slope must be measured, not guessed: take its lower 2-sigma bound, so that an arc too
   // narrow for the normals' noise (a huge radius through a flat patch) scores 0.
-  const double slope = 1.0 + cov / var;
-  const double residual = std::max(0.0, var_eps - cov * cov / var);
-  const double standard_error = std::sqrt(residual / (count * var));
+  const double slope = 1.0 + line.beta;
+  const double residual_var = std::max(0.0, line.var_eps - line.cov * line.cov / line.var);
+  const double standard_error = std::sqrt(residual_var / (line.weight * line.var));
   return static_cast<float>(std::clamp(slope - 2.0 * standard_error, 0.0, 1.0));
 }
 

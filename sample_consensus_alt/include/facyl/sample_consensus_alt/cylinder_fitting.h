@@ -159,9 +159,12 @@ float normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& no
  * least-squares slope of (normal angle) against (position angle) over the inliers, about 1 on
  * a cylinder and about 0 on a plane strip that a wide cylinder happens to fit (a lid seen from
  * an axis in its plane). Angles are taken modulo pi, so strips on opposite sides (two lids)
- * pool. Returns the slope's lower 2-sigma bound clamped to [0, 1], so an arc too narrow for
- * the normals' noise to show the turn scores 0; 1 when the inliers spread over more than a
- * quarter turn (modulo pi; no plane strip does) or are fewer than 3.
+ * pool their slopes, each side with its own intercept. The line is Tukey-reweighted, so what
+ * most inliers say decides: a fit to two lids that also catches a few points of the true arc
+ * between them is still a plane. Returns the slope's lower 2-sigma bound clamped to [0, 1],
+ * so an arc too narrow for the normals' noise to show the turn scores 0; 1 when the inliers
+ * spread over more than a quarter turn (modulo pi, about each side's mean; no plane strip
+ * does) or are fewer than 3.
  * \param normals unit normals of \a points (sign not needed)
  */
 float normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
