@@ -443,6 +443,8 @@ struct Contender {
   Candidate candidate;
   CylinderModel model;
   double score{-1.0};
+  /** The seed's own axis, when refineAxis moved it by more than half the seed's cell. */
+  std::optional<Eigen::Vector3f> seed_axis;
 };
 
 /** The points' own noise (estimateLocalNoise over 12 neighbours, 128 samples of the active
@@ -709,25 +711,85 @@ public:
   }
 
 private:
+  /** The seed's refined axis competes (unless it was tried already); the seed's own axis
+   * instead when the refined one gives no candidate. */
   void tryOne(const AxisSeed& seed)
   {
-    Eigen::Vector3f axis = seed.axis;
-    if (params_.refine) {
-      axis = refineAxis(refining_, seed.axis, std::max(3.f * seed.cell_radius, 10.f * kOneDegree));
-      if (std::any_of(tried_.begin(), tried_.end(), [&](const Eigen::Vector3f& t) {
-            return axisAngle(t, axis) < 0.5f * kOneDegree;
-          }))
-        return;
-      tried_.push_back(axis);
+    if (!params_.refine) {
+      add(contend(seed.axis));
+      return;
     }
+    const Eigen::Vector3f axis =
+      refineAxis(refining_, seed.axis, std::max(3.f * seed.cell_radius, 10.f * kOneDegree));
+    if (!untried(axis))
+      return;
+    std::optional<Contender> refined = contend(axis);
+    const bool moved = axisAngle(axis, seed.axis) > 0.5f * seed.cell_radius;
+    if (refined && moved)
+      refined->seed_axis = seed.axis;
+    else if (!refined && moved && untried(seed.axis))
+      refined = contend(seed.axis);
+    add(std::move(refined));
+  }
+
+public:
+  /** The contenders whose refineAxis moved their seed by more than half a cell meet their
+   * seed's own axis, and the better of the two stays (fitterOfPair): the normals of a plane
+   * beside the cylinder, nearly parallel to its axis, fall in the refinement's window and
+   * can pull it off. */
+  void meetSeedAxes()
+  {
+    for (Contender& c : contenders_) {
+      if (!c.seed_axis || !untried(*c.seed_axis))
+        continue;
+      std::optional<Contender> better = fitterOfPair(c, contend(*c.seed_axis));
+      c = std::move(*better);
+    }
+  }
+
+private:
+  /** Whether no axis within half a degree of \a axis was tried; if so, it is now. */
+  bool untried(const Eigen::Vector3f& axis)
+  {
+    if (std::any_of(tried_.begin(), tried_.end(), [&](const Eigen::Vector3f& t) {
+          return axisAngle(t, axis) < 0.5f * kOneDegree;
+        }))
+      return false;
+    tried_.push_back(axis);
+    return true;
+  }
+  /** The candidate on \a axis (fitPosition), described and scored; nothing if none. */
+  std::optional<Contender> contend(const Eigen::Vector3f& axis) const
+  {
     const auto candidate = fitPosition(cues_, active_, axis, params_);
     if (!candidate)
-      return;
+      return std::nullopt;
     Contender c;
     c.candidate = *candidate;
     c.model = describe(cues_, active_, *candidate, params_);
     c.score = candidateScore(cues_, c.model, curvature_);
-    contenders_.push_back(std::move(c));
+    return c;
+  }
+  /** The better of \a a (the refined axis's) and \a b (the seed's own), scored at the
+   * tighter of their two inlier thresholds: each threshold comes from its own residuals, so a
+   * loose fit (a circle twice too wide on an axis a few degrees off a narrow arc) would
+   * otherwise win by the points its own looseness admits. Ties go to \a a. */
+  std::optional<Contender> fitterOfPair(std::optional<Contender> a,
+                                        std::optional<Contender> b) const
+  {
+    if (!a || !b)
+      return a ? a : b;
+    const float common = std::min(a->candidate.threshold, b->candidate.threshold);
+    const auto scoreAt = [&](Candidate c) {
+      c.threshold = common;
+      return candidateScore(cues_, describe(cues_, active_, c, params_), curvature_);
+    };
+    return scoreAt(b->candidate) > scoreAt(a->candidate) ? b : a;
+  }
+  void add(std::optional<Contender> c)
+  {
+    if (c)
+      contenders_.push_back(std::move(*c));
   }
 
   const CylinderCues& cues_;
@@ -736,7 +798,7 @@ private:
   const HoughCylinderParameters& params_;
   const bool curvature_;
   std::vector<Contender> contenders_;
-  std::vector<Eigen::Vector3f> tried_; ///< refined axes
+  std::vector<Eigen::Vector3f> tried_; ///< axes positioned so far
 };
 
 /** The candidates that the cues propose among the \a active points: the seeds (the
@@ -768,6 +830,10 @@ competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
     addVotePeaks(accumulators.front(), voting, VotingMode::SoftNormal, params, 1, more);
     competition.run({more.begin() + static_cast<std::ptrdiff_t>(seeds.size()), more.end()});
   }
+  // Only when no candidate convinces: a good fit needs no second look, and positioning every
+  // seed twice would double the fit's time.
+  if (!competition.convincing())
+    competition.meetSeedAxes();
   return std::move(competition).contenders();
 }
 
