@@ -197,6 +197,29 @@ TEST(HoughCylinderEstimation, HoldsAtHighNoiseBesideAPlane)
   }
 }
 
+TEST(HoughCylinderEstimation, HoldsBesideAPlaneAtThreeQuartersOcclusion)
+{
+  // facyl_bench's practical setting at 75% occlusion: a quarter of the side beside a plane
+  // nearly parallel to the axis. The plane's normals fall in the window of the axis
+  // refinement and can pull it a few degrees off, where no circle explains the arc; the
+  // seed's own axis then meets the refined one (SeedCompetition::meetSeedAxes). These 60
+  // clouds: 2 failures (axis > 10 deg or none), 7 without the meeting.
+  constexpr int kRuns = 60;
+  int failures = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    auto p = randomCylinder(run, 0.f, 0.01f);
+    p.occlusion = 0.75f;
+    const auto sim = facyl::simulateCylinder(p);
+    Hough hough;
+    hough.setRadiusLimits(0.01f, 0.5f);
+    const auto o = fitOnce(withPlaneBeside(sim, p, run), sim.truth, hough);
+    failures += o.axis_deg > 10.f;
+  }
+  std::printf("[ figures  ] plane beside, 75%% occlusion, %d fits: %d off by > 10 deg\n", kRuns,
+              failures);
+  EXPECT_LE(failures, 3);
+}
+
 TEST(HoughCylinderEstimation, FindsANarrowSliverOfATallCylinder)
 {
   // facyl_bench, random setting, occlusion 75%: a tall, thin cylinder seen over a quarter of its
