@@ -678,6 +678,72 @@ ranked(const std::vector<Contender>& contenders, std::size_t count)
   return order;
 }
 
+/** Whether the best of \a contenders is convincing: a quarter of the \a active points, half
+ * the circumference. */
+bool
+convinces(const std::vector<Contender>& contenders, std::size_t active)
+{
+  const auto b = ranked(contenders, 1);
+  return !b.empty() && b[0]->model.angular_coverage >= 0.5f &&
+         4 * b[0]->model.inliers.size() >= active;
+}
+
+/** The candidate on \a axis among the \a active points (fitPosition), described and scored;
+ * nothing if none. */
+std::optional<Contender>
+contend(const CylinderCues& cues, const std::vector<int>& active, const Eigen::Vector3f& axis,
+        const HoughCylinderParameters& params)
+{
+  const auto candidate = fitPosition(cues, active, axis, params);
+  if (!candidate)
+    return std::nullopt;
+  Contender c;
+  c.candidate = *candidate;
+  c.model = describe(cues, active, *candidate, params);
+  c.score = candidateScore(cues, c.model, params.voting_mode == VotingMode::SoftCurvature);
+  return c;
+}
+
+/** The better of \a a and \a b, scored at the tighter of their two inlier thresholds: each
+ * threshold comes from its own residuals, so a loose fit (a circle twice too wide on an axis a
+ * few degrees off a narrow arc) would otherwise win by the points its own looseness admits.
+ * Ties go to \a a. */
+const Contender&
+fitterOfPair(const CylinderCues& cues, const std::vector<int>& active, const Contender& a,
+             const Contender& b, const HoughCylinderParameters& params)
+{
+  const float common = std::min(a.candidate.threshold, b.candidate.threshold);
+  const auto scoreAt = [&](Candidate c) {
+    c.threshold = common;
+    return candidateScore(cues, describe(cues, active, c, params),
+                          params.voting_mode == VotingMode::SoftCurvature);
+  };
+  return scoreAt(b.candidate) > scoreAt(a.candidate) ? b : a;
+}
+
+/** The \a contenders whose refineAxis moved their seed by more than half a cell meet their
+ * seed's own axis, and the better of the two stays (fitterOfPair): the normals of a plane
+ * beside the cylinder, nearly parallel to its axis, fall in the refinement's window and can
+ * pull it off (facyl_bench, practical setting, 75% occlusion: 4-6 failures of 60 instead of
+ * 10-11). \return whether any contender changed. */
+bool
+meetSeedAxes(const CylinderCues& cues, const std::vector<int>& active,
+             std::vector<Contender>& contenders, const HoughCylinderParameters& params)
+{
+  bool changed = false;
+  for (Contender& c : contenders) {
+    if (!c.seed_axis)
+      continue;
+    const std::optional<Contender> own = contend(cues, active, *c.seed_axis, params);
+    c.seed_axis.reset();
+    if (own && &fitterOfPair(cues, active, c, *own, params) == &*own) {
+      c = *own;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
 /** The competition of the seeds' candidates: each seed is refined (unless its refined axis
  * was tried already), positioned and scored by its inliers. */
 class SeedCompetition {
@@ -697,13 +763,10 @@ public:
     for (const AxisSeed& seed : seeds)
       tryOne(seed);
   }
-  /** Whether the best candidate is convincing: a quarter of the points, half the
-   * circumference. */
+  /** Whether the best candidate is convincing (convinces). */
   bool convincing() const
   {
-    const auto b = ranked(contenders_, 1);
-    return !b.empty() && b[0]->model.angular_coverage >= 0.5f &&
-           4 * b[0]->model.inliers.size() >= active_.size();
+    return convinces(contenders_, active_.size());
   }
   std::vector<Contender> contenders() &&
   {
@@ -732,21 +795,6 @@ private:
     add(std::move(refined));
   }
 
-public:
-  /** The contenders whose refineAxis moved their seed by more than half a cell meet their
-   * seed's own axis, and the better of the two stays (fitterOfPair): the normals of a plane
-   * beside the cylinder, nearly parallel to its axis, fall in the refinement's window and
-   * can pull it off. */
-  void meetSeedAxes()
-  {
-    for (Contender& c : contenders_) {
-      if (!c.seed_axis || !untried(*c.seed_axis))
-        continue;
-      std::optional<Contender> better = fitterOfPair(c, contend(*c.seed_axis));
-      c = std::move(*better);
-    }
-  }
-
 private:
   /** Whether no axis within half a degree of \a axis was tried; if so, it is now. */
   bool untried(const Eigen::Vector3f& axis)
@@ -758,33 +806,9 @@ private:
     tried_.push_back(axis);
     return true;
   }
-  /** The candidate on \a axis (fitPosition), described and scored; nothing if none. */
   std::optional<Contender> contend(const Eigen::Vector3f& axis) const
   {
-    const auto candidate = fitPosition(cues_, active_, axis, params_);
-    if (!candidate)
-      return std::nullopt;
-    Contender c;
-    c.candidate = *candidate;
-    c.model = describe(cues_, active_, *candidate, params_);
-    c.score = candidateScore(cues_, c.model, curvature_);
-    return c;
-  }
-  /** The better of \a a (the refined axis's) and \a b (the seed's own), scored at the
-   * tighter of their two inlier thresholds: each threshold comes from its own residuals, so a
-   * loose fit (a circle twice too wide on an axis a few degrees off a narrow arc) would
-   * otherwise win by the points its own looseness admits. Ties go to \a a. */
-  std::optional<Contender> fitterOfPair(std::optional<Contender> a,
-                                        std::optional<Contender> b) const
-  {
-    if (!a || !b)
-      return a ? a : b;
-    const float common = std::min(a->candidate.threshold, b->candidate.threshold);
-    const auto scoreAt = [&](Candidate c) {
-      c.threshold = common;
-      return candidateScore(cues_, describe(cues_, active_, c, params_), curvature_);
-    };
-    return scoreAt(b->candidate) > scoreAt(a->candidate) ? b : a;
+    return facyl::contend(cues_, active_, axis, params_);
   }
   void add(std::optional<Contender> c)
   {
@@ -830,10 +854,6 @@ competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
     addVotePeaks(accumulators.front(), voting, VotingMode::SoftNormal, params, 1, more);
     competition.run({more.begin() + static_cast<std::ptrdiff_t>(seeds.size()), more.end()});
   }
-  // Only when no candidate convinces: a good fit needs no second look, and positioning every
-  // seed twice would double the fit's time.
-  if (!competition.convincing())
-    competition.meetSeedAxes();
   return std::move(competition).contenders();
 }
 
@@ -866,6 +886,21 @@ coarserCues(const CylinderCues& cues, const std::vector<int>& active, float radi
   return out;
 }
 
+/** The answer while the cues are good: \a refined (the best of \a contenders, refined on its
+ * inliers), unless no contender convinces and a seed's own axis, met (meetSeedAxes), gives
+ * a new best; then that one, refined. Not at high noise: there refineAxis moves a seed by
+ * noise, and the competition on the points decides instead (facyl_bench, paper setting, 10%
+ * noise: meeting there turned 3 good fits of 200 into failures). */
+Candidate
+goodCuesFit(const CylinderCues& cues, const std::vector<int>& active,
+            std::vector<Contender>& contenders, const Candidate& refined,
+            const HoughCylinderParameters& params)
+{
+  if (convinces(contenders, active.size()) || !meetSeedAxes(cues, active, contenders, params))
+    return refined;
+  return refineCandidate(cues, active, ranked(contenders, 1).front()->candidate, params);
+}
+
 /** One cylinder among the \a active points: the candidates of the cues (competeSeeds), the best
  * refined (with params.refine) and described. When the best candidate's normals are more noise
  * than cue, cues at a coarser scale (half its radius) propose candidates too, and these cues
@@ -875,7 +910,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
        const std::vector<OrientationAccumulator>& accumulators,
        const HoughCylinderParameters& params)
 {
-  const std::vector<Contender> contenders = competeSeeds(cues, active, accumulators, params);
+  std::vector<Contender> contenders = competeSeeds(cues, active, accumulators, params);
   if (contenders.empty())
     return std::nullopt;
   const std::vector<const Contender*> finalists =
@@ -889,7 +924,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   const LocalNoise local(cues, active);
   if (params.point_candidates == 0 ||
       !cuesAreNoise(probeNoise(cues, active, refined, params), local, params))
-    return describe(cues, active, refined, params);
+    return describe(cues, active, goodCuesFit(cues, active, contenders, refined, params), params);
 
   const auto settled = settleOnPoints(cues, active, finalists, params);
   if (!settled) // no refinement on the points held
