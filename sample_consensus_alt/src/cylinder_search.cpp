@@ -754,7 +754,6 @@ public:
       , active_(active)
       , refining_(refining)
       , params_(params)
-      , curvature_(params.voting_mode == VotingMode::SoftCurvature)
   {
   }
 
@@ -775,7 +774,8 @@ public:
 
 private:
   /** The seed's refined axis competes (unless it was tried already); the seed's own axis
-   * instead when the refined one gives no candidate. */
+   * instead when the refined one, moved by more than half a cell, gives no candidate. A moved
+   * seed's own axis is kept for meetSeedAxes. */
   void tryOne(const AxisSeed& seed)
   {
     if (!params_.refine) {
@@ -794,8 +794,6 @@ private:
       refined = contend(seed.axis);
     add(std::move(refined));
   }
-
-private:
   /** Whether no axis within half a degree of \a axis was tried; if so, it is now. */
   bool untried(const Eigen::Vector3f& axis)
   {
@@ -820,7 +818,6 @@ private:
   const std::vector<int>& active_;
   const VotingCues& refining_;
   const HoughCylinderParameters& params_;
-  const bool curvature_;
   std::vector<Contender> contenders_;
   std::vector<Eigen::Vector3f> tried_; ///< axes positioned so far
 };
