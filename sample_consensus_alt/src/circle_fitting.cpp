@@ -350,14 +350,12 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
   // strip fits.
   if (line.var > M_PI * M_PI / 48.0)
     return 1.f;
-  std::vector<double> residual(count);
+  std::vector<double> residual(count), sorted(count);
   for (int round = 0; round < kTurnRounds && line.var > 0.0; ++round) {
     for (std::size_t k = 0; k < count; ++k)
       residual[k] = std::abs(line.residual(t, k));
-    std::vector<double> sorted = residual;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(count / 2),
-                     sorted.end());
-    const double cut = 4.685 * 1.4826 * sorted[count / 2];
+    sorted.assign(residual.begin(), residual.end());
+    const double cut = 4.685 * 1.4826 * medianOf(sorted);
     if (!(cut > 0.0))
       break;
     for (std::size_t k = 0; k < count; ++k) {

@@ -713,12 +713,15 @@ fitterOfPair(const CylinderCues& cues, const std::vector<int>& active, const Con
              const Contender& b, const HoughCylinderParameters& params)
 {
   const float common = std::min(a.candidate.threshold, b.candidate.threshold);
-  const auto scoreAt = [&](Candidate c) {
+  const auto scoreAt = [&](const Contender& x) {
+    if (x.candidate.threshold == common) // scored at it already
+      return x.score;
+    Candidate c = x.candidate;
     c.threshold = common;
     return candidateScore(cues, describe(cues, active, c, params),
                           params.voting_mode == VotingMode::SoftCurvature);
   };
-  return scoreAt(b.candidate) > scoreAt(a.candidate) ? b : a;
+  return scoreAt(b) > scoreAt(a) ? b : a;
 }
 
 /** The \a contenders whose refineAxis moved their seed by more than half a cell meet their

@@ -17,11 +17,12 @@ namespace facyl {
 namespace detail {
 
 /** The median of \a v (reordered); 0 when empty. */
-inline float
-medianOf(std::vector<float>& v)
+template <typename T>
+T
+medianOf(std::vector<T>& v)
 {
   if (v.empty())
-    return 0.f;
+    return T(0);
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
