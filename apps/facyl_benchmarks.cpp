@@ -284,11 +284,17 @@ BM_Frame(benchmark::State& state, const std::string& file)
     }
     const auto& t = rec.getTiming();
     sum.segmentation += t.segmentation;
+    sum.segmentation_steps.planes += t.segmentation_steps.planes;
+    sum.segmentation_steps.points += t.segmentation_steps.points;
+    sum.segmentation_steps.objects += t.segmentation_steps.objects;
     sum.classification += t.classification;
     sum.fitting += t.fitting;
   }
   const double n = static_cast<double>(state.iterations());
   state.counters["segmentation_ms"] = sum.segmentation / n;
+  state.counters["planes_ms"] = sum.segmentation_steps.planes / n;
+  state.counters["points_ms"] = sum.segmentation_steps.points / n;
+  state.counters["objects_ms"] = sum.segmentation_steps.objects / n;
   state.counters["classification_ms"] = sum.classification / n;
   state.counters["fitting_ms"] = sum.fitting / n;
   state.counters["objects"] = static_cast<double>(objects.size());

@@ -213,10 +213,13 @@ segmentationHeader(const std::string& title)
 void
 timingReport(const std::vector<facyl::RecognitionTiming>& t, const std::vector<double>& objects)
 {
-  std::vector<double> s, c, f, total;
-  for (const auto& x : t)
+  std::vector<double> s, c, f, total, planes, points, clustering;
+  for (const auto& x : t) {
     s.push_back(x.segmentation), c.push_back(x.classification), f.push_back(x.fitting),
       total.push_back(x.total);
+    planes.push_back(x.segmentation_steps.planes), points.push_back(x.segmentation_steps.points),
+      clustering.push_back(x.segmentation_steps.objects);
+  }
   const auto mean = [](const std::vector<double>& v) {
     double m = 0.0;
     for (const double x : v)
@@ -229,6 +232,8 @@ timingReport(const std::vector<facyl::RecognitionTiming>& t, const std::vector<d
   std::printf("Mean per frame: %.2f objects; segmentation %.2f, classification %.2f, fitting "
               "%.2f, total %.2f ms\n",
               mean(objects), mean(s), mean(c), mean(f), mean(total));
+  std::printf("Segmentation steps (ms, median): planes %.2f, points %.2f, objects %.2f\n",
+              median(planes), median(points), median(clustering));
 }
 
 struct Options {

@@ -477,6 +477,13 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
     const auto& t = rec.getTiming();
     EXPECT_GT(t.total, 0.0);
     EXPECT_GE(t.total + 1e-9, t.segmentation + t.fitting);
+    // The segmentation's own split: each step measured, together within its total.
+    const auto& steps = t.segmentation_steps;
+    EXPECT_GT(steps.planes, 0.0);
+    EXPECT_GT(steps.points, 0.0);
+    EXPECT_GT(steps.objects, 0.0);
+    EXPECT_GE(steps.total + 1e-9, steps.planes + steps.points + steps.objects);
+    EXPECT_GE(t.segmentation + 1e-9, steps.total);
     std::map<int, const facyl::RecognizedObject*> by_id;
     for (const auto& o : objects) {
       const int id = majorityId(s, o.cluster.indices.indices);

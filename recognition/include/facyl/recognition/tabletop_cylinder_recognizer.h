@@ -97,6 +97,7 @@ struct RecognizedObject {
 /** \brief Wall-clock time per stage of the last recognize() (ms), like the paper's Table III. */
 struct RecognitionTiming {
   double segmentation{0.0};
+  SegmentationTiming segmentation_steps; ///< the segmentation's own split
   double classification{0.0};
   double fitting{0.0};
   double total{0.0};
@@ -238,6 +239,11 @@ private:
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   ShapeClassifier::Ptr classifier_;
   TabletopSegmentation<PointT> segmentation_;
+  /** What segmentation_ was last given by setIndices: given again only when it changes, so
+   * that the segmentation keeps the index list it makes of a whole frame (else made again at
+   * every frame: 1.2 MB zeroed and numbered at VGA). */
+  pcl::IndicesConstPtr segmentation_indices_;
+  bool segmentation_indices_set_{false};
   RecognitionTiming timing_;
   bool configured_{false};
   NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;

@@ -155,6 +155,16 @@ sensorFrameCopy(const pcl::PointCloud<PointT>& cloud, const Eigen::Affine3f& pos
   return local;
 }
 
+template <typename PointT> class TabletopCylinderRecognizer;
+
+/** \brief Wall-clock time per step of the last TabletopSegmentation::segment() (ms). */
+struct SegmentationTiming {
+  double planes{0.0};  ///< the plane grid, its seeds and their regions (the candidates)
+  double points{0.0};  ///< every point sorted onto and above the candidates (one pass)
+  double objects{0.0}; ///< the families of supports tried, the objects clustered and placed
+  double total{0.0};
+};
+
 /** \brief One object above a support. */
 struct TabletopCluster {
   pcl::PointIndices indices;    ///< into the input cloud, ascending
@@ -278,7 +288,10 @@ public:
   }
 
   /** \brief Runs the segmentation. \return false (with PCL_ERROR) on bad input. */
-  bool segment(std::vector<TabletopCluster>& clusters);
+  bool segment(std::vector<TabletopCluster>& clusters)
+  {
+    return run(clusters, true);
+  }
 
   /** \brief Moves the results of the last run (supports, table, hull, and \a clusters'
    * centroids) by the rigid transform \a t: for a caller that ran segment() on a copy of its
@@ -290,6 +303,11 @@ public:
   const std::vector<SupportPlane>& getSupports() const
   {
     return supports_;
+  }
+  /** \brief Time per step of the last segment(). */
+  const SegmentationTiming& getTiming() const
+  {
+    return timing_;
   }
   /** \brief Focal length in pixels of the last organized input (the camera's, or estimated
    * from the cloud); 0 for unorganized clouds. */
@@ -365,6 +383,11 @@ private:
   bool searchedAsImage() const;
   /** segment() on a cloud in the sensor's frame (identity sensor pose). */
   bool segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
+  /** segment(); with \a check_pose false, the cloud is known to be in the sensor's frame and
+   * within kMaxCoordinate (the recognizer's own checks, or its copy, made it so): its sensor
+   * pose and far points are not looked for again (a pass over the frame). */
+  bool run(std::vector<TabletopCluster>& clusters, bool check_pose);
+  template <typename> friend class TabletopCylinderRecognizer; // runs run(clusters, false)
   /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
    * depth near the first one's, its normal, and its first pixel; with \a twice, also the grid
    * of 2 \a step pixels, from the same pass over the image. */
@@ -448,6 +471,7 @@ private:
   PinholeCamera camera_;
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   std::vector<SupportPlane> supports_;
+  SegmentationTiming timing_;
   std::vector<std::vector<Eigen::Vector2f>> extents_; ///< hulls of all the supports' points
   /** Per candidate of the last run: its hulls (see supportHull) and region area, computed once
    * for all the trials of its family. */

@@ -87,6 +87,9 @@ sceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
   for (std::size_t k = 0; k < objects.size(); ++k)
     j["objects"].push_back(objectJson(k, objects[k], digits));
   j["timing_ms"]["segmentation"] = jsonNumber(t.segmentation, digits);
+  j["timing_ms"]["segmentation_planes"] = jsonNumber(t.segmentation_steps.planes, digits);
+  j["timing_ms"]["segmentation_points"] = jsonNumber(t.segmentation_steps.points, digits);
+  j["timing_ms"]["segmentation_objects"] = jsonNumber(t.segmentation_steps.objects, digits);
   j["timing_ms"]["classification"] = jsonNumber(t.classification, digits);
   j["timing_ms"]["fitting"] = jsonNumber(t.fitting, digits);
   j["timing_ms"]["total"] = jsonNumber(t.total, digits);

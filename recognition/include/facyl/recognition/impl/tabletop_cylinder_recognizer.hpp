@@ -139,11 +139,17 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   std::vector<TabletopCluster> clusters;
   segmentation_.setParameters(params_.segmentation);
   segmentation_.setInputCloud(input_);
-  segmentation_.setIndices(indices_); // nullptr: the whole cloud
+  if (!segmentation_indices_set_ || segmentation_indices_ != indices_) {
+    segmentation_.setIndices(indices_); // nullptr: the whole cloud
+    segmentation_indices_ = indices_;
+    segmentation_indices_set_ = true;
+  }
   segmentation_.setCamera(camera_);
   segmentation_.setUpDirection(up_);
-  const bool segmented = segmentation_.segment(clusters);
+  // The cloud is in the sensor's frame, its far points gone (recognize() saw to it).
+  const bool segmented = segmentation_.run(clusters, false);
   timing_.segmentation = ms(t0, Clock::now());
+  timing_.segmentation_steps = segmentation_.getTiming();
   if (!segmented) {
     timing_.total = ms(t0, Clock::now());
     return false;

@@ -46,10 +46,12 @@ TabletopSegmentation<PointT>::reset()
 
 template <typename PointT>
 bool
-TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
+TabletopSegmentation<PointT>::run(std::vector<TabletopCluster>& clusters, bool check_pose)
 {
   clusters.clear();
   reset();
+  timing_ = SegmentationTiming{};
+  const auto t0 = std::chrono::steady_clock::now();
   const std::string why = validate(params_);
   if (!why.empty()) {
     PCL_ERROR("[facyl::TabletopSegmentation::segment] Invalid parameters: %s.\n", why.c_str());
@@ -82,8 +84,9 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
     this->deinitCompute();
     return false;
   }
-  const Eigen::Affine3f pose = plausibleSensorPose(*input_);
-  const std::size_t far = countFarPoints(*input_);
+  const Eigen::Affine3f pose =
+    check_pose ? plausibleSensorPose(*input_) : Eigen::Affine3f(Eigen::Affine3f::Identity());
+  const std::size_t far = check_pose ? countFarPoints(*input_) : 0;
   if (far > 0)
     PCL_WARN("[facyl::TabletopSegmentation::segment] %zu points have a coordinate beyond +-%g "
              "and are ignored (treated as missing).\n",
@@ -105,6 +108,8 @@ TabletopSegmentation<PointT>::segment(std::vector<TabletopCluster>& clusters)
       transformResults(pose, clusters);
   }
   this->deinitCompute();
+  timing_.total =
+    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return found;
 }
 
@@ -184,6 +189,8 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
     if (!trial.supports.empty())
       best = std::move(trial);
   }
+  timing_.planes = t_planes;
+  timing_.points = t_points - t_planes;
   PCL_DEBUG("[facyl::TabletopSegmentation] %.2f ms: planes %.2f, points %.2f, family %zu of "
             "%zu (%zu with supports)\n",
             ms(t0), t_planes, t_points - t_planes, chosen, families.size(), tried);
@@ -213,6 +220,7 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
   });
+  timing_.objects = ms(t0) - t_points;
   return true;
 }
 
