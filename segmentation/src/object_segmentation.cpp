@@ -154,9 +154,32 @@ public:
   /** Compact number of pixel (u, v), or -1 (outside the image, or not valid). */
   int at(int u, int v) const
   {
-    if (u < 0 || v < 0 || u >= w_ || v >= h_)
+    // One unsigned comparison per coordinate: negative ones wrap beyond the size.
+    if (static_cast<unsigned>(u) >= static_cast<unsigned>(w_) ||
+        static_cast<unsigned>(v) >= static_cast<unsigned>(h_))
       return -1;
-    return slot_[static_cast<std::size_t>(v) * w_ + u];
+    return slot_[static_cast<std::size_t>(v) * static_cast<std::size_t>(w_) +
+                 static_cast<std::size_t>(u)];
+  }
+  /** at() of the pixels of column \a u (valid) in rows v + d, d in [d0, d1], into \a out:
+   * one bounds test per row and no multiplication per pixel. */
+  template <int d0, int d1> void column(int u, int v, int (&out)[d1 - d0 + 1]) const
+  {
+    const auto stride = static_cast<std::ptrdiff_t>(w_);
+    const int* centre =
+      slot_.data() + static_cast<std::ptrdiff_t>(v) * stride + static_cast<std::ptrdiff_t>(u);
+    for (int d = d0; d <= d1; ++d)
+      out[d - d0] =
+        static_cast<unsigned>(v + d) < static_cast<unsigned>(h_) ? centre[d * stride] : -1;
+  }
+  /** The same for row \a v (valid), columns u + d. */
+  template <int d0, int d1> void row(int u, int v, int (&out)[d1 - d0 + 1]) const
+  {
+    const int* centre = slot_.data() +
+                        static_cast<std::ptrdiff_t>(v) * static_cast<std::ptrdiff_t>(w_) +
+                        static_cast<std::ptrdiff_t>(u);
+    for (int d = d0; d <= d1; ++d)
+      out[d - d0] = static_cast<unsigned>(u + d) < static_cast<unsigned>(w_) ? centre[d] : -1;
   }
   const Eigen::Vector3f& point(int c) const
   {
@@ -218,8 +241,12 @@ acrossMeans(const Grid& grid, bool horizontal)
     grid.position(static_cast<int>(c), u, v);
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
     int n = 0;
-    for (int d = -2; d <= 2; ++d) {
-      const int b = horizontal ? grid.at(u, v + d) : grid.at(u + d, v);
+    int across[5];
+    if (horizontal)
+      grid.column<-2, 2>(u, v, across);
+    else
+      grid.row<-2, 2>(u, v, across);
+    for (const int b : across) {
       if (b >= 0) {
         sum += grid.point(b);
         ++n;
