@@ -59,8 +59,13 @@ estimateDepthBand(const std::vector<float>& ranges, const std::vector<float>& re
     b.factor = factor;
     return b;
   }
-  std::sort(pairs.begin(), pairs.end());
   const std::size_t bins = std::clamp<std::size_t>(pairs.size() / 150, 1, 8);
+  // The bins of equal counts by range: each bin holds the pairs a sort would put there (pairs
+  // that compare equal are equal), in some order, which its medians do not see.
+  for (std::size_t b = 1; b < bins; ++b)
+    std::nth_element(pairs.begin() + static_cast<std::ptrdiff_t>((b - 1) * pairs.size() / bins),
+                     pairs.begin() + static_cast<std::ptrdiff_t>(b * pairs.size() / bins),
+                     pairs.end());
   DepthBand band;
   band.factor = factor;
   std::vector<float> r, a;
