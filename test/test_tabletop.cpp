@@ -342,6 +342,12 @@ TEST(TabletopSegmentation, FindsTheTableAndEveryObject)
     seg.setInputCloud(cloud);
     std::vector<facyl::TabletopCluster> clusters;
     ASSERT_TRUE(seg.segment(clusters));
+    // Its own timing: each step measured, together within the total.
+    const facyl::SegmentationTiming& t = seg.getTiming();
+    EXPECT_GT(t.planes, 0.0);
+    EXPECT_GT(t.points, 0.0);
+    EXPECT_GT(t.objects, 0.0);
+    EXPECT_GE(t.total + 1e-9, t.planes + t.points + t.objects);
     const auto& c = seg.getTableCoefficients().values;
     ASSERT_EQ(c.size(), 4u);
     EXPECT_LT(facyl_test::degrees(std::acos(
@@ -449,6 +455,7 @@ TEST(TabletopSegmentation, ReportsBadInput)
   pcl::copyPointCloud(cyl.cloud, *xyz);
   seg.setInputCloud(xyz);
   EXPECT_TRUE(seg.segment(clusters));
+  EXPECT_GT(seg.getTiming().objects, 0.0);
   EXPECT_FALSE(seg.tableFound());
   EXPECT_TRUE(seg.getSupports().empty());
   EXPECT_TRUE(seg.getTableCoefficients().values.empty());
@@ -458,6 +465,8 @@ TEST(TabletopSegmentation, ReportsBadInput)
   EXPECT_FALSE(facyl::validate(bad).empty());
   seg.setParameters(bad);
   EXPECT_FALSE(seg.segment(clusters));
+  EXPECT_EQ(seg.getTiming().planes, 0.0); // no step ran
+  EXPECT_EQ(seg.getTiming().objects, 0.0);
 }
 
 // ---------------------------------------------------------------- recognition
