@@ -161,25 +161,18 @@ public:
     return slot_[static_cast<std::size_t>(v) * static_cast<std::size_t>(w_) +
                  static_cast<std::size_t>(u)];
   }
-  /** at() of the pixels of column \a u (valid) in rows v + d, d in [d0, d1], into \a out:
-   * one bounds test per row and no multiplication per pixel. */
-  template <int d0, int d1> void column(int u, int v, int (&out)[d1 - d0 + 1]) const
+  /** at() of the five pixels centred on the valid pixel (\a u, \a v) along a column
+   * (\a vertical) or a row: one bounds test per pixel, no multiplication. */
+  void across(int u, int v, bool vertical, int (&out)[5]) const
   {
-    const auto stride = static_cast<std::ptrdiff_t>(w_);
-    const int* centre =
-      slot_.data() + static_cast<std::ptrdiff_t>(v) * stride + static_cast<std::ptrdiff_t>(u);
-    for (int d = d0; d <= d1; ++d)
-      out[d - d0] =
-        static_cast<unsigned>(v + d) < static_cast<unsigned>(h_) ? centre[d * stride] : -1;
-  }
-  /** The same for row \a v (valid), columns u + d. */
-  template <int d0, int d1> void row(int u, int v, int (&out)[d1 - d0 + 1]) const
-  {
+    const std::ptrdiff_t step = vertical ? w_ : 1;
+    const int along = vertical ? v : u, size = vertical ? h_ : w_;
     const int* centre = slot_.data() +
                         static_cast<std::ptrdiff_t>(v) * static_cast<std::ptrdiff_t>(w_) +
                         static_cast<std::ptrdiff_t>(u);
-    for (int d = d0; d <= d1; ++d)
-      out[d - d0] = static_cast<unsigned>(u + d) < static_cast<unsigned>(w_) ? centre[d] : -1;
+    for (int d = -2; d <= 2; ++d)
+      out[d + 2] =
+        static_cast<unsigned>(along + d) < static_cast<unsigned>(size) ? centre[d * step] : -1;
   }
   const Eigen::Vector3f& point(int c) const
   {
@@ -241,12 +234,9 @@ acrossMeans(const Grid& grid, bool horizontal)
     grid.position(static_cast<int>(c), u, v);
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
     int n = 0;
-    int across[5];
-    if (horizontal)
-      grid.column<-2, 2>(u, v, across);
-    else
-      grid.row<-2, 2>(u, v, across);
-    for (const int b : across) {
+    int line[5]; // across the test direction: a column for horizontal tests
+    grid.across(u, v, horizontal, line);
+    for (const int b : line) {
       if (b >= 0) {
         sum += grid.point(b);
         ++n;

@@ -239,11 +239,10 @@ private:
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
   ShapeClassifier::Ptr classifier_;
   TabletopSegmentation<PointT> segmentation_;
-  /** What segmentation_ was last given by setIndices: given again only when it changes, so
-   * that the segmentation keeps the index list it makes of a whole frame (else made again at
-   * every frame: 1.2 MB zeroed and numbered at VGA). */
+  /** What segmentation_ was last given by setIndices (none at first, as it starts): given
+   * again only when it changes, so that the segmentation keeps the index list it makes of a
+   * whole frame (else made again at every frame: 1.2 MB zeroed and numbered at VGA). */
   pcl::IndicesConstPtr segmentation_indices_;
-  bool segmentation_indices_set_{false};
   RecognitionTiming timing_;
   bool configured_{false};
   NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;

@@ -139,10 +139,9 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   std::vector<TabletopCluster> clusters;
   segmentation_.setParameters(params_.segmentation);
   segmentation_.setInputCloud(input_);
-  if (!segmentation_indices_set_ || segmentation_indices_ != indices_) {
+  if (segmentation_indices_ != indices_) {
     segmentation_.setIndices(indices_); // nullptr: the whole cloud
     segmentation_indices_ = indices_;
-    segmentation_indices_set_ = true;
   }
   segmentation_.setCamera(camera_);
   segmentation_.setUpDirection(up_);
