@@ -158,6 +158,21 @@ TEST(PlaneRegion, GrowsANoisyBentTableFromOnePieceAndStaysOffTheWall)
   // of 3 cm.
   EXPECT_GT(region.band.halfWidth(1.f), 3.f * 2e-3f);
   EXPECT_LT(region.band.halfWidth(1.f), 0.03f);
+  // Cells prepared once grow the same region, call after call; with the table's cells
+  // excluded (a plane found before), the seed does not grow.
+  const facyl::PlaneRegionCells prepared(c, q, c, Eigen::Vector3f::Zero());
+  for (int call = 0; call < 2; ++call) {
+    facyl::PlaneRegion again;
+    ASSERT_TRUE(facyl::refinePlaneRegion(prepared, seed, {}, again));
+    EXPECT_EQ(again.member, region.member);
+    EXPECT_EQ(again.plane, region.plane);
+  }
+  facyl::PlaneRegion none;
+  EXPECT_FALSE(facyl::refinePlaneRegion(prepared, seed, {}, none, &is_table));
+  // Matrices of different sizes are no cells.
+  const Eigen::Matrix3Xf fewer = q.leftCols(n - 1);
+  EXPECT_FALSE(facyl::refinePlaneRegion(
+    facyl::PlaneRegionCells(c, fewer, c, Eigen::Vector3f::Zero()), seed, {}, none));
   // A seed whose normals spread like a dome's is no plane.
   facyl::PlaneRegionSettings strict;
   strict.max_angle = 0.01f;

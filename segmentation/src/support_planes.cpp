@@ -123,29 +123,30 @@ fitWeightedPlane(const Eigen::Matrix3Xf& points, const Eigen::VectorXf& weights,
 
 namespace {
 
-/** The cells flagged in \a member and their weights 1 / sigma(range)^2. */
+/** Cells of a region as their indices, ascending (the order of a pass over every cell). */
+using Members = std::vector<std::uint32_t>;
+
+/** The plane of the cells \a member, weighted by 1 / sigma(range)^2 (\a band; nullptr: 1). */
 bool
-fitMembers(const Eigen::Matrix3Xf& cells, const std::vector<std::uint8_t>& member,
-           const DepthBand* band, const Eigen::Vector3f& viewpoint, Eigen::Vector4f& plane)
+fitMembers(const PlaneRegionCells& g, const Members& member, const DepthBand* band,
+           Eigen::Vector4f& plane)
 {
-  const auto n = static_cast<Eigen::Index>(std::count(member.begin(), member.end(), 1));
+  const auto n = static_cast<Eigen::Index>(member.size());
   Eigen::Matrix3Xf pts(3, n);
   Eigen::VectorXf w(n);
-  Eigen::Index k = 0;
-  for (std::size_t i = 0; i < member.size(); ++i)
-    if (member[i]) {
-      pts.col(k) = cells.col(static_cast<Eigen::Index>(i));
-      const float s = band ? band->sigma((pts.col(k) - viewpoint).norm()) : 1.f;
-      w[k++] = 1.f / std::max(s * s, 1e-12f);
-    }
-  return fitWeightedPlane(pts, w, viewpoint, plane);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const std::uint32_t i = member[static_cast<std::size_t>(k)];
+    pts.col(k) = g.cells.col(static_cast<Eigen::Index>(i));
+    const float s = band ? band->sigma(g.range[i]) : 1.f;
+    w[k] = 1.f / std::max(s * s, 1e-12f);
+  }
+  return fitWeightedPlane(pts, w, g.viewpoint, plane);
 }
 
 /** The band of \a plane measured on the samples (or cells) of the members. */
 DepthBand
-measureBand(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& samples,
-            const std::vector<std::uint8_t>& member, const Eigen::Vector4f& plane,
-            const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& s)
+measureBand(const PlaneRegionCells& g, const Members& member, const Eigen::Vector4f& plane,
+            const PlaneRegionSettings& s)
 {
   if (s.fixed_band > 0.f) {
     DepthBand b = fixedBand(s.fixed_band);
@@ -153,16 +154,15 @@ measureBand(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& samples,
     return b;
   }
   // Every k-th member: estimateDepthBand uses at most 4000 anyway.
-  const std::size_t count = static_cast<std::size_t>(std::count(member.begin(), member.end(), 1));
-  const std::size_t stride = std::max<std::size_t>(1, count / 4000);
+  const std::size_t stride = std::max<std::size_t>(1, member.size() / 4000);
   std::vector<float> ranges, residuals;
-  for (std::size_t i = 0, seen = 0; i < member.size(); ++i) {
-    if (!member[i] || seen++ % stride != 0)
-      continue;
-    const auto c = static_cast<Eigen::Index>(i);
-    const Eigen::Vector3f p =
-      samples.col(c).allFinite() ? Eigen::Vector3f(samples.col(c)) : Eigen::Vector3f(cells.col(c));
-    ranges.push_back((p - viewpoint).norm());
+  ranges.reserve(member.size() / stride + 1);
+  residuals.reserve(member.size() / stride + 1);
+  for (std::size_t k = 0; k < member.size(); k += stride) {
+    const auto c = static_cast<Eigen::Index>(member[k]);
+    const Eigen::Vector3f p = g.samples.col(c).allFinite() ? Eigen::Vector3f(g.samples.col(c))
+                                                           : Eigen::Vector3f(g.cells.col(c));
+    ranges.push_back((p - g.viewpoint).norm());
     residuals.push_back(plane.head<3>().dot(p) + plane[3]);
   }
   return estimateDepthBand(ranges, residuals, s.band_factor, s.min_sigma);
@@ -170,18 +170,16 @@ measureBand(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& samples,
 
 /** 3 x the median angle between the members' normals and the plane's, at least min_angle. */
 float
-normalTolerance(const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& member,
-                const Eigen::Vector3f& n, const PlaneRegionSettings& s)
+normalTolerance(const PlaneRegionCells& g, const Members& member, const Eigen::Vector3f& n,
+                const PlaneRegionSettings& s)
 {
   // On every k-th member (at most about 2000).
-  const std::size_t count = static_cast<std::size_t>(std::count(member.begin(), member.end(), 1));
-  const std::size_t stride = std::max<std::size_t>(1, count / 2000);
+  const std::size_t stride = std::max<std::size_t>(1, member.size() / 2000);
   std::vector<float> angles;
-  for (std::size_t i = 0, seen = 0; i < member.size(); ++i)
-    if (member[i] && seen++ % stride == 0) {
-      const float c = std::abs(n.dot(normals.col(static_cast<Eigen::Index>(i))));
-      angles.push_back(std::acos(std::min(1.f, c)));
-    }
+  for (std::size_t k = 0; k < member.size(); k += stride) {
+    const float c = std::abs(n.dot(g.normals.col(static_cast<Eigen::Index>(member[k]))));
+    angles.push_back(std::acos(std::min(1.f, c)));
+  }
   if (angles.empty())
     return s.min_angle;
   std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(angles.size() / 2),
@@ -204,46 +202,77 @@ limitBand(DepthBand band, const DepthBand& limit, float factor)
 
 } // namespace
 
+PlaneRegionCells::PlaneRegionCells(const Eigen::Matrix3Xf& cells_, const Eigen::Matrix3Xf& normals_,
+                                   const Eigen::Matrix3Xf& samples_,
+                                   const Eigen::Vector3f& viewpoint_)
+    : cells(cells_)
+    , normals(normals_)
+    , samples(samples_)
+    , viewpoint(viewpoint_)
+{
+  if (!valid())
+    return;
+  const auto n = static_cast<std::size_t>(cells.cols());
+  range.assign(n, 0.f);
+  usable.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    if (cells.col(c).allFinite() && normals.col(c).allFinite()) {
+      usable.push_back(static_cast<std::uint32_t>(i));
+      range[i] = (Eigen::Vector3f(cells.col(c)) - viewpoint).norm();
+    }
+  }
+}
+
 bool
 refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
                   const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
                   const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& s,
                   PlaneRegion& region, const std::vector<std::uint8_t>* excluded)
 {
-  const std::size_t n = static_cast<std::size_t>(cells.cols());
-  if (seed.size() != n || normals.cols() != cells.cols() || samples.cols() != cells.cols() ||
-      (excluded && excluded->size() != n))
+  return refinePlaneRegion(PlaneRegionCells(cells, normals, samples, viewpoint), seed, s, region,
+                           excluded);
+}
+
+bool
+refinePlaneRegion(const PlaneRegionCells& g, const std::vector<std::uint8_t>& seed,
+                  const PlaneRegionSettings& s, PlaneRegion& region,
+                  const std::vector<std::uint8_t>* excluded)
+{
+  const std::size_t n = static_cast<std::size_t>(g.cells.cols());
+  if (!g.valid() || seed.size() != n || (excluded && excluded->size() != n))
     return false;
-  // Once per cell: whether it may be a member at all, and its range.
-  std::vector<std::uint8_t> usable(n, 0);
-  std::vector<float> range(n, 0.f);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<Eigen::Index>(i);
-    usable[i] =
-      !(excluded && (*excluded)[i]) && cells.col(c).allFinite() && normals.col(c).allFinite();
-    if (usable[i])
-      range[i] = (Eigen::Vector3f(cells.col(c)) - viewpoint).norm();
-  }
-  std::vector<std::uint8_t> member(n, 0);
+  // The cells that may be members in this call.
+  Members usable;
+  usable.reserve(g.usable.size());
+  for (const std::uint32_t i : g.usable)
+    if (!(excluded && (*excluded)[i]))
+      usable.push_back(i);
+  Members member;
   for (std::size_t i = 0; i < n; ++i)
-    member[i] = seed[i] && cells.col(static_cast<Eigen::Index>(i)).allFinite();
+    if (seed[i] && g.cells.col(static_cast<Eigen::Index>(i)).allFinite())
+      member.push_back(static_cast<std::uint32_t>(i));
   Eigen::Vector4f plane;
-  if (!fitMembers(cells, member, nullptr, viewpoint, plane))
+  if (!fitMembers(g, member, nullptr, plane))
     return false;
   // The seed's own band and normal spread bound the growth: a band re-measured on a grown
   // region may widen (a table's bias shows over its whole extent) to twice the seed's at
   // most, so that a region never runs away into a neighbouring surface.
-  const DepthBand seed_band = measureBand(cells, samples, member, plane, viewpoint, s);
-  const float tolerance = normalTolerance(normals, member, plane.head<3>(), s);
+  const DepthBand seed_band = measureBand(g, member, plane, s);
+  const float tolerance = normalTolerance(g, member, plane.head<3>(), s);
   if (!(tolerance <= s.max_angle))
     return false; // normals that spread this much are not a plane's (a dome, a cylinder's top)
   const float cos_max = std::cos(tolerance);
-  const auto members = [&](const DepthBand& band, std::size_t step) {
-    std::vector<std::uint8_t> out(n, 0);
-    for (std::size_t i = 0; i < n; i += step) {
+  // The usable cells on the plane within \a band (every other one: \a every_other).
+  const auto members = [&](const DepthBand& band, bool every_other) {
+    Members out;
+    for (const std::uint32_t i : usable) {
+      if (every_other && i % 2 != 0)
+        continue;
       const auto c = static_cast<Eigen::Index>(i);
-      out[i] = usable[i] && std::abs(normals.col(c).dot(plane.head<3>())) >= cos_max &&
-               std::abs(plane.head<3>().dot(cells.col(c)) + plane[3]) <= band.halfWidth(range[i]);
+      if (std::abs(g.normals.col(c).dot(plane.head<3>())) >= cos_max &&
+          std::abs(plane.head<3>().dot(g.cells.col(c)) + plane[3]) <= band.halfWidth(g.range[i]))
+        out.push_back(i);
     }
     return out;
   };
@@ -256,25 +285,26 @@ refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals
   if (wide.fixed > 0.f)
     wide.fixed = seed_band.fixed; // a given band is not widened
   for (int it = 0; it < std::max(1, s.iterations); ++it) {
-    std::vector<std::uint8_t> next = members(wide, 2);
+    Members next = members(wide, true);
     const bool same = next == member;
     member.swap(next);
     Eigen::Vector4f refit;
-    if (!fitMembers(cells, member, &seed_band, viewpoint, refit))
+    if (!fitMembers(g, member, &seed_band, refit))
       return false;
     plane = refit;
     if (same)
       break;
   }
-  member = members(wide, 1);
-  const DepthBand band =
-    limitBand(measureBand(cells, samples, member, plane, viewpoint, s), seed_band, 2.f);
+  member = members(wide, false);
+  const DepthBand band = limitBand(measureBand(g, member, plane, s), seed_band, 2.f);
   region.plane = plane;
   region.band = band;
   region.max_angle = tolerance;
-  region.member = members(band, 1);
-  region.members =
-    static_cast<std::size_t>(std::count(region.member.begin(), region.member.end(), 1));
+  member = members(band, false);
+  region.member.assign(n, 0);
+  for (const std::uint32_t i : member)
+    region.member[i] = 1;
+  region.members = member.size();
   return region.members >= 3;
 }
 

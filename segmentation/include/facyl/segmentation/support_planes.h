@@ -75,6 +75,26 @@ struct PlaneRegion {
   std::size_t members{0};
 };
 
+/** \brief The cells of a plane search, prepared once for every region grown on them: which
+ * may be members at all (finite position and normal) and their ranges from the viewpoint.
+ * Holds references: \a cells, \a normals and \a samples (see refinePlaneRegion) must outlive
+ * it and stay unchanged. */
+struct PlaneRegionCells {
+  PlaneRegionCells(const Eigen::Matrix3Xf& cells_, const Eigen::Matrix3Xf& normals_,
+                   const Eigen::Matrix3Xf& samples_, const Eigen::Vector3f& viewpoint_);
+  const Eigen::Matrix3Xf& cells;
+  const Eigen::Matrix3Xf& normals;
+  const Eigen::Matrix3Xf& samples;
+  Eigen::Vector3f viewpoint;
+  std::vector<std::uint32_t> usable; ///< cells with finite position and normal, ascending
+  std::vector<float> range;          ///< per cell, its range (0 for cells not usable)
+  /** false when the three matrices differ in their number of columns. */
+  bool valid() const
+  {
+    return normals.cols() == cells.cols() && samples.cols() == cells.cols();
+  }
+};
+
 /** \brief Grows a seed region into a whole support plane, with a band measured from the data
  * (robust to depth noise and bias: regions of a noisy or slightly bent table found apart are
  * one plane at the end). From the \a seed cells: fit the plane, measure its band on the
@@ -95,6 +115,13 @@ bool refinePlaneRegion(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& no
                        const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
                        const Eigen::Vector3f& viewpoint, const PlaneRegionSettings& settings,
                        PlaneRegion& region, const std::vector<std::uint8_t>* excluded = nullptr);
+
+/** \brief refinePlaneRegion on cells prepared once (PlaneRegionCells): the same region, without
+ * a pass over every cell for their ranges in each call (a frame grows a region from each of
+ * its seeds). */
+bool refinePlaneRegion(const PlaneRegionCells& cells, const std::vector<std::uint8_t>& seed,
+                       const PlaneRegionSettings& settings, PlaneRegion& region,
+                       const std::vector<std::uint8_t>* excluded = nullptr);
 
 /** \brief Least-squares plane through the columns of \a points with \a weights (>= 0), unit
  * normal pointing to \a viewpoint's side. \return false when they do not span a plane. */

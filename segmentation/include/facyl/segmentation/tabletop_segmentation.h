@@ -406,8 +406,7 @@ private:
    * candidates stay with them, the new ones are marked. \a source maps cells to input
    * indices, \a cell_points is the number of pixels a cell stands for.
    * \return false when the region is not a plane of min_plane_points. */
-  bool growCandidate(const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals,
-                     const Eigen::Matrix3Xf& samples, const std::vector<std::uint8_t>& seed,
+  bool growCandidate(const PlaneRegionCells& cells, const std::vector<std::uint8_t>& seed,
                      const std::vector<pcl::index_t>& source, std::size_t cell_points,
                      std::vector<std::uint8_t>& taken, Candidate& out) const;
   /** Supports span a plane that does not pass by the sensor, are not a part of a larger

@@ -308,14 +308,14 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
 
 template <typename PointT>
 bool
-TabletopSegmentation<PointT>::growCandidate(
-  const Eigen::Matrix3Xf& cells, const Eigen::Matrix3Xf& normals, const Eigen::Matrix3Xf& samples,
-  const std::vector<std::uint8_t>& seed, const std::vector<pcl::index_t>& source,
-  std::size_t cell_points, std::vector<std::uint8_t>& taken, Candidate& out) const
+TabletopSegmentation<PointT>::growCandidate(const PlaneRegionCells& cells,
+                                            const std::vector<std::uint8_t>& seed,
+                                            const std::vector<pcl::index_t>& source,
+                                            std::size_t cell_points,
+                                            std::vector<std::uint8_t>& taken, Candidate& out) const
 {
   PlaneRegion region;
-  if (!refinePlaneRegion(cells, normals, samples, seed, input_->sensor_origin_.head(3),
-                         regionSettings(), region, &taken))
+  if (!refinePlaneRegion(cells, seed, regionSettings(), region, &taken))
     return false;
   out.plane = region.plane;
   out.band = region.band;
@@ -421,6 +421,8 @@ TabletopSegmentation<PointT>::growCandidates(const PlaneGrid& grid,
       if (k < taken.size())
         taken[k] = 1;
     }
+  const PlaneRegionCells region_cells(grid.cells, grid.cell_normals, grid.samples,
+                                      input_->sensor_origin_.head(3));
   for (const auto& r : seeds) {
     // A seed mostly on a plane found already is a part of it (a noisy table's regions).
     std::size_t on_earlier = 0;
@@ -432,8 +434,7 @@ TabletopSegmentation<PointT>::growCandidates(const PlaneGrid& grid,
     for (const auto k : r.indices)
       seed[static_cast<std::size_t>(k)] = 1;
     Candidate c;
-    if (growCandidate(grid.cells, grid.cell_normals, grid.samples, seed, grid.source, cell, taken,
-                      c))
+    if (growCandidate(region_cells, seed, grid.source, cell, taken, c))
       candidates.push_back(std::move(c));
   }
 }
@@ -470,12 +471,13 @@ TabletopSegmentation<PointT>::findPlanesUnorganized(std::vector<Candidate>& cand
   const double scale = static_cast<double>(finite->size()) / static_cast<double>(sampled.size());
   const std::size_t cell_points = static_cast<std::size_t>(std::max(1.0, std::round(scale)));
   std::vector<std::uint8_t> taken(sampled.size(), 0);
+  const PlaneRegionCells region_cells(cues.points, cues.normals, cues.points,
+                                      input_->sensor_origin_.head(3));
   ransacPlaneSeeds(
     cues, params_.max_planes, scale, params_.min_plane_points,
     [&](const std::vector<std::uint8_t>& seed) {
       Candidate cand;
-      if (growCandidate(cues.points, cues.normals, cues.points, seed, sampled, cell_points, taken,
-                        cand))
+      if (growCandidate(region_cells, seed, sampled, cell_points, taken, cand))
         candidates.push_back(std::move(cand));
     },
     taken);
