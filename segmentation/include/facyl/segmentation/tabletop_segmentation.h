@@ -495,6 +495,8 @@ private:
   mutable std::vector<std::uint8_t> has_depth_;        ///< per pixel of the input: finite
   mutable bool has_depth_known_{false}; ///< has_depth_ is this run's (planeGrid fills it)
   mutable pcl::PointCloud<pcl::Label> labels_;
+  /** classifyPoints' lists of each candidate's points, one slice of every point each. */
+  mutable pcl::Indices on_buffer_;
 };
 
 } // namespace facyl

@@ -15,6 +15,7 @@
 #include <pcl/filters/random_sample.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <limits>
@@ -555,36 +556,50 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
 {
   // One pass: each candidate's points, and the points above some candidate (in its object
   // band) with the candidates they lie on and above. Bands by range, tabulated every 5 mm.
-  const std::size_t n = candidates.size(); // <= 8
+  const std::size_t n = candidates.size(); // <= 8 (max_planes)
   all.assign(n, SupportPlane{});
   above.clear();
   if (n == 0)
     return;
   constexpr float bin = 0.005f;
   constexpr std::size_t bins = 2400; // 12 m
-  std::vector<float> half(n * bins);
+  // The candidates' planes and half-widths (by bin, then candidate: a point reads adjacent
+  // values), held apart from the candidates. Each candidate's points go to a slice of a buffer
+  // kept between frames that could take every point: no growth test (nor a call) per point.
+  std::vector<float> half(bins * n);
+  std::vector<Eigen::Vector4f, Eigen::aligned_allocator<Eigen::Vector4f>> planes(n);
   for (std::size_t s = 0; s < n; ++s) {
     for (std::size_t b = 0; b < bins; ++b)
-      half[s * bins + b] = candidates[s].band.halfWidth((static_cast<float>(b) + 0.5f) * bin);
-    all[s].inliers.indices.reserve(candidates[s].support + candidates[s].support / 2);
+      half[b * n + s] = candidates[s].band.halfWidth((static_cast<float>(b) + 0.5f) * bin);
+    planes[s] = candidates[s].plane;
   }
+  const pcl::index_t* given = fake_indices_ ? nullptr : indices_->data();
+  const std::size_t count = fake_indices_ ? input_->size() : indices_->size();
+  if (on_buffer_.size() < n * count)
+    on_buffer_.resize(n * count);
+  std::array<pcl::index_t*, 8> ends;
+  for (std::size_t s = 0; s < n; ++s)
+    ends[s] = on_buffer_.data() + s * count;
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
   const float floor = params_.min_height, top = params_.max_height;
-  for (const auto i : *indices_) {
+  // The whole cloud (no indices given) is visited without reading PCL's list of every index.
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto i = given ? given[k] : static_cast<pcl::index_t>(k);
     const auto& p = (*input_)[i];
     if (!pcl::isFinite(p))
       continue;
     const Eigen::Vector3f q = p.getVector3fMap();
     const float range = (q - viewpoint).norm();
     const auto b = static_cast<std::size_t>(range / bin);
+    const float* widths = b < bins ? half.data() + b * n : nullptr;
     std::uint8_t on = 0, over = 0;
     for (std::size_t s = 0; s < n; ++s) {
-      const Eigen::Vector4f& c = candidates[s].plane;
+      const Eigen::Vector4f& c = planes[s];
       const float h = c.template head<3>().dot(q) + c[3];
-      const float w = b < bins ? half[s * bins + b] : candidates[s].band.halfWidth(range);
+      const float w = widths ? widths[s] : candidates[s].band.halfWidth(range);
       if (std::abs(h) <= w) {
         on |= static_cast<std::uint8_t>(1u << s);
-        all[s].inliers.indices.push_back(i);
+        *ends[s]++ = i;
       }
       else if (h > std::max(floor, w) && h <= top)
         over |= static_cast<std::uint8_t>(1u << s);
@@ -592,6 +607,8 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
     if (over)
       above.push_back({i, on, over});
   }
+  for (std::size_t s = 0; s < n; ++s)
+    all[s].inliers.indices.assign(on_buffer_.data() + s * count, ends[s]);
   for (std::size_t s = 0; s < n; ++s) {
     all[s].plane = candidates[s].plane;
     all[s].band = candidates[s].band;
