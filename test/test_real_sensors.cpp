@@ -9,6 +9,7 @@
 
 #include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/segmentation/plane_search.h>
 #include <facyl/segmentation/support_planes.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 #include <facyl/simulation/frame_roll.h>
@@ -21,7 +22,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <map>
+#include <random>
 #include <sstream>
 
 using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
@@ -177,6 +180,96 @@ TEST(PlaneRegion, GrowsANoisyBentTableFromOnePieceAndStaysOffTheWall)
   facyl::PlaneRegionSettings strict;
   strict.max_angle = 0.01f;
   EXPECT_FALSE(facyl::refinePlaneRegion(c, q, c, seed, Eigen::Vector3f::Zero(), strict, region));
+}
+
+TEST(PlaneSorter, SortsOntoAndAboveItsPlanes)
+{
+  // A table (z up, through the origin) with a 1 cm band, seen from 1 m above; a wall.
+  const Eigen::Vector3f viewpoint(0.f, 0.f, 1.f);
+  const facyl::PlaneSorter sorter(
+    {Eigen::Vector4f(0.f, 0.f, 1.f, 0.f), Eigen::Vector4f(1.f, 0.f, 0.f, 0.5f)},
+    {facyl::fixedBand(0.01f), facyl::fixedBand(0.01f)}, viewpoint, 0.005f, 0.3f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // x, y, z, pad: on the table, above it, below it, on both, not finite, too high.
+  const std::vector<float> xyz = {0.1f, 0.f, 0.005f, 1.f, 0.1f,  0.f, 0.1f, 1.f,
+                                  0.1f, 0.f, -0.1f,  1.f, -0.5f, 0.f, 0.f,  1.f,
+                                  nan,  0.f, 0.f,    1.f, 0.1f,  0.f, 0.5f, 1.f};
+  for (const bool vectorized : {true, false}) {
+    std::vector<pcl::index_t> lists(2 * 6);
+    pcl::index_t* ends[2] = {lists.data(), lists.data() + 6};
+    std::vector<facyl::PointOverPlanes> above;
+    sorter.sort(xyz.data(), 4, 6, nullptr, ends, above, vectorized);
+    EXPECT_EQ(std::vector<pcl::index_t>(lists.data(), ends[0]), (std::vector<pcl::index_t>{0, 3}));
+    EXPECT_EQ(std::vector<pcl::index_t>(lists.data() + 6, ends[1]), (std::vector<pcl::index_t>{3}));
+    // Point 1 is above the table and beside the wall (h = 0.6 > top); point 0 is above the
+    // wall (h = 0.6 too): none above it.
+    ASSERT_EQ(above.size(), 1u);
+    EXPECT_EQ(above[0].index, 1);
+    EXPECT_EQ(above[0].on, 0);
+    EXPECT_EQ(above[0].above, 1);
+  }
+  EXPECT_THROW(facyl::PlaneSorter({Eigen::Vector4f::UnitZ()}, {}, viewpoint, 0.f, 1.f),
+               std::invalid_argument);
+}
+
+TEST(PlaneSorter, FourAtATimeEqualsOneAtATime)
+{
+  // Random points around 8 random planes with measured bands, some not finite, some beyond
+  // the tabulated 12 m, many at the bands' edges: the SSE sort gives the same lists.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  std::vector<Eigen::Vector4f> planes;
+  std::vector<facyl::DepthBand> bands;
+  for (int s = 0; s < 8; ++s) {
+    const Eigen::Vector3f n = Eigen::Vector3f(u(rng), u(rng), u(rng)).normalized();
+    planes.emplace_back(n.x(), n.y(), n.z(), 0.5f * u(rng));
+    facyl::DepthBand b;
+    b.ranges = {0.8f, 1.5f, 3.f};
+    b.sigmas = {0.002f, 0.004f, 0.01f};
+    bands.push_back(s % 3 == 0 ? facyl::fixedBand(0.01f) : b);
+  }
+  const Eigen::Vector3f viewpoint(0.1f, -0.2f, 0.f);
+  const facyl::PlaneSorter sorter(planes, bands, viewpoint, 0.005f, 0.3f);
+  const std::size_t count = 20003;
+  std::vector<float> xyz(5 * count); // a stride of 5 floats
+  for (std::size_t k = 0; k < count; ++k) {
+    Eigen::Vector3f p(2.f * u(rng), 2.f * u(rng), 1.f + 1.5f * u(rng));
+    if (k % 3 == 0) { // onto the edge of a band
+      const std::size_t s = k % 8;
+      const float range = (p - viewpoint).norm();
+      const float h = planes[s].head<3>().dot(p) + planes[s][3];
+      p += (bands[s].halfWidth(range) * (u(rng) > 0.f ? 1.f : -1.f) - h) * planes[s].head<3>();
+    }
+    if (k % 97 == 0)
+      p *= 13.f / p.norm(); // beyond 12 m
+    if (k % 89 == 0)
+      p.y() = std::numeric_limits<float>::quiet_NaN();
+    if (k % 101 == 0)
+      p.z() = std::numeric_limits<float>::infinity();
+    Eigen::Map<Eigen::Vector3f>(xyz.data() + 5 * k) = p;
+  }
+  std::vector<pcl::index_t> a(8 * count), b(8 * count);
+  pcl::index_t *ea[8], *eb[8];
+  for (std::size_t s = 0; s < 8; ++s)
+    ea[s] = a.data() + s * count, eb[s] = b.data() + s * count;
+  std::vector<facyl::PointOverPlanes> above_a, above_b;
+  sorter.sort(xyz.data(), 5, count, nullptr, ea, above_a, true);
+  sorter.sort(xyz.data(), 5, count, nullptr, eb, above_b, false);
+  std::size_t on = 0;
+  for (std::size_t s = 0; s < 8; ++s) {
+    EXPECT_EQ(std::vector<pcl::index_t>(a.data() + s * count, ea[s]),
+              std::vector<pcl::index_t>(b.data() + s * count, eb[s]))
+      << "plane " << s;
+    on += static_cast<std::size_t>(ea[s] - (a.data() + s * count));
+  }
+  EXPECT_GT(on, count / 8);
+  ASSERT_EQ(above_a.size(), above_b.size());
+  EXPECT_GT(above_a.size(), count / 20);
+  for (std::size_t k = 0; k < above_a.size(); ++k) {
+    EXPECT_EQ(above_a[k].index, above_b[k].index);
+    EXPECT_EQ(above_a[k].on, above_b[k].on);
+    EXPECT_EQ(above_a[k].above, above_b[k].above);
+  }
 }
 
 // ---------------------------------------------------------------- supports

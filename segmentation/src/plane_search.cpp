@@ -19,7 +19,12 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 #include <unordered_map>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
 
 namespace facyl {
 
@@ -201,6 +206,149 @@ rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
     return ua != ub ? ua : sum(a) > sum(b);
   });
   return families;
+}
+
+namespace {
+constexpr float kSortBin = 0.005f;      // the band half-widths' range bins (m)
+constexpr std::size_t kSortBins = 2400; // 12 m
+} // namespace
+
+PlaneSorter::PlaneSorter(std::vector<Eigen::Vector4f> planes, std::vector<DepthBand> bands,
+                         const Eigen::Vector3f& viewpoint, float floor, float top)
+    : planes_(std::move(planes))
+    , bands_(std::move(bands))
+    , viewpoint_(viewpoint)
+    , floor_(floor)
+    , top_(top)
+{
+  const std::size_t n = planes_.size();
+  if (n > 8 || bands_.size() != n)
+    throw std::invalid_argument("facyl::PlaneSorter: at most 8 planes, one band each");
+  half_.resize(kSortBins * n);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t b = 0; b < kSortBins; ++b)
+      half_[b * n + s] = bands_[s].halfWidth((static_cast<float>(b) + 0.5f) * kSortBin);
+}
+
+void
+PlaneSorter::sortOne(pcl::index_t i, const float* p, pcl::index_t** ends,
+                     std::vector<PointOverPlanes>& above) const
+{
+  const Eigen::Vector3f q(p[0], p[1], p[2]);
+  if (!q.allFinite())
+    return;
+  const std::size_t n = planes_.size();
+  const float range = (q - viewpoint_).norm();
+  const auto b = static_cast<std::size_t>(range / kSortBin);
+  const float* widths = b < kSortBins ? half_.data() + b * n : nullptr;
+  std::uint8_t on = 0, over = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const float h = planes_[s].head<3>().dot(q) + planes_[s][3];
+    const float w = widths ? widths[s] : bands_[s].halfWidth(range);
+    if (std::abs(h) <= w) {
+      on |= static_cast<std::uint8_t>(1u << s);
+      *ends[s]++ = i;
+    }
+    else if (h > std::max(floor_, w) && h <= top_)
+      over |= static_cast<std::uint8_t>(1u << s);
+  }
+  if (over)
+    above.push_back({i, on, over});
+}
+
+#if defined(__SSE2__)
+std::size_t
+PlaneSorter::sortByFour(const float* xyz, std::size_t stride, std::size_t count,
+                        pcl::index_t** ends, std::vector<PointOverPlanes>& above) const
+{
+  // The same floats as sortOne: the same operations in Eigen's association (x * x' + (y * y' +
+  // z * z')) and no other rounding; the lists in the same order.
+  const std::size_t n = planes_.size();
+  const __m128 zero = _mm_setzero_ps(), vx = _mm_set1_ps(viewpoint_.x()),
+               vy = _mm_set1_ps(viewpoint_.y()), vz = _mm_set1_ps(viewpoint_.z()),
+               bin = _mm_set1_ps(kSortBin), last = _mm_set1_ps(static_cast<float>(kSortBins)),
+               floor = _mm_set1_ps(floor_), top = _mm_set1_ps(top_),
+               magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  alignas(16) std::int32_t bin_of[4];
+  int on_lanes[8], over_lanes[8];
+  std::size_t k = 0;
+  for (; k + 4 <= count; k += 4) {
+    __m128 x = _mm_loadu_ps(xyz + k * stride), y = _mm_loadu_ps(xyz + (k + 1) * stride),
+           z = _mm_loadu_ps(xyz + (k + 2) * stride), t = _mm_loadu_ps(xyz + (k + 3) * stride);
+    _MM_TRANSPOSE4_PS(x, y, z, t);
+    // v - v is 0 for a finite v, NaN for NaN and infinities.
+    const __m128 finite = _mm_and_ps(
+      _mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(x, x), zero), _mm_cmpeq_ps(_mm_sub_ps(y, y), zero)),
+      _mm_cmpeq_ps(_mm_sub_ps(z, z), zero));
+    const int lanes = _mm_movemask_ps(finite);
+    if (lanes == 0)
+      continue;
+    const __m128 dx = _mm_sub_ps(x, vx), dy = _mm_sub_ps(y, vy), dz = _mm_sub_ps(z, vz);
+    const __m128 range = _mm_sqrt_ps(
+      _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz))));
+    const __m128 b = _mm_div_ps(range, bin);
+    if ((_mm_movemask_ps(_mm_cmplt_ps(b, last)) & lanes) != lanes) {
+      for (std::size_t j = k; j < k + 4; ++j) // one beyond the tabulated ranges
+        sortOne(static_cast<pcl::index_t>(j), xyz + j * stride, ends, above);
+      continue;
+    }
+    // Bins of the finite points (0 for the others, never read).
+    _mm_store_si128(reinterpret_cast<__m128i*>(bin_of),
+                    _mm_and_si128(_mm_cvttps_epi32(b), _mm_castps_si128(finite)));
+    int any_over = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      const Eigen::Vector4f& c = planes_[s];
+      const __m128 h = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[0]), x),
+                   _mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[1]), y), _mm_mul_ps(_mm_set1_ps(c[2]), z))),
+        _mm_set1_ps(c[3]));
+      const __m128 w = _mm_set_ps(half_[static_cast<std::size_t>(bin_of[3]) * n + s],
+                                  half_[static_cast<std::size_t>(bin_of[2]) * n + s],
+                                  half_[static_cast<std::size_t>(bin_of[1]) * n + s],
+                                  half_[static_cast<std::size_t>(bin_of[0]) * n + s]);
+      const __m128 on = _mm_and_ps(_mm_cmple_ps(_mm_and_ps(h, magnitude), w), finite);
+      const __m128 over = _mm_andnot_ps(
+        on, _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(h, _mm_max_ps(floor, w)), _mm_cmple_ps(h, top)),
+                       finite));
+      on_lanes[s] = _mm_movemask_ps(on);
+      over_lanes[s] = _mm_movemask_ps(over);
+      any_over |= over_lanes[s];
+      for (int m = on_lanes[s]; m != 0; m &= m - 1)
+        *ends[s]++ = static_cast<pcl::index_t>(
+          k + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(m))));
+    }
+    for (int m = any_over; m != 0; m &= m - 1) {
+      const int lane = __builtin_ctz(static_cast<unsigned>(m));
+      std::uint8_t on = 0, over = 0;
+      for (std::size_t s = 0; s < n; ++s) {
+        on |= static_cast<std::uint8_t>(((on_lanes[s] >> lane) & 1) << s);
+        over |= static_cast<std::uint8_t>(((over_lanes[s] >> lane) & 1) << s);
+      }
+      above.push_back({static_cast<pcl::index_t>(k + static_cast<std::size_t>(lane)), on, over});
+    }
+  }
+  return k;
+}
+#endif
+
+void
+PlaneSorter::sort(const float* xyz, std::size_t stride, std::size_t count,
+                  const pcl::index_t* indices, pcl::index_t** ends,
+                  std::vector<PointOverPlanes>& above, bool vectorized) const
+{
+  if (planes_.empty())
+    return;
+  std::size_t k = 0;
+#if defined(__SSE2__)
+  if (vectorized && !indices && stride >= 4)
+    k = sortByFour(xyz, stride, count, ends, above);
+#else
+  (void)vectorized;
+#endif
+  for (; k < count; ++k) {
+    const std::size_t i = indices ? static_cast<std::size_t>(indices[k]) : k;
+    sortOne(static_cast<pcl::index_t>(i), xyz + i * stride, ends, above);
+  }
 }
 
 std::vector<pcl::Indices>

@@ -7,6 +7,8 @@
  */
 #pragma once
 
+#include <facyl/segmentation/support_planes.h>
+
 #include <pcl/PointIndices.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -123,6 +125,50 @@ std::vector<std::vector<std::size_t>>
 rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
                     const std::vector<std::size_t>& points, bool up_known,
                     const Eigen::Vector3f& image_down);
+
+/** \brief A point above some support candidate: its index, and the candidates (bit s for
+ * candidate s) it lies on and above. */
+struct PointOverPlanes {
+  pcl::index_t index;
+  std::uint8_t on, above;
+};
+
+/** \brief One pass that sorts points onto and above up to 8 candidate planes, each with its
+ * band: a point is on plane s when its height h over it is within the band's half-width at
+ * the point's range from the viewpoint (tabulated every 5 mm up to 12 m, computed beyond), and
+ * above it when h is in (max(floor, half-width), top]. Thread-safe: sort() is const. */
+class PlaneSorter {
+public:
+  /** \brief \a planes (unit normals towards the viewpoint; at most 8) and their \a bands (as
+   * many). \throws std::invalid_argument otherwise. */
+  PlaneSorter(std::vector<Eigen::Vector4f> planes, std::vector<DepthBand> bands,
+              const Eigen::Vector3f& viewpoint, float floor, float top);
+  /** \brief Sorts \a count points, whose x, y and z are the first three of every \a stride
+   * floats from \a xyz; the k-th is point k, or indices[k] when \a indices is given. Non-finite
+   * points are skipped. Each plane s's points are written at ends[s] (one pointer per plane,
+   * each with room for \a count; it advances), in the order visited; the points above some plane
+   * are appended to \a above. \a vectorized: the whole cloud (no indices) four points at a time
+   * where SSE2 is there (x86-64), with the same floats and lists as one at a time (false). */
+  void sort(const float* xyz, std::size_t stride, std::size_t count, const pcl::index_t* indices,
+            pcl::index_t** ends, std::vector<PointOverPlanes>& above, bool vectorized = true) const;
+  std::size_t size() const
+  {
+    return planes_.size();
+  }
+
+private:
+  void sortOne(pcl::index_t i, const float* p, pcl::index_t** ends,
+               std::vector<PointOverPlanes>& above) const;
+  /** The whole cloud's points four at a time (SSE2), up to the last whole four; \return how
+   * many were sorted. */
+  std::size_t sortByFour(const float* xyz, std::size_t stride, std::size_t count,
+                         pcl::index_t** ends, std::vector<PointOverPlanes>& above) const;
+  std::vector<Eigen::Vector4f> planes_;
+  std::vector<DepthBand> bands_;
+  Eigen::Vector3f viewpoint_;
+  float floor_, top_;
+  std::vector<float> half_; ///< half-widths by 5 mm bin of range, then plane
+};
 
 /** \brief Connected components of the organized \a cloud, neighbours closer than \a
  * tolerance (pcl::EuclideanClusterComparator); \a labels is a buffer kept between calls. */

@@ -358,10 +358,7 @@ private:
     std::size_t support{0}; ///< full-resolution points it stands for
   };
   /** A point above some candidate: the candidates it lies on and above (bit masks). */
-  struct Above {
-    pcl::index_t index;
-    std::uint8_t on, above;
-  };
+  using Above = PointOverPlanes;
   /** Where a cluster goes among the supports. */
   struct Placement {
     int support{-1};      ///< index into supports_, -1: none (not over one, or a leg)

@@ -17,10 +17,6 @@
 
 #include <algorithm>
 #include <array>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#include <xmmintrin.h>
-#endif
 #include <chrono>
 #include <cstdint>
 #include <limits>
@@ -566,18 +562,17 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
   above.clear();
   if (n == 0)
     return;
-  constexpr float bin = 0.005f;
-  constexpr std::size_t bins = 2400; // 12 m
-  // The candidates' planes and half-widths (by bin, then candidate: a point reads adjacent
-  // values), held apart from the candidates. Each candidate's points go to a slice of a buffer
-  // kept between frames that could take every point: no growth test (nor a call) per point.
-  std::vector<float> half(bins * n);
-  std::vector<Eigen::Vector4f, Eigen::aligned_allocator<Eigen::Vector4f>> planes(n);
-  for (std::size_t s = 0; s < n; ++s) {
-    for (std::size_t b = 0; b < bins; ++b)
-      half[b * n + s] = candidates[s].band.halfWidth((static_cast<float>(b) + 0.5f) * bin);
-    planes[s] = candidates[s].plane;
+  std::vector<Eigen::Vector4f> planes;
+  std::vector<DepthBand> bands;
+  for (const auto& c : candidates) {
+    planes.push_back(c.plane);
+    bands.push_back(c.band);
   }
+  const PlaneSorter sorter(std::move(planes), std::move(bands), input_->sensor_origin_.head(3),
+                           params_.min_height, params_.max_height);
+  // Each candidate's points go to a slice of a buffer kept between frames that could take
+  // every point (no growth test per point); PCL's list of every index is not read when no
+  // indices were given.
   const pcl::index_t* given = fake_indices_ ? nullptr : indices_->data();
   const std::size_t count = fake_indices_ ? input_->size() : indices_->size();
   if (on_buffer_.size() < n * count)
@@ -585,114 +580,19 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
   std::array<pcl::index_t*, 8> ends;
   for (std::size_t s = 0; s < n; ++s)
     ends[s] = on_buffer_.data() + s * count;
-  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  const float floor = params_.min_height, top = params_.max_height;
-  // Sorts point i, at range \a range, with \a h[s] its height over candidate s.
-  const auto sort = [&](pcl::index_t i, float range, const float* h) {
-    const auto b = static_cast<std::size_t>(range / bin);
-    const float* widths = b < bins ? half.data() + b * n : nullptr;
-    std::uint8_t on = 0, over = 0;
-    for (std::size_t s = 0; s < n; ++s) {
-      const float w = widths ? widths[s] : candidates[s].band.halfWidth(range);
-      if (std::abs(h[s]) <= w) {
-        on |= static_cast<std::uint8_t>(1u << s);
-        *ends[s]++ = i;
-      }
-      else if (h[s] > std::max(floor, w) && h[s] <= top)
-        over |= static_cast<std::uint8_t>(1u << s);
-    }
-    if (over)
-      above.push_back({i, on, over});
-  };
-  const auto sortOne = [&](pcl::index_t i) {
-    const auto& p = (*input_)[i];
-    if (!pcl::isFinite(p))
-      return;
-    const Eigen::Vector3f q = p.getVector3fMap();
-    float h[8];
-    for (std::size_t s = 0; s < n; ++s)
-      h[s] = planes[s].template head<3>().dot(q) + planes[s][3];
-    sort(i, (q - viewpoint).norm(), h);
-  };
-  std::size_t k = 0;
-#if defined(__SSE2__)
-  // The whole cloud, four points at a time, in SSE: the same floats as sortOne (the same
-  // operations in Eigen's association, x * x' + (y * y' + z * z'), and no other rounding) and
-  // the same lists in the same order. Four points of which one is beyond the tabulated ranges
-  // go to sortOne.
-  constexpr bool xyz_first = pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
-                             pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
-                             pcl::traits::offset<PointT, pcl::fields::z>::value == 8;
-  if (!given && xyz_first && sizeof(PointT) % 16 == 0) {
-    const float* base = reinterpret_cast<const float*>(input_->points.data());
-    constexpr std::size_t stride = sizeof(PointT) / sizeof(float);
-    const __m128 vx = _mm_set1_ps(viewpoint.x()), vy = _mm_set1_ps(viewpoint.y()),
-                 vz = _mm_set1_ps(viewpoint.z()), zero = _mm_setzero_ps(), bin4 = _mm_set1_ps(bin),
-                 last = _mm_set1_ps(static_cast<float>(bins)), floor4 = _mm_set1_ps(floor),
-                 top4 = _mm_set1_ps(top), magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    alignas(16) std::int32_t bin_of[4];
-    int on_lanes[8], over_lanes[8];
-    for (; k + 4 <= count; k += 4) {
-      __m128 x = _mm_loadu_ps(base + k * stride), y = _mm_loadu_ps(base + (k + 1) * stride),
-             z = _mm_loadu_ps(base + (k + 2) * stride), t = _mm_loadu_ps(base + (k + 3) * stride);
-      _MM_TRANSPOSE4_PS(x, y, z, t);
-      // v - v is 0 for a finite v, NaN for NaN and infinities.
-      const __m128 finite = _mm_and_ps(
-        _mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(x, x), zero), _mm_cmpeq_ps(_mm_sub_ps(y, y), zero)),
-        _mm_cmpeq_ps(_mm_sub_ps(z, z), zero));
-      const int lanes = _mm_movemask_ps(finite);
-      if (lanes == 0)
-        continue;
-      const __m128 dx = _mm_sub_ps(x, vx), dy = _mm_sub_ps(y, vy), dz = _mm_sub_ps(z, vz);
-      const __m128 range = _mm_sqrt_ps(
-        _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz))));
-      const __m128 b = _mm_div_ps(range, bin4);
-      if ((_mm_movemask_ps(_mm_cmplt_ps(b, last)) & lanes) != lanes) {
-        for (std::size_t j = k; j < k + 4; ++j)
-          sortOne(static_cast<pcl::index_t>(j));
-        continue;
-      }
-      // Bins of the finite points (0 for the others, never read).
-      _mm_store_si128(reinterpret_cast<__m128i*>(bin_of),
-                      _mm_and_si128(_mm_cvttps_epi32(b), _mm_castps_si128(finite)));
-      int any_over = 0;
-      for (std::size_t s = 0; s < n; ++s) {
-        const Eigen::Vector4f& c = planes[s];
-        const __m128 h = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[0]), x),
-                                               _mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[1]), y),
-                                                          _mm_mul_ps(_mm_set1_ps(c[2]), z))),
-                                    _mm_set1_ps(c[3]));
-        const __m128 w = _mm_set_ps(half[static_cast<std::size_t>(bin_of[3]) * n + s],
-                                    half[static_cast<std::size_t>(bin_of[2]) * n + s],
-                                    half[static_cast<std::size_t>(bin_of[1]) * n + s],
-                                    half[static_cast<std::size_t>(bin_of[0]) * n + s]);
-        const __m128 on = _mm_and_ps(_mm_cmple_ps(_mm_and_ps(h, magnitude), w), finite);
-        const __m128 over = _mm_andnot_ps(
-          on, _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(h, _mm_max_ps(floor4, w)), _mm_cmple_ps(h, top4)),
-                         finite));
-        on_lanes[s] = _mm_movemask_ps(on);
-        over_lanes[s] = _mm_movemask_ps(over);
-        any_over |= over_lanes[s];
-        for (int m = on_lanes[s]; m != 0; m &= m - 1)
-          *ends[s]++ = static_cast<pcl::index_t>(
-            k + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(m))));
-      }
-      for (int m = any_over; m != 0; m &= m - 1) {
-        const int lane = __builtin_ctz(static_cast<unsigned>(m));
-        std::uint8_t on = 0, over = 0;
-        for (std::size_t s = 0; s < n; ++s) {
-          on |= static_cast<std::uint8_t>(((on_lanes[s] >> lane) & 1) << s);
-          over |= static_cast<std::uint8_t>(((over_lanes[s] >> lane) & 1) << s);
-        }
-        above.push_back({static_cast<pcl::index_t>(k + static_cast<std::size_t>(lane)), on, over});
-      }
-    }
+  // PCL's point types start with x, y, z (PCL_ADD_POINT4D): the sort reads the cloud itself.
+  if constexpr (pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
+                pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
+                pcl::traits::offset<PointT, pcl::fields::z>::value == 8 &&
+                sizeof(PointT) % sizeof(float) == 0 && sizeof(PointT) >= 4 * sizeof(float))
+    sorter.sort(reinterpret_cast<const float*>(input_->points.data()),
+                sizeof(PointT) / sizeof(float), count, given, ends.data(), above);
+  else {
+    std::vector<float> xyz(4 * input_->size());
+    for (std::size_t i = 0; i < input_->size(); ++i)
+      Eigen::Map<Eigen::Vector3f>(xyz.data() + 4 * i) = (*input_)[i].getVector3fMap();
+    sorter.sort(xyz.data(), 4, count, given, ends.data(), above);
   }
-#endif
-  // The rest (given indices, or the last points) one at a time. The whole cloud is visited
-  // without reading PCL's list of every index.
-  for (; k < count; ++k)
-    sortOne(given ? given[k] : static_cast<pcl::index_t>(k));
   for (std::size_t s = 0; s < n; ++s)
     all[s].inliers.indices.assign(on_buffer_.data() + s * count, ends[s]);
   for (std::size_t s = 0; s < n; ++s) {
