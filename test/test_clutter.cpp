@@ -21,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <map>
 
 using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
@@ -289,6 +290,55 @@ TEST(ObjectSegmentation, CreasesAreTheValleysNotTheRidges)
   EXPECT_GT(at_valley, 50u * 5u);
   EXPECT_EQ(at_ridge, 0u);
   EXPECT_EQ(elsewhere, 0u);
+}
+
+TEST(ObjectSegmentation, ObjectPointsAloneSplitAsTheirMaskedFrame)
+{
+  // The object pixels of a cluttered frame (NaN elsewhere): the points alone at their pixels
+  // give the segments of the masked frame, scanned or given its finite pixels.
+  facyl::TabletopSceneParameters sp = facyl::clutteredSceneParameters();
+  sp.seed = 11;
+  const facyl::RenderedScene s = facyl::simulateTabletopScene(sp);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  pcl::PointCloud<pcl::PointXYZ> masked(s.cloud.width, s.cloud.height,
+                                        pcl::PointXYZ(nan, nan, nan));
+  std::vector<std::uint8_t> has_depth(s.cloud.size(), 0);
+  pcl::Indices pixels;
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) {
+    has_depth[i] = pcl::isFinite(s.cloud[i]);
+    if (s.object_id[i] >= 2 && has_depth[i]) {
+      masked[i].getVector3fMap() = s.cloud[i].getVector3fMap();
+      pixels.push_back(static_cast<pcl::index_t>(i));
+    }
+  }
+  ASSERT_GT(pixels.size(), 5000u);
+  Eigen::Matrix3Xf points(3, static_cast<Eigen::Index>(pixels.size()));
+  for (std::size_t k = 0; k < pixels.size(); ++k)
+    points.col(static_cast<Eigen::Index>(k)) = s.cloud[pixels[k]].getVector3fMap();
+  points.col(3) = Eigen::Vector3f::Constant(nan); // left out, as NaN in the frame would be
+  masked[pixels[3]].getVector3fMap().setConstant(nan);
+  const facyl::ObjectSegmentationParameters p;
+  const facyl::DepthBand noise = facyl::fixedBand(0.004f);
+  const Eigen::Vector3f origin = Eigen::Vector3f::Zero();
+  const auto scanned = facyl::segmentObjectsOrganized(masked, has_depth, 525.f, origin, p, &noise);
+  const auto listed =
+    facyl::segmentObjectsOrganized(masked, has_depth, 525.f, origin, p, &noise, &pixels);
+  const auto alone = facyl::segmentObjectsOrganized(points, pixels, s.cloud.width, s.cloud.height,
+                                                    has_depth, 525.f, origin, p, &noise);
+  EXPECT_GE(alone.size(), 3u);
+  EXPECT_EQ(alone, scanned);
+  EXPECT_EQ(alone, listed);
+  // Invalid input: no segments.
+  pcl::Indices reversed(pixels.rbegin(), pixels.rend());
+  EXPECT_TRUE(facyl::segmentObjectsOrganized(points, reversed, s.cloud.width, s.cloud.height,
+                                             has_depth, 525.f, origin, p)
+                .empty());
+  EXPECT_TRUE(facyl::segmentObjectsOrganized(points, pixels, s.cloud.width, s.cloud.height - 1,
+                                             has_depth, 525.f, origin, p)
+                .empty());
+  EXPECT_TRUE(facyl::segmentObjectsOrganized(points.leftCols(10), pixels, s.cloud.width,
+                                             s.cloud.height, has_depth, 525.f, origin, p)
+                .empty());
 }
 
 TEST(SegmentationScore, RecoveredMergedAndSplit)

@@ -81,50 +81,15 @@ public:
   Grid(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal, const Eigen::Vector3f& viewpoint,
        const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr,
        const pcl::Indices* finite_pixels = nullptr)
-      : w_(static_cast<int>(cloud.width))
-      , h_(static_cast<int>(cloud.height))
-      , slot_(cloud.size(), -1)
+      : Grid(static_cast<int>(cloud.width), static_cast<int>(cloud.height), focal, viewpoint, p,
+             noise, finite_pixels ? finite_pixels->size() : countFinite(cloud))
   {
-    std::size_t valid = 0;
-    if (finite_pixels)
-      valid = finite_pixels->size();
-    else
-      for (const auto& q : cloud)
-        valid += finite(q);
-    // The noise's half-width by range, every 5 mm up to 12 m.
-    constexpr float kBin = 0.005f;
-    constexpr std::size_t kBins = 2400;
-    std::vector<float> noise_half;
-    if (noise) {
-      noise_half.resize(kBins);
-      for (std::size_t b = 0; b < kBins; ++b)
-        noise_half[b] = noise->halfWidth((static_cast<float>(b) + 0.5f) * kBin);
-    }
-    pixel_.reserve(valid);
-    xyz_.reserve(valid);
-    u_.reserve(valid);
-    v_.reserve(valid);
-    range_.reserve(valid);
-    gap2_.reserve(valid);
-    const auto add = [&](std::size_t i, int u, int v) {
-      slot_[i] = static_cast<int>(pixel_.size());
-      pixel_.push_back(i);
-      xyz_.push_back(cloud[i].getVector3fMap());
-      u_.push_back(u);
-      v_.push_back(v);
-      const float r = (xyz_.back() - viewpoint).norm();
-      range_.push_back(r);
-      float gap = std::clamp(p.jump_factor * r / focal, p.min_gap, p.max_gap);
-      if (noise) // neighbours on one surface differ by the sensor's noise: never a jump
-        gap = std::max(gap, noise_half[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
-      gap2_.push_back(gap * gap);
-    };
     if (finite_pixels) {
       for (const auto idx : *finite_pixels) {
         const auto i = static_cast<std::size_t>(idx);
         if (finite(cloud[i]))
           add(i, static_cast<int>(i % static_cast<std::size_t>(w_)),
-              static_cast<int>(i / static_cast<std::size_t>(w_)));
+              static_cast<int>(i / static_cast<std::size_t>(w_)), cloud[i].getVector3fMap());
       }
       return;
     }
@@ -132,7 +97,23 @@ public:
     for (int v = 0, i = 0; v < h_; ++v)
       for (int u = 0; u < w_; ++u, ++i)
         if (finite(cloud[static_cast<std::size_t>(i)]))
-          add(static_cast<std::size_t>(i), u, v);
+          add(static_cast<std::size_t>(i), u, v,
+              cloud[static_cast<std::size_t>(i)].getVector3fMap());
+  }
+  /** The finite columns of \a points, at the pixels \a pixels (ascending) of a \a width x
+   * \a height image. */
+  Grid(const Eigen::Matrix3Xf& points, const pcl::Indices& pixels, int width, int height,
+       float focal, const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
+       const DepthBand* noise)
+      : Grid(width, height, focal, viewpoint, p, noise, pixels.size())
+  {
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      const auto i = static_cast<std::size_t>(pixels[k]);
+      const auto c = static_cast<Eigen::Index>(k);
+      if (points.col(c).allFinite())
+        add(i, static_cast<int>(i % static_cast<std::size_t>(w_)),
+            static_cast<int>(i / static_cast<std::size_t>(w_)), points.col(c));
+    }
   }
   int width() const
   {
@@ -208,8 +189,59 @@ public:
   }
 
 private:
+  /** An empty grid of a \a width x \a height image, with room for \a valid pixels. */
+  Grid(int width, int height, float focal, const Eigen::Vector3f& viewpoint,
+       const ObjectSegmentationParameters& p, const DepthBand* noise, std::size_t valid)
+      : w_(width)
+      , h_(height)
+      , slot_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1)
+      , focal_(focal)
+      , viewpoint_(viewpoint)
+      , p_(p)
+  {
+    // The noise's half-width by range, every 5 mm up to 12 m.
+    if (noise) {
+      noise_half_.resize(kBins);
+      for (std::size_t b = 0; b < kBins; ++b)
+        noise_half_[b] = noise->halfWidth((static_cast<float>(b) + 0.5f) * kBin);
+    }
+    pixel_.reserve(valid);
+    xyz_.reserve(valid);
+    u_.reserve(valid);
+    v_.reserve(valid);
+    range_.reserve(valid);
+    gap2_.reserve(valid);
+  }
+  static std::size_t countFinite(const pcl::PointCloud<pcl::PointXYZ>& cloud)
+  {
+    std::size_t valid = 0;
+    for (const auto& q : cloud)
+      valid += finite(q);
+    return valid;
+  }
+  /** Pixel \a i at (\a u, \a v) with the point \a q. */
+  void add(std::size_t i, int u, int v, const Eigen::Vector3f& q)
+  {
+    slot_[i] = static_cast<int>(pixel_.size());
+    pixel_.push_back(i);
+    xyz_.push_back(q);
+    u_.push_back(u);
+    v_.push_back(v);
+    const float r = (q - viewpoint_).norm();
+    range_.push_back(r);
+    float gap = std::clamp(p_.jump_factor * r / focal_, p_.min_gap, p_.max_gap);
+    if (!noise_half_.empty()) // neighbours on one surface differ by the sensor's noise
+      gap = std::max(gap, noise_half_[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
+    gap2_.push_back(gap * gap);
+  }
+  static constexpr float kBin = 0.005f;
+  static constexpr std::size_t kBins = 2400;
   int w_, h_;
   std::vector<int> slot_;
+  float focal_;
+  Eigen::Vector3f viewpoint_;
+  ObjectSegmentationParameters p_;
+  std::vector<float> noise_half_;
   std::vector<std::size_t> pixel_;
   std::vector<Eigen::Vector3f> xyz_; ///< per valid pixel: its point
   std::vector<int> u_, v_;
@@ -695,18 +727,13 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
   return out;
 }
 
+namespace {
+
+/** segmentObjectsOrganized on its grid of valid pixels. */
 std::vector<pcl::Indices>
-segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                        const std::vector<std::uint8_t>& has_depth, float focal,
-                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-                        const DepthBand* noise, const pcl::Indices* finite)
+segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float focal,
+            const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p)
 {
-  if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
-    return {};
-  if (finite && std::adjacent_find(finite->begin(), finite->end(),
-                                   [](auto a, auto b) { return a >= b; }) != finite->end())
-    finite = nullptr; // not strictly ascending: the grid's order is the image's, so scan
-  const Grid grid(cloud, focal, viewpoint, p, noise, finite);
   if (grid.size() == 0)
     return {};
   const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);
@@ -741,6 +768,42 @@ segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   if (p.bridge_occlusions)
     segments.bridgeOcclusions(has_depth, p.min_fragment, p);
   return segments.indices();
+}
+
+} // namespace
+
+std::vector<pcl::Indices>
+segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                        const std::vector<std::uint8_t>& has_depth, float focal,
+                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
+                        const DepthBand* noise, const pcl::Indices* finite)
+{
+  if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
+    return {};
+  if (finite && std::adjacent_find(finite->begin(), finite->end(),
+                                   [](auto a, auto b) { return a >= b; }) != finite->end())
+    finite = nullptr; // not strictly ascending: the grid's order is the image's, so scan
+  return segmentGrid(Grid(cloud, focal, viewpoint, p, noise, finite), has_depth, focal, viewpoint,
+                     p);
+}
+
+std::vector<pcl::Indices>
+segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixels,
+                        std::uint32_t width, std::uint32_t height,
+                        const std::vector<std::uint8_t>& has_depth, float focal,
+                        const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
+                        const DepthBand* noise)
+{
+  const std::size_t size = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (width == 0 || height < 2 || !(focal > 0.f) || has_depth.size() != size ||
+      points.cols() != static_cast<Eigen::Index>(pixels.size()) ||
+      std::adjacent_find(pixels.begin(), pixels.end(), [](auto a, auto b) { return a >= b; }) !=
+        pixels.end() ||
+      (!pixels.empty() && (pixels.front() < 0 || static_cast<std::size_t>(pixels.back()) >= size)))
+    return {};
+  return segmentGrid(Grid(points, pixels, static_cast<int>(width), static_cast<int>(height), focal,
+                          viewpoint, p, noise),
+                     has_depth, focal, viewpoint, p);
 }
 
 } // namespace facyl

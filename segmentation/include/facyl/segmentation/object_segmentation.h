@@ -92,4 +92,17 @@ std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::Poi
                                                   const DepthBand* noise = nullptr,
                                                   const pcl::Indices* finite = nullptr);
 
+/** \brief segmentObjectsOrganized on the object points alone: \a points (3 x n; non-finite
+ * columns are left out) at the pixels \a pixels (strictly ascending indices into a \a width x
+ * \a height image). The same segments as the cloud version on a cloud that holds these points
+ * and NaN elsewhere, without an image-sized cloud to fill. Empty on invalid input (sizes that
+ * disagree, pixels out of the image or not ascending, focal <= 0). */
+std::vector<pcl::Indices> segmentObjectsOrganized(const Eigen::Matrix3Xf& points,
+                                                  const pcl::Indices& pixels, std::uint32_t width,
+                                                  std::uint32_t height,
+                                                  const std::vector<std::uint8_t>& has_depth,
+                                                  float focal, const Eigen::Vector3f& viewpoint,
+                                                  const ObjectSegmentationParameters& params,
+                                                  const DepthBand* noise = nullptr);
+
 } // namespace facyl

@@ -492,8 +492,20 @@ private:
   mutable std::vector<std::uint8_t> has_depth_;        ///< per pixel of the input: finite
   mutable bool has_depth_known_{false}; ///< has_depth_ is this run's (planeGrid fills it)
   mutable pcl::PointCloud<pcl::Label> labels_;
-  /** classifyPoints' lists of each candidate's points, one slice of every point each. */
-  mutable pcl::Indices on_buffer_;
+  /** classifyPoints' lists of each candidate's points, a slice that could take every point
+   * each. Not initialised (a frame touches only the pages it writes) and not copied with the
+   * segmentation (a copy starts with none). */
+  struct SortBuffer {
+    std::unique_ptr<pcl::index_t[]> data;
+    std::size_t size{0};
+    SortBuffer() = default;
+    SortBuffer(const SortBuffer&) {}
+    SortBuffer& operator=(const SortBuffer&)
+    {
+      return *this;
+    }
+  };
+  mutable SortBuffer on_buffer_;
 };
 
 } // namespace facyl

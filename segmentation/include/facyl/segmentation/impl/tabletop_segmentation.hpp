@@ -575,11 +575,13 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
   // indices were given.
   const pcl::index_t* given = fake_indices_ ? nullptr : indices_->data();
   const std::size_t count = fake_indices_ ? input_->size() : indices_->size();
-  if (on_buffer_.size() < n * count)
-    on_buffer_.resize(n * count);
+  if (on_buffer_.size < n * count) {
+    on_buffer_.data.reset(new pcl::index_t[n * count]); // not initialised: only writes touch it
+    on_buffer_.size = n * count;
+  }
   std::array<pcl::index_t*, 8> ends;
   for (std::size_t s = 0; s < n; ++s)
-    ends[s] = on_buffer_.data() + s * count;
+    ends[s] = on_buffer_.data.get() + s * count;
   // PCL's point types start with x, y, z (PCL_ADD_POINT4D): the sort reads the cloud itself.
   if constexpr (pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
                 pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
@@ -594,7 +596,7 @@ TabletopSegmentation<PointT>::classifyPoints(const std::vector<Candidate>& candi
     sorter.sort(xyz.data(), 4, count, given, ends.data(), above);
   }
   for (std::size_t s = 0; s < n; ++s)
-    all[s].inliers.indices.assign(on_buffer_.data() + s * count, ends[s]);
+    all[s].inliers.indices.assign(on_buffer_.data.get() + s * count, ends[s]);
   for (std::size_t s = 0; s < n; ++s) {
     all[s].plane = candidates[s].plane;
     all[s].band = candidates[s].band;
@@ -980,6 +982,33 @@ void
 TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
                                                std::vector<pcl::Indices>& out) const
 {
+  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
+    if (!has_depth_known_ || has_depth_.size() != input_->size()) { // else from planeGrid
+      has_depth_.resize(input_->size());
+      for (std::size_t i = 0; i < input_->size(); ++i)
+        has_depth_[i] = pcl::isFinite((*input_)[i]);
+      has_depth_known_ = true;
+    }
+    // The object points alone, at their pixels in image order: no image-sized copy is filled
+    // or read.
+    pcl::Indices sorted;
+    const bool ascending = std::adjacent_find(objects.begin(), objects.end(), [](auto a, auto b) {
+                             return a >= b;
+                           }) == objects.end();
+    if (!ascending) {
+      sorted = objects;
+      std::sort(sorted.begin(), sorted.end());
+      sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    }
+    const pcl::Indices& pixels = ascending ? objects : sorted;
+    Eigen::Matrix3Xf points(3, static_cast<Eigen::Index>(pixels.size()));
+    for (std::size_t k = 0; k < pixels.size(); ++k)
+      points.col(static_cast<Eigen::Index>(k)) = (*input_)[pixels[k]].getVector3fMap();
+    out = segmentObjectsOrganized(points, pixels, input_->width, input_->height, has_depth_, focal_,
+                                  input_->sensor_origin_.head(3), params_.objects,
+                                  has_noise_ ? &noise_ : nullptr);
+    return;
+  }
   // A sparse copy with only the object points finite: the components then never visit the
   // rest of the image. (Buffers kept between calls: fresh VGA-sized allocations cost more in
   // page faults than the work done on them; only the pixels written last time are cleared.)
@@ -999,18 +1028,6 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
   for (const auto i : objects)
     (*masked)[i].getVector3fMap() = (*input_)[i].getVector3fMap();
   masked_written_ = objects;
-  if (params_.clustering == TabletopSegmentationParameters::Clustering::EdgeAware && focal_ > 0.f) {
-    if (!has_depth_known_ || has_depth_.size() != input_->size()) { // else from planeGrid
-      has_depth_.resize(input_->size());
-      for (std::size_t i = 0; i < input_->size(); ++i)
-        has_depth_[i] = pcl::isFinite((*input_)[i]);
-      has_depth_known_ = true;
-    }
-    // The grid is built from the object points themselves: the masked frame is not scanned.
-    out = segmentObjectsOrganized(*masked, has_depth_, focal_, input_->sensor_origin_.head(3),
-                                  params_.objects, has_noise_ ? &noise_ : nullptr, &objects);
-    return;
-  }
   out = organizedEuclideanClusters(masked, params_.cluster_tolerance, labels_);
 }
 
