@@ -199,12 +199,8 @@ private:
       , viewpoint_(viewpoint)
       , p_(p)
   {
-    // The noise's half-width by range, every 5 mm up to 12 m.
-    if (noise) {
-      noise_half_.resize(kBins);
-      for (std::size_t b = 0; b < kBins; ++b)
-        noise_half_[b] = noise->halfWidth((static_cast<float>(b) + 0.5f) * kBin);
-    }
+    if (noise)
+      noise_half_ = tabulateHalfWidths(*noise);
     pixel_.reserve(valid);
     xyz_.reserve(valid);
     u_.reserve(valid);
@@ -231,11 +227,11 @@ private:
     range_.push_back(r);
     float gap = std::clamp(p_.jump_factor * r / focal_, p_.min_gap, p_.max_gap);
     if (!noise_half_.empty()) // neighbours on one surface differ by the sensor's noise
-      gap = std::max(gap, noise_half_[std::min(static_cast<std::size_t>(r / kBin), kBins - 1)]);
+      gap = std::max(
+        gap,
+        noise_half_[std::min(static_cast<std::size_t>(r / kHalfWidthBin), kHalfWidthBins - 1)]);
     gap2_.push_back(gap * gap);
   }
-  static constexpr float kBin = 0.005f;
-  static constexpr std::size_t kBins = 2400;
   int w_, h_;
   std::vector<int> slot_;
   float focal_;
@@ -727,6 +723,13 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
   return out;
 }
 
+bool
+strictlyAscending(const pcl::Indices& indices)
+{
+  return std::adjacent_find(indices.begin(), indices.end(),
+                            [](auto a, auto b) { return a >= b; }) == indices.end();
+}
+
 namespace {
 
 /** segmentObjectsOrganized on its grid of valid pixels. */
@@ -780,8 +783,7 @@ segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
 {
   if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
     return {};
-  if (finite && std::adjacent_find(finite->begin(), finite->end(),
-                                   [](auto a, auto b) { return a >= b; }) != finite->end())
+  if (finite && !strictlyAscending(*finite))
     finite = nullptr; // not strictly ascending: the grid's order is the image's, so scan
   return segmentGrid(Grid(cloud, focal, viewpoint, p, noise, finite), has_depth, focal, viewpoint,
                      p);
@@ -796,9 +798,7 @@ segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixe
 {
   const std::size_t size = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (width == 0 || height < 2 || !(focal > 0.f) || has_depth.size() != size ||
-      points.cols() != static_cast<Eigen::Index>(pixels.size()) ||
-      std::adjacent_find(pixels.begin(), pixels.end(), [](auto a, auto b) { return a >= b; }) !=
-        pixels.end() ||
+      points.cols() != static_cast<Eigen::Index>(pixels.size()) || !strictlyAscending(pixels) ||
       (!pixels.empty() && (pixels.front() < 0 || static_cast<std::size_t>(pixels.back()) >= size)))
     return {};
   return segmentGrid(Grid(points, pixels, static_cast<int>(width), static_cast<int>(height), focal,

@@ -208,11 +208,6 @@ rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
   return families;
 }
 
-namespace {
-constexpr float kSortBin = 0.005f;      // the band half-widths' range bins (m)
-constexpr std::size_t kSortBins = 2400; // 12 m
-} // namespace
-
 PlaneSorter::PlaneSorter(std::vector<Eigen::Vector4f> planes, std::vector<DepthBand> bands,
                          const Eigen::Vector3f& viewpoint, float floor, float top)
     : planes_(std::move(planes))
@@ -224,10 +219,12 @@ PlaneSorter::PlaneSorter(std::vector<Eigen::Vector4f> planes, std::vector<DepthB
   const std::size_t n = planes_.size();
   if (n > 8 || bands_.size() != n)
     throw std::invalid_argument("facyl::PlaneSorter: at most 8 planes, one band each");
-  half_.resize(kSortBins * n);
-  for (std::size_t s = 0; s < n; ++s)
-    for (std::size_t b = 0; b < kSortBins; ++b)
-      half_[b * n + s] = bands_[s].halfWidth((static_cast<float>(b) + 0.5f) * kSortBin);
+  half_.resize(kHalfWidthBins * n);
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::vector<float> half = tabulateHalfWidths(bands_[s]);
+    for (std::size_t b = 0; b < kHalfWidthBins; ++b)
+      half_[b * n + s] = half[b];
+  }
 }
 
 void
@@ -239,8 +236,8 @@ PlaneSorter::sortOne(pcl::index_t i, const float* p, pcl::index_t** ends,
     return;
   const std::size_t n = planes_.size();
   const float range = (q - viewpoint_).norm();
-  const auto b = static_cast<std::size_t>(range / kSortBin);
-  const float* widths = b < kSortBins ? half_.data() + b * n : nullptr;
+  const auto b = static_cast<std::size_t>(range / kHalfWidthBin);
+  const float* widths = b < kHalfWidthBins ? half_.data() + b * n : nullptr;
   std::uint8_t on = 0, over = 0;
   for (std::size_t s = 0; s < n; ++s) {
     const float h = planes_[s].head<3>().dot(q) + planes_[s][3];
@@ -266,9 +263,9 @@ PlaneSorter::sortByFour(const float* xyz, std::size_t stride, std::size_t count,
   const std::size_t n = planes_.size();
   const __m128 zero = _mm_setzero_ps(), vx = _mm_set1_ps(viewpoint_.x()),
                vy = _mm_set1_ps(viewpoint_.y()), vz = _mm_set1_ps(viewpoint_.z()),
-               bin = _mm_set1_ps(kSortBin), last = _mm_set1_ps(static_cast<float>(kSortBins)),
-               floor = _mm_set1_ps(floor_), top = _mm_set1_ps(top_),
-               magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+               bin = _mm_set1_ps(kHalfWidthBin),
+               last = _mm_set1_ps(static_cast<float>(kHalfWidthBins)), floor = _mm_set1_ps(floor_),
+               top = _mm_set1_ps(top_), magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   alignas(16) std::int32_t bin_of[4];
   int on_lanes[8], over_lanes[8];
   std::size_t k = 0;

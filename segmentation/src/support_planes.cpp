@@ -41,6 +41,15 @@ fixedBand(float half_width)
   return b;
 }
 
+std::vector<float>
+tabulateHalfWidths(const DepthBand& band)
+{
+  std::vector<float> half(kHalfWidthBins);
+  for (std::size_t b = 0; b < kHalfWidthBins; ++b)
+    half[b] = band.halfWidth((static_cast<float>(b) + 0.5f) * kHalfWidthBin);
+  return half;
+}
+
 DepthBand
 estimateDepthBand(const std::vector<float>& ranges, const std::vector<float>& residuals,
                   float factor, float min_sigma)

@@ -92,6 +92,10 @@ std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::Poi
                                                   const DepthBand* noise = nullptr,
                                                   const pcl::Indices* finite = nullptr);
 
+/** \brief Whether \a indices ascend strictly (no repeat): the image order that
+ * segmentObjectsOrganized's pixel lists keep. */
+bool strictlyAscending(const pcl::Indices& indices);
+
 /** \brief segmentObjectsOrganized on the object points alone: \a points (3 x n; non-finite
  * columns are left out) at the pixels \a pixels (strictly ascending indices into a \a width x
  * \a height image). The same segments as the cloud version on a cloud that holds these points

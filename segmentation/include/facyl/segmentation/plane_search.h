@@ -151,10 +151,6 @@ public:
    * where SSE2 is there (x86-64), with the same floats and lists as one at a time (false). */
   void sort(const float* xyz, std::size_t stride, std::size_t count, const pcl::index_t* indices,
             pcl::index_t** ends, std::vector<PointOverPlanes>& above, bool vectorized = true) const;
-  std::size_t size() const
-  {
-    return planes_.size();
-  }
 
 private:
   void sortOne(pcl::index_t i, const float* p, pcl::index_t** ends,
@@ -167,7 +163,7 @@ private:
   std::vector<DepthBand> bands_;
   Eigen::Vector3f viewpoint_;
   float floor_, top_;
-  std::vector<float> half_; ///< half-widths by 5 mm bin of range, then plane
+  std::vector<float> half_; ///< half-widths by bin of range (tabulateHalfWidths), then plane
 };
 
 /** \brief Connected components of the organized \a cloud, neighbours closer than \a

@@ -43,6 +43,16 @@ struct DepthBand {
 /** \brief A band of the same half-width \a half_width (> 0) at every range. */
 DepthBand fixedBand(float half_width);
 
+/** \brief Bins of range in which per-point loops look a band's half-width up (5 mm, up to
+ * 12 m): see tabulateHalfWidths. */
+constexpr float kHalfWidthBin = 0.005f;
+constexpr std::size_t kHalfWidthBins = 2400;
+
+/** \brief \a band's half-width at the centre of each of the kHalfWidthBins bins of range:
+ * entry b is halfWidth((b + 0.5) kHalfWidthBin), for a point at range r in bin r /
+ * kHalfWidthBin. */
+std::vector<float> tabulateHalfWidths(const DepthBand& band);
+
 /** \brief The DepthBand of signed \a residuals (distances from a plane) measured at \a
  * ranges (at most 4000 of them, evenly): up to 8 bins of equal counts (at least 150 samples
  * each), each with 1.4826 x the

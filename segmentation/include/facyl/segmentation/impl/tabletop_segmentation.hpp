@@ -992,9 +992,7 @@ TabletopSegmentation<PointT>::clusterOrganized(const pcl::Indices& objects,
     // The object points alone, at their pixels in image order: no image-sized copy is filled
     // or read.
     pcl::Indices sorted;
-    const bool ascending = std::adjacent_find(objects.begin(), objects.end(), [](auto a, auto b) {
-                             return a >= b;
-                           }) == objects.end();
+    const bool ascending = strictlyAscending(objects);
     if (!ascending) {
       sorted = objects;
       std::sort(sorted.begin(), sorted.end());
