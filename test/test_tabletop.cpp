@@ -588,6 +588,49 @@ TEST(TabletopCylinderRecognizer, EndToEndOnSimulatedScenes)
   EXPECT_LT(facyl_test::quantile(axis_error, 0.9), 3.f);
 }
 
+TEST(TabletopCylinderRecognizer, ResultsDoNotDependOnTheThreads)
+{
+  // Clusters are fitted on several threads, each with estimators of its own: one thread, two
+  // and more than there are clusters give the same objects, frame after frame.
+  const auto run = [](facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
+                      const Cloud::Ptr& cloud) {
+    rec.setInputCloud(cloud);
+    std::vector<facyl::RecognizedObject> objects;
+    EXPECT_TRUE(rec.recognize(objects));
+    return objects;
+  };
+  facyl::TabletopRecognizerParameters p;
+  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> one, two, many;
+  p.threads = 1;
+  one.setParameters(p);
+  p.threads = 2;
+  two.setParameters(p);
+  p.threads = 16;
+  many.setParameters(p);
+  std::size_t fitted = 0;
+  for (std::uint64_t seed = 31; seed < 35; ++seed) {
+    const Cloud::Ptr cloud(new Cloud(scene(seed).cloud));
+    const auto a = run(one, cloud);
+    for (auto* rec : {&two, &many}) {
+      const auto b = run(*rec, cloud);
+      ASSERT_EQ(a.size(), b.size()) << "seed " << seed;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_EQ(a[k].cluster.indices.indices, b[k].cluster.indices.indices);
+        EXPECT_EQ(a[k].is_cylinder, b[k].is_cylinder);
+        EXPECT_EQ(a[k].evidence.fitted, b[k].evidence.fitted);
+        EXPECT_EQ(a[k].evidence.inlier_ratio, b[k].evidence.inlier_ratio);
+        EXPECT_EQ(a[k].cylinder.radius, b[k].cylinder.radius);
+        EXPECT_EQ(a[k].cylinder.axis, b[k].cylinder.axis);
+        EXPECT_EQ(a[k].cylinder.point_on_axis, b[k].cylinder.point_on_axis);
+        EXPECT_EQ(a[k].cylinder.inliers, b[k].cylinder.inliers);
+      }
+    }
+    for (const auto& o : a)
+      fitted += o.evidence.fitted;
+  }
+  EXPECT_GT(fitted, 8u); // several clusters a frame: the threads had work to share
+}
+
 /** Always says "not a cylinder", or NaN. */
 class FixedClassifier : public facyl::ShapeClassifier {
 public:
@@ -653,6 +696,11 @@ TEST(TabletopCylinderRecognizer, ReportsBadInput)
   facyl::TabletopRecognizerParameters p;
   p.decision.min_score = 1.5f;
   EXPECT_FALSE(facyl::validate(p).empty());
+  p = facyl::TabletopRecognizerParameters{};
+  for (const int threads : {-1, 65}) {
+    p.threads = threads;
+    EXPECT_NE(facyl::validate(p).find("threads"), std::string::npos);
+  }
   p = facyl::TabletopRecognizerParameters{};
   p.hough.radius_min = 0.3f;
   p.hough.radius_max = 0.1f;

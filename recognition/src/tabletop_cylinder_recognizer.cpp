@@ -35,6 +35,8 @@ validate(const TabletopRecognizerParameters& p)
     s << "reject_below " << p.reject_below << " must be in [0, 1]";
   else if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))
     s << "recovery_margin " << p.recovery_margin << " must be in [0, 1] m";
+  else if (p.threads < 0 || p.threads > 64)
+    s << "threads " << p.threads << " must be in [0, 64]";
   return s.str();
 }
 

@@ -31,29 +31,31 @@ parallelWorkers(std::size_t n, int threads, std::size_t grain)
     std::max<std::size_t>(1, std::min<std::size_t>(blocks, static_cast<std::size_t>(t))));
 }
 
-/** \brief Calls \a body(begin, end) on blocks of at most \a grain items covering [0, n), on
- * parallelWorkers(n, threads, grain) threads (the caller's among them); blocks are taken in
- * order by whichever thread is free. Returns when all blocks are done; the first exception a
- * block throws is rethrown here. \a body must only write what its block owns: the result
- * then does not depend on the number of threads. */
+/** \brief Calls \a body(begin, end, worker) on blocks of at most \a grain items covering
+ * [0, n), on parallelWorkers(n, threads, grain) threads (the caller's among them); blocks are
+ * taken in order by whichever thread is free, and \a worker (in [0, parallelWorkers(...)))
+ * names the thread that runs the block, so that each thread can use state of its own. Returns
+ * when all blocks are done; the first exception a block throws is rethrown here. \a body must
+ * only write what its block or its worker owns: the result then does not depend on the number
+ * of threads. */
 template <typename Body>
 void
-parallelFor(std::size_t n, int threads, std::size_t grain, Body&& body)
+parallelForWorkers(std::size_t n, int threads, std::size_t grain, Body&& body)
 {
   grain = std::max<std::size_t>(grain, 1);
   const int workers = parallelWorkers(n, threads, grain);
   if (workers <= 1) {
     for (std::size_t b = 0; b < n; b += grain)
-      body(b, std::min(n, b + grain));
+      body(b, std::min(n, b + grain), 0);
     return;
   }
   std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex failure_mutex;
-  const auto work = [&]() {
+  const auto work = [&](int worker) {
     try {
       for (std::size_t b = next.fetch_add(grain); b < n; b = next.fetch_add(grain))
-        body(b, std::min(n, b + grain));
+        body(b, std::min(n, b + grain), worker);
     }
     catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -66,17 +68,28 @@ parallelFor(std::size_t n, int threads, std::size_t grain, Body&& body)
   pool.reserve(static_cast<std::size_t>(workers - 1));
   for (int w = 1; w < workers; ++w) {
     try {
-      pool.emplace_back(work);
+      pool.emplace_back(work, w);
     }
     catch (const std::system_error&) { // no more threads: the ones running do the work
       break;
     }
   }
-  work();
+  work(0);
   for (auto& t : pool)
     t.join();
   if (failure)
     std::rethrow_exception(failure);
+}
+
+/** \brief Calls \a body(begin, end) on blocks of at most \a grain items covering [0, n), as
+ * parallelForWorkers does. \a body must only write what its block owns: the result then does
+ * not depend on the number of threads. */
+template <typename Body>
+void
+parallelFor(std::size_t n, int threads, std::size_t grain, Body&& body)
+{
+  parallelForWorkers(n, threads, grain,
+                     [&body](std::size_t begin, std::size_t end, int) { body(begin, end); });
 }
 
 } // namespace facyl

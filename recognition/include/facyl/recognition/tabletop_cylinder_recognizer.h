@@ -79,6 +79,10 @@ struct TabletopRecognizerParameters {
    * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
   float reject_below{0.1f};
   int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
+  /** Clusters fitted at once, each thread with a cue estimation and estimators of its own:
+   * 0 (default) the hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting
+   * threads sleep (parallelFor), and the results do not depend on it. */
+  int threads{0};
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
@@ -117,7 +121,8 @@ struct RecognitionTiming {
  * \endcode
  * Errors (bad parameters, no cloud, no table) are reported with PCL_ERROR and make
  * recognize() return false with no objects. recognize() is not reentrant on one object;
- * distinct objects may run concurrently.
+ * distinct objects may run concurrently. Within recognize(), clusters are fitted on
+ * TabletopRecognizerParameters::threads threads.
  */
 template <typename PointT> class TabletopCylinderRecognizer : public pcl::PCLBase<PointT> {
 public:
@@ -198,7 +203,7 @@ private:
   /** recognize() on a cloud in the sensor's frame (identity sensor pose); \a t0: its start. */
   bool recognizeInSensorFrame(std::vector<RecognizedObject>& objects,
                               std::chrono::steady_clock::time_point t0);
-  /** Builds the cue estimation and the estimators (one per prior of the retries). */
+  /** Builds the fitters (one per thread of the fits). */
   void configure();
   /** What the classifier sees of the points \a indices: the image's pixels, or (an unorganized
    * cloud without a camera) a virtual camera's at the sensor origin (lookAtObjectView). */
@@ -208,24 +213,47 @@ private:
   /** The objects [first, end) made of one cluster of network probability \a p_cluster: their
    * p_network (split parts: of their own view), p_cylinder (fused) and the decision. */
   void applyClassifier(std::vector<RecognizedObject>& objects, std::size_t first, float p_cluster);
-  /** Sets the estimators' prior frame to that of support \a support (-1: none). */
-  void usePriorFrameOf(int support);
+  /** What fits one cluster at a time: the cue estimation and the estimators (one per prior of
+   * the retries), configured alike; one per thread of the fits. */
+  struct Fitter {
+    NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues;
+    std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators;
+    std::size_t upright{0};   ///< index of the estimator with the axis along the support's normal
+    bool with_support{false}; ///< the cluster being fitted has a support
+    int retry_threads{1};     ///< threads that run the retries of one cluster at once
+  };
+  /** Builds a fitter from the settings. */
+  std::unique_ptr<Fitter> makeFitter() const;
+  /** Sets the prior frame of \a fitter's estimators to that of support \a support (-1: none). */
+  void usePriorFrameOf(Fitter& fitter, int support) const;
+  /** recognizeCluster for every cluster that the classifier does not reject before fitting
+   * (p_network below reject_below: one object, not fitted), on params_.threads threads (one
+   * fitter each, largest cluster first): the objects of cluster k in element k. Sets
+   * timing_.fitting (0 when no cluster is fitted). */
+  std::vector<std::vector<RecognizedObject>> fitClusters(std::vector<TabletopCluster>& clusters,
+                                                         const std::vector<float>& p_network);
   /** Joins each object lying inside the cylinder fitted to another (the inside of an open
    * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
    * that one, which keeps its fit and is classified again as a whole. */
   void joinContainerInsides(std::vector<RecognizedObject>& objects);
-  /** Subsamples \a cluster and estimates normals and curvatures. */
-  FitInput prepareFit(const TabletopCluster& cluster);
+  /** Subsamples \a cluster and estimates normals and curvatures (with \a fitter). The fitting
+   * functions below change only their fitter: threads with fitters of their own may run them
+   * at once. */
+  FitInput prepareFit(Fitter& fitter, const TabletopCluster& cluster) const;
   /** Fits the points of \a input flagged in \a alive (all when empty) with the configured
    * prior, then (when not accepted) the retries. The evidence is relative to those points. */
-  Fit fitWithRetries(const FitInput& input, const std::vector<std::uint8_t>& alive);
-  Fit fitOnce(const FitInput& input, const std::vector<std::uint8_t>& alive, std::size_t estimator);
-  /** Classifies, fits and decides one cluster: one object, or several (recovery). */
-  void recognizeCluster(TabletopCluster cluster, float p_network,
-                        std::vector<RecognizedObject>& objects);
+  Fit fitWithRetries(Fitter& fitter, const FitInput& input,
+                     const std::vector<std::uint8_t>& alive) const;
+  Fit fitOnce(Fitter& fitter, const FitInput& input, const std::vector<std::uint8_t>& alive,
+              std::size_t estimator) const;
+  /** Fits and decides one cluster: one object, or several (recovery); the classifier's
+   * probability \a p_network asks for the recovery when in doubt (applyClassifier judges the
+   * objects). */
+  void recognizeCluster(Fitter& fitter, TabletopCluster cluster, float p_network,
+                        std::vector<RecognizedObject>& objects) const;
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
-  std::vector<Fit> extractCylinders(const FitInput& input, Fit first);
+  std::vector<Fit> extractCylinders(Fitter& fitter, const FitInput& input, Fit first) const;
   /** Least squares of \a model on the cluster's points (\a indices) near its surface. */
   void refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
@@ -245,10 +273,7 @@ private:
   pcl::IndicesConstPtr segmentation_indices_;
   RecognitionTiming timing_;
   bool configured_{false};
-  NormalCurvatureEstimation<pcl::PointXYZ, NormalCurvature> cues_estimation_;
-  std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators_;
-  std::size_t upright_{0};   ///< index of the estimator with the axis along the support's normal
-  bool with_support_{false}; ///< the cluster being fitted has a support
+  std::vector<std::unique_ptr<Fitter>> fitters_; ///< one per thread of the fits
 };
 
 /** \brief The convention of the recognizer's cylinders: the axis runs from the base (

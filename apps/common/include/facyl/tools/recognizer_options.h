@@ -29,6 +29,7 @@ recognizerValueOptions()
           "--orientations",
           "--max-fit-points",
           "--neighbours",
+          "--threads",
           "--seed",
           "--plane-distance",
           "--height-limits",
@@ -100,6 +101,8 @@ recognizerOptionsHelp()
     "  --max-fit-points N     points fitted per cluster at most (default 1200)\n"
     "  --neighbours K         k of the normal/curvature estimation (default 16; old\n"
     "                         spelling --k)\n"
+    "  --threads N            clusters fitted at once (default 0: the hardware's\n"
+    "                         concurrency; 1: the calling thread alone)\n"
     "  --seed S               accumulator seed (default 0)\n"
     "  --max-cylinders-per-cluster N  cylinders extracted from a cluster the best fit\n"
     "                         does not explain (touching, stacked objects; default 3;\n"
@@ -165,6 +168,7 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   p.max_fit_points = static_cast<std::size_t>(
     args.integer("--max-fit-points", static_cast<long long>(p.max_fit_points), 50, 1000000));
   p.neighbours = static_cast<int>(args.integer("--neighbours", p.neighbours, 5, 200));
+  p.threads = static_cast<int>(args.integer("--threads", p.threads, 0, 64));
   p.hough.seed = static_cast<std::uint64_t>(
     args.integer("--seed", static_cast<long long>(p.hough.seed), 0, kMaxSeed));
   p.max_cylinders_per_cluster = static_cast<std::size_t>(args.integer(

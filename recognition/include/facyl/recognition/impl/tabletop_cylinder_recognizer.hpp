@@ -3,6 +3,7 @@
  */
 #pragma once
 
+#include <facyl/features/parallel.h>
 #include <facyl/recognition/impl/classifier_input.hpp>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
@@ -14,6 +15,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <numeric>
+#include <thread>
 #include <unordered_set>
 
 namespace facyl {
@@ -38,26 +42,42 @@ template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::configure()
 {
-  cues_estimation_.setKSearch(params_.neighbours);
+  const int threads = params_.threads > 0
+                        ? params_.threads
+                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  fitters_.clear();
+  for (int t = 0; t < threads; ++t)
+    fitters_.push_back(makeFitter());
+  configured_ = true;
+}
+
+template <typename PointT>
+std::unique_ptr<typename TabletopCylinderRecognizer<PointT>::Fitter>
+TabletopCylinderRecognizer<PointT>::makeFitter() const
+{
+  auto f = std::make_unique<Fitter>();
+  f->cues.setKSearch(params_.neighbours);
   // A cluster's cues are a millisecond of work: threads would cost more in start-up and, beside
-  // other busy processes, in waiting for each other than they save.
-  cues_estimation_.setNumberOfThreads(1);
+  // other busy processes, in waiting for each other than they save (clusters are fitted in
+  // parallel instead).
+  f->cues.setNumberOfThreads(1);
   // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
   // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
   // face from pulling the axis. Optionally a last try allows any normal sign: the inside of
   // an open container can make a cluster of its own (so can the inside of a bowl).
   const bool any_sign =
     params_.retry_upright_lying && params_.hough.outward_normals && params_.retry_any_normal_sign;
-  estimators_.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
+  auto& estimators = f->estimators;
+  estimators.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
   const OrientationPrior priors[4] = {params_.hough.prior, OrientationPrior::VerticalStrong,
                                       OrientationPrior::Horizontal, params_.hough.prior};
-  for (std::size_t e = 0; e < estimators_.size(); ++e) {
+  for (std::size_t e = 0; e < estimators.size(); ++e) {
     HoughCylinderParameters hp = params_.hough;
     if (e == 3)
       hp.outward_normals = false;
     hp.prior = priors[e];
-    estimators_[e].setParameters(hp);
-    estimators_[e].setDiagnoseFailures(false); // a cluster without a cylinder is an answer
+    estimators[e].setParameters(hp);
+    estimators[e].setDiagnoseFailures(false); // a cluster without a cylinder is an answer
   }
   // Last, on objects with a support: the axis fixed along the support's normal, only position
   // and radius fitted. A short, wide tin seen from above shows mostly its lid and a thin band
@@ -65,14 +85,14 @@ TabletopCylinderRecognizer<PointT>::configure()
   if (params_.retry_upright_lying) {
     HoughCylinderParameters hp = params_.hough;
     hp.refine = false; // the axis stays the support's normal
-    estimators_.emplace_back();
-    estimators_.back().setParameters(hp);
-    estimators_.back().setDiagnoseFailures(false);
-    upright_ = estimators_.size() - 1;
+    estimators.emplace_back();
+    estimators.back().setParameters(hp);
+    estimators.back().setDiagnoseFailures(false);
+    f->upright = estimators.size() - 1;
   }
   else
-    upright_ = estimators_.size();
-  configured_ = true;
+    f->upright = estimators.size();
+  return f;
 }
 
 template <typename PointT>
@@ -154,12 +174,14 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
     return false;
   }
   const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  cues_estimation_.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
+  for (auto& f : fitters_)
+    f->cues.setViewPoint(viewpoint.x(), viewpoint.y(), viewpoint.z());
   const std::vector<float> p_network = classifyClusters(clusters);
-  for (std::size_t k = 0; k < clusters.size(); ++k) {
-    usePriorFrameOf(clusters[k].support);
+  std::vector<std::vector<RecognizedObject>> fitted = fitClusters(clusters, p_network);
+  for (std::size_t k = 0; k < fitted.size(); ++k) {
     const std::size_t first = objects.size();
-    recognizeCluster(std::move(clusters[k]), p_network[k], objects);
+    for (auto& o : fitted[k])
+      objects.push_back(std::move(o));
     if (classifier_)
       applyClassifier(objects, first, p_network[k]);
   }
@@ -178,8 +200,50 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
 }
 
 template <typename PointT>
+std::vector<std::vector<RecognizedObject>>
+TabletopCylinderRecognizer<PointT>::fitClusters(std::vector<TabletopCluster>& clusters,
+                                                const std::vector<float>& p_network)
+{
+  std::vector<std::vector<RecognizedObject>> fitted(clusters.size());
+  std::vector<std::size_t> order; // the clusters to fit
+  for (std::size_t k = 0; k < clusters.size(); ++k) {
+    if (classifier_ && p_network[k] < params_.reject_below) { // rejected before fitting
+      RecognizedObject object;                                // (paper III-B)
+      object.cluster = std::move(clusters[k]);
+      fitted[k].push_back(std::move(object));
+    }
+    else
+      order.push_back(k);
+  }
+  if (order.empty())
+    return fitted;
+  // One cluster at a time per thread, largest first (a long fit started last would keep the
+  // others waiting); each thread uses its own fitter.
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return clusters[a].indices.indices.size() > clusters[b].indices.indices.size();
+  });
+  // Threads the clusters leave idle run a cluster's retries at once.
+  const int spare = std::max<int>(1, static_cast<int>(fitters_.size() / order.size()));
+  for (auto& f : fitters_)
+    f->retry_threads = spare;
+  const auto t = std::chrono::steady_clock::now();
+  parallelForWorkers(order.size(), static_cast<int>(fitters_.size()), 1,
+                     [&](std::size_t begin, std::size_t end, int worker) {
+                       Fitter& fitter = *fitters_[static_cast<std::size_t>(worker)];
+                       for (std::size_t i = begin; i < end; ++i) {
+                         const std::size_t k = order[i];
+                         usePriorFrameOf(fitter, clusters[k].support);
+                         recognizeCluster(fitter, std::move(clusters[k]), p_network[k], fitted[k]);
+                       }
+                     });
+  timing_.fitting =
+    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  return fitted;
+}
+
+template <typename PointT>
 void
-TabletopCylinderRecognizer<PointT>::usePriorFrameOf(int support)
+TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support) const
 {
   // The frame of the support the object stands on; without one, that of an upright camera
   // (z up: against the image's rows).
@@ -188,11 +252,12 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(int support)
     frame = segmentation_.getSupports()[static_cast<std::size_t>(support)].frame.linear();
   else
     frame << 1.f, 0.f, 0.f, 0.f, 0.f, -1.f, 0.f, 1.f, 0.f; // columns x, y, z = -image y
-  for (auto& hough : estimators_)
+  for (auto& hough : fitter.estimators)
     hough.setReferenceFrame(frame);
-  with_support_ = support >= 0;
-  if (upright_ < estimators_.size())
-    estimators_[upright_].setAccumulators({OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
+  fitter.with_support = support >= 0;
+  if (fitter.upright < fitter.estimators.size())
+    fitter.estimators[fitter.upright].setAccumulators(
+      {OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
 }
 
 template <typename PointT>
@@ -402,22 +467,14 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
 
 template <typename PointT>
 void
-TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, float p_network,
-                                                     std::vector<RecognizedObject>& objects)
+TabletopCylinderRecognizer<PointT>::recognizeCluster(Fitter& fitter, TabletopCluster cluster,
+                                                     float p_network,
+                                                     std::vector<RecognizedObject>& objects) const
 {
-  using Clock = std::chrono::steady_clock;
-  const auto ms = [](Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-  };
   RecognizedObject object;
   object.cluster = std::move(cluster);
-  auto t = Clock::now();
-  if (classifier_ && p_network < params_.reject_below) {
-    objects.push_back(std::move(object)); // rejected before fitting (paper III-B)
-    return;
-  }
-  const FitInput input = prepareFit(object.cluster);
-  Fit best = fitWithRetries(input, {});
+  const FitInput input = prepareFit(fitter, object.cluster);
+  Fit best = fitWithRetries(fitter, input, {});
   if (best.evidence.fitted) {
     object.evidence = best.evidence;
     object.cylinder = best.model;
@@ -433,20 +490,19 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(TabletopCluster cluster, fl
   const bool doubted = classifier_ && p_network < params_.decision.min_probability;
   if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
-    std::vector<Fit> parts = extractCylinders(input, std::move(best));
+    std::vector<Fit> parts = extractCylinders(fitter, input, std::move(best));
     if (!parts.empty()) {
       splitCluster(object, input, parts, objects);
-      timing_.fitting += ms(t, Clock::now());
       return;
     }
   }
   objects.push_back(std::move(object));
-  timing_.fitting += ms(t, Clock::now());
 }
 
 template <typename PointT>
 std::vector<typename TabletopCylinderRecognizer<PointT>::Fit>
-TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit fit)
+TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitInput& input,
+                                                     Fit fit) const
 {
   // Judged on the points around each cylinder; the margins make a sphere's or a cone's band
   // leave the rest of the sphere or cone in its region, and a box edge its faces.
@@ -462,7 +518,7 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(const FitInput& input, Fit 
   const std::size_t min_part = std::max<std::size_t>(30, input.points->size() / 30);
   for (std::size_t round = 0; round < params_.max_cylinders_per_cluster; ++round) {
     if (round > 0)
-      fit = fitWithRetries(input, alive);
+      fit = fitWithRetries(fitter, input, alive);
     if (!fit.evidence.fitted)
       break;
     std::vector<std::uint8_t> alive_columns(static_cast<std::size_t>(input.columns.cols()), 0);
@@ -634,7 +690,7 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
 
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::FitInput
-TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
+TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopCluster& cluster) const
 {
   FitInput in;
   // Organized clouds: a grid of pixels fit_point_angle apart, so that the neighbourhoods of
@@ -654,8 +710,8 @@ TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
     in.points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
   }
   in.cues.reset(new pcl::PointCloud<NormalCurvature>);
-  cues_estimation_.setInputCloud(in.points);
-  cues_estimation_.compute(*in.cues);
+  fitter.cues.setInputCloud(in.points);
+  fitter.cues.compute(*in.cues);
   // Points with a normal, as columns (the estimator's inliers skip the rest).
   const auto n = static_cast<Eigen::Index>(in.points->size());
   in.columns.resize(3, n);
@@ -677,12 +733,12 @@ TabletopCylinderRecognizer<PointT>::prepareFit(const TabletopCluster& cluster)
 
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::Fit
-TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input,
+TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& input,
                                             const std::vector<std::uint8_t>& alive,
-                                            std::size_t estimator)
+                                            std::size_t estimator) const
 {
   Fit f;
-  auto& hough = estimators_[estimator];
+  auto& hough = fitter.estimators[estimator];
   hough.setInputCloud(input.points);
   hough.setInputNormals(input.cues);
   pcl::IndicesPtr indices; // nullptr: every point
@@ -737,14 +793,28 @@ TabletopCylinderRecognizer<PointT>::fitOnce(const FitInput& input,
 
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::Fit
-TabletopCylinderRecognizer<PointT>::fitWithRetries(const FitInput& input,
-                                                   const std::vector<std::uint8_t>& alive)
+TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInput& input,
+                                                   const std::vector<std::uint8_t>& alive) const
 {
-  Fit best = fitOnce(input, alive, 0);
-  for (std::size_t e = 1; e < estimators_.size() && !best.accepted; ++e) {
-    if (e == upright_ && !with_support_)
-      continue;
-    Fit f = fitOnce(input, alive, e);
+  Fit best = fitOnce(fitter, input, alive, 0);
+  if (best.accepted)
+    return best;
+  std::vector<std::size_t> retries;
+  for (std::size_t e = 1; e < fitter.estimators.size(); ++e)
+    if (e != fitter.upright || fitter.with_support)
+      retries.push_back(e);
+  // Each retry has an estimator of its own: with threads to spare they run at once (a retry
+  // after an accepted one is then wasted), and are taken in order as if one after another.
+  std::vector<Fit> fits(retries.size());
+  if (fitter.retry_threads > 1)
+    parallelFor(retries.size(), fitter.retry_threads, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        fits[i] = fitOnce(fitter, input, alive, retries[i]);
+    });
+  for (std::size_t i = 0; i < retries.size() && !best.accepted; ++i) {
+    if (fitter.retry_threads <= 1)
+      fits[i] = fitOnce(fitter, input, alive, retries[i]);
+    Fit& f = fits[i];
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
          !best.evidence.fitted))
