@@ -79,8 +79,7 @@ struct TabletopRecognizerParameters {
    * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
   float reject_below{0.1f};
   int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
-  /** Threads of recognize(): clusters fitted at once, each thread with a cue estimation and
-   * estimators of its own, and the segmentation's (TabletopSegmentation::setNumberOfThreads);
+  /** Clusters fitted at once, each thread with a cue estimation and estimators of its own:
    * 0 (default) the hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting
    * threads sleep (parallelFor), and the results do not depend on it. */
   int threads{0};

@@ -286,17 +286,6 @@ public:
   {
     return up_;
   }
-  /** \brief Threads of the passes over the whole image that run in parallel (the plane
-   * grid's); 0 (default): the hardware's concurrency. Waiting threads sleep, and the results
-   * do not depend on it. */
-  void setNumberOfThreads(unsigned int threads)
-  {
-    threads_ = threads;
-  }
-  unsigned int getNumberOfThreads() const
-  {
-    return threads_;
-  }
 
   /** \brief Runs the segmentation. \return false (with PCL_ERROR) on bad input. */
   bool segment(std::vector<TabletopCluster>& clusters)
@@ -493,7 +482,6 @@ private:
   std::size_t table_{0};
   bool table_found_{false};
   float focal_{0.f};                                    ///< pixels (organized input)
-  unsigned int threads_{0};                             ///< see setNumberOfThreads
   Eigen::Vector3f image_down_{Eigen::Vector3f::Zero()}; ///< organized input; zero: unknown
   pcl::ModelCoefficients table_coefficients_;
   typename PointCloud::Ptr hull_{new PointCloud};

@@ -158,7 +158,6 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   };
   std::vector<TabletopCluster> clusters;
   segmentation_.setParameters(params_.segmentation);
-  segmentation_.setNumberOfThreads(static_cast<unsigned int>(params_.threads));
   segmentation_.setInputCloud(input_);
   if (segmentation_indices_ != indices_) {
     segmentation_.setIndices(indices_); // nullptr: the whole cloud

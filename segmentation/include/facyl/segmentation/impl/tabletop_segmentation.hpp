@@ -3,7 +3,6 @@
  */
 #pragma once
 
-#include <facyl/features/parallel.h>
 #include <facyl/features/polygon.h>
 #include <facyl/segmentation/plane_search.h>
 #include <facyl/segmentation/support_planes.h>
@@ -284,36 +283,25 @@ TabletopSegmentation<PointT>::planeGrid(int step, PlaneGrid& grid, PlaneGrid* tw
   const bool record = !has_depth_known_;
   if (record)
     has_depth_.resize(input_->size());
-  // Pixel rows [v0, v1) into the blocks.
-  const auto addRows = [&](int v0, int v1) {
-    for (int v = v0; v < v1; ++v) {
-      const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
-      const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
-      for (int u = 0; u < w; ++u) {
-        const std::size_t idx = base + static_cast<std::size_t>(u);
-        const PointT& p = points[idx];
-        const bool finite = std::isfinite(p.z) && pcl::isFinite(p);
-        if (record)
-          has_depth_[idx] = finite;
-        if (!finite || !(fake_indices_ || allowed[idx]))
-          continue;
-        const auto uu = static_cast<std::size_t>(u);
-        fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx),
-                   p.getVector3fMap());
-        if (coarse)
-          coarse->addTo(coarse_row + coarse->column_block[uu], static_cast<pcl::index_t>(idx),
-                        p.getVector3fMap());
-      }
+  for (int v = 0; v < h; ++v) {
+    const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
+    const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
+    for (int u = 0; u < w; ++u) {
+      const std::size_t idx = base + static_cast<std::size_t>(u);
+      const PointT& p = points[idx];
+      const bool finite = std::isfinite(p.z) && pcl::isFinite(p);
+      if (record)
+        has_depth_[idx] = finite;
+      if (!finite || !(fake_indices_ || allowed[idx]))
+        continue;
+      const auto uu = static_cast<std::size_t>(u);
+      fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx),
+                 p.getVector3fMap());
+      if (coarse)
+        coarse->addTo(coarse_row + coarse->column_block[uu], static_cast<pcl::index_t>(idx),
+                      p.getVector3fMap());
     }
-  };
-  // The rows of the coarsest blocks in two halves, one per thread: each block is summed by one
-  // thread in row order, so the means do not depend on the threads.
-  const int band = coarse ? 2 * step : step;
-  const auto bands = static_cast<std::size_t>((h + band - 1) / band);
-  parallelFor(bands, static_cast<int>(threads_), (bands + 1) / 2,
-              [&](std::size_t first, std::size_t end) {
-                addRows(static_cast<int>(first) * band, std::min(h, static_cast<int>(end) * band));
-              });
+  }
   has_depth_known_ = true;
   finishPlaneGrid(fine, w, grid);
   if (twice)
