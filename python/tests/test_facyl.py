@@ -215,6 +215,19 @@ def test_normals_and_curvatures():
     assert np.median(np.abs(d[lateral] @ axis)) < 0.1
 
 
+def test_detect_threads_do_not_change_the_result():
+    scene = facyl.render_tabletop_scene(seed=21, layout="cluttered")
+    one = facyl.detect(scene["points"], scene["colors"], threads=1)
+    two = facyl.detect(scene["points"], scene["colors"], threads=2)
+    assert len(one["objects"]) >= 3
+    for a, b in zip(one["objects"], two["objects"]):
+        assert np.array_equal(np.asarray(a["indices"]), np.asarray(b["indices"]))
+        assert a["is_cylinder"] == b["is_cylinder"] and a["p_cylinder"] == b["p_cylinder"]
+    assert len(one["objects"]) == len(two["objects"])
+    with pytest.raises(ValueError, match="threads"):
+        facyl.detect(scene["points"], scene["colors"], threads=65)
+
+
 def test_detect_on_a_rendered_frame():
     scene = facyl.render_tabletop_scene(seed=20, layout="cluttered")
     assert scene["points"].shape == (480, 640, 3) and scene["colors"].dtype == np.uint8
