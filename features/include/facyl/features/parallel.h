@@ -18,13 +18,20 @@
 
 namespace facyl {
 
-/** \brief Threads a parallel loop over \a n items uses: \a threads (0: the hardware's
- * concurrency), at most one per \a grain items, at least 1. */
+/** \brief The threads a setting asks for: \a threads, or (0 or less) the hardware's
+ * concurrency; at least 1. */
+inline int
+threadCount(int threads)
+{
+  return std::max(threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()), 1);
+}
+
+/** \brief Threads a parallel loop over \a n items uses: threadCount(\a threads), at most one
+ * per \a grain items, at least 1. */
 inline int
 parallelWorkers(std::size_t n, int threads, std::size_t grain)
 {
-  int t = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
-  t = std::max(t, 1);
+  const int t = threadCount(threads);
   const std::size_t blocks =
     (n + std::max<std::size_t>(grain, 1) - 1) / std::max<std::size_t>(grain, 1);
   return static_cast<int>(

@@ -16,8 +16,6 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
-#include <numeric>
-#include <thread>
 #include <unordered_set>
 
 namespace facyl {
@@ -42,9 +40,7 @@ template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::configure()
 {
-  const int threads = params_.threads > 0
-                        ? params_.threads
-                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = threadCount(params_.threads);
   fitters_.clear();
   for (int t = 0; t < threads; ++t)
     fitters_.push_back(makeFitter());
@@ -803,18 +799,17 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInpu
   for (std::size_t e = 1; e < fitter.estimators.size(); ++e)
     if (e != fitter.upright || fitter.with_support)
       retries.push_back(e);
-  // Each retry has an estimator of its own: with threads to spare they run at once (a retry
-  // after an accepted one is then wasted), and are taken in order as if one after another.
-  std::vector<Fit> fits(retries.size());
-  if (fitter.retry_threads > 1)
+  // Each retry has an estimator of its own: with threads to spare they all run at once (a
+  // retry after an accepted one is then wasted work); either way they are taken in order.
+  const bool at_once = fitter.retry_threads > 1;
+  std::vector<Fit> fits(at_once ? retries.size() : 0);
+  if (at_once)
     parallelFor(retries.size(), fitter.retry_threads, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i)
         fits[i] = fitOnce(fitter, input, alive, retries[i]);
     });
   for (std::size_t i = 0; i < retries.size() && !best.accepted; ++i) {
-    if (fitter.retry_threads <= 1)
-      fits[i] = fitOnce(fitter, input, alive, retries[i]);
-    Fit& f = fits[i];
+    Fit f = at_once ? std::move(fits[i]) : fitOnce(fitter, input, alive, retries[i]);
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
          !best.evidence.fitted))
