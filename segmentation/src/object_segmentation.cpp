@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <map>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
@@ -423,27 +422,36 @@ public:
   void bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size_t min_part,
                         const ObjectSegmentationParameters& p)
   {
-    std::map<int, std::vector<int>> pixels; // group -> its pixels
-    for (int i = 0; i < static_cast<int>(grid_.size()); ++i)
-      pixels[find(label_[static_cast<std::size_t>(i)])].push_back(i);
-    std::vector<int> groups;
-    for (const auto& [g, px] : pixels)
-      if (px.size() >= min_part)
-        groups.push_back(g);
-    std::map<int, std::vector<int>> borders;
-    std::map<int, Eigen::AlignedBox3f> boxes;
-    for (const int g : groups) {
-      borders[g] = border(pixels[g], g);
-      for (const int i : pixels[g])
-        boxes[g].extend(grid_.point(i));
+    // The pixels of each group of at least min_part (ascending), the groups by their root.
+    std::vector<int> root(grid_.size());
+    std::vector<std::size_t> size(group_.size(), 0);
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      ++size[static_cast<std::size_t>(root[i] = find(label_[i]))];
+    std::vector<int> groups, slot(group_.size(), -1);
+    for (std::size_t g = 0; g < size.size(); ++g)
+      if (size[g] > 0 && size[g] >= min_part) {
+        slot[g] = static_cast<int>(groups.size());
+        groups.push_back(static_cast<int>(g));
+      }
+    std::vector<std::vector<int>> pixels(groups.size());
+    for (std::size_t k = 0; k < groups.size(); ++k)
+      pixels[k].reserve(size[static_cast<std::size_t>(groups[k])]);
+    for (std::size_t i = 0; i < grid_.size(); ++i)
+      if (const int k = slot[static_cast<std::size_t>(root[i])]; k >= 0)
+        pixels[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+    std::vector<std::vector<int>> borders(groups.size());
+    std::vector<Eigen::AlignedBox3f> boxes(groups.size());
+    for (std::size_t k = 0; k < groups.size(); ++k) {
+      borders[k] = border(pixels[k], groups[k]);
+      for (const int i : pixels[k])
+        boxes[k].extend(grid_.point(i));
     }
     for (std::size_t a = 0; a < groups.size(); ++a)
       for (std::size_t b = a + 1; b < groups.size(); ++b) {
         const int g = find(groups[a]), h = find(groups[b]);
-        if (g == h || boxes[groups[a]].exteriorDistance(boxes[groups[b]]) > p.bridge_max_gap)
+        if (g == h || boxes[a].exteriorDistance(boxes[b]) > p.bridge_max_gap)
           continue;
-        if (sameSurfaceBehind(pixels[groups[a]], pixels[groups[b]], borders[groups[a]],
-                              borders[groups[b]], g, h, has_depth, p))
+        if (sameSurfaceBehind(pixels[a], pixels[b], borders[a], borders[b], g, h, has_depth, p))
           group_[static_cast<std::size_t>(std::max(g, h))] = std::min(g, h);
       }
   }
