@@ -17,6 +17,7 @@
 #include <facyl/simulation/tabletop_scene.h>
 
 #include <pcl/common/point_tests.h>
+#include <pcl/features/integral_image_normal.h>
 #include <pcl/io/pcd_io.h>
 
 #include <gtest/gtest.h>
@@ -273,6 +274,67 @@ TEST(PlaneSorter, FourAtATimeEqualsOneAtATime)
 }
 
 // ---------------------------------------------------------------- supports
+
+TEST(PlaneGrid, AverageGradientNormalsArePcls)
+{
+  // Bent surfaces with depth jumps, holes, a row and a column without depth, at the plane
+  // grids' sizes and settings and at sizes PCL's borders barely fit: the same floats as
+  // pcl::IntegralImageNormalEstimation (AVERAGE_3D_GRADIENT), NaN where it gives NaN.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  struct Case {
+    int w, h;
+    float depth_factor, smoothing;
+  };
+  const Case cases[] = {{160, 120, 0.02f, 4.f},  {80, 60, 0.04f, 4.f},  {40, 30, 0.08f, 4.f},
+                        {160, 120, 0.02f, 10.f}, {53, 41, 0.03f, 6.5f}, {9, 9, 0.02f, 4.f},
+                        {12, 200, 0.02f, 4.f},   {8, 8, 0.02f, 4.f}};
+  std::size_t compared = 0, finite = 0;
+  for (const Case& c : cases) {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+    cloud->width = static_cast<std::uint32_t>(c.w);
+    cloud->height = static_cast<std::uint32_t>(c.h);
+    cloud->is_dense = false;
+    if (c.w == 53)
+      cloud->sensor_origin_ = Eigen::Vector4f(0.1f, -0.2f, 0.3f, 0.f);
+    for (int v = 0; v < c.h; ++v)
+      for (int u_ = 0; u_ < c.w; ++u_) {
+        const float x = (static_cast<float>(u_) - 0.5f * c.w) / 120.f,
+                    y = (static_cast<float>(v) - 0.5f * c.h) / 120.f;
+        float z = 1.f + 0.3f * std::sin(3.f * x) * std::cos(2.f * y) + 0.002f * u(rng);
+        if (u_ > c.w / 2 && v > c.h / 3)
+          z -= 0.25f; // an object in front: a depth jump
+        const bool hole = u(rng) < 0.005f || v == c.h / 4 || u_ == c.w / 5;
+        cloud->push_back(hole ? pcl::PointXYZ(nan, nan, nan) : pcl::PointXYZ(x * z, y * z, z));
+      }
+    cloud->width = static_cast<std::uint32_t>(c.w);
+    cloud->height = static_cast<std::uint32_t>(c.h);
+    pcl::PointCloud<pcl::Normal> ours, pcls;
+    facyl::averageGradientNormals(*cloud, c.depth_factor, c.smoothing, ours);
+    pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
+    ne.setMaxDepthChangeFactor(c.depth_factor);
+    ne.setNormalSmoothingSize(c.smoothing);
+    ne.setInputCloud(cloud);
+    ne.compute(pcls);
+    SCOPED_TRACE(std::to_string(c.w) + " x " + std::to_string(c.h));
+    ASSERT_EQ(ours.size(), pcls.size());
+    EXPECT_EQ(ours.width, pcls.width);
+    EXPECT_EQ(ours.height, pcls.height);
+    const auto same = [](float a, float b) { return std::isnan(a) ? std::isnan(b) : a == b; };
+    for (std::size_t i = 0; i < ours.size(); ++i) {
+      const pcl::Normal &a = ours[i], &b = pcls[i];
+      ASSERT_TRUE(same(a.normal_x, b.normal_x) && same(a.normal_y, b.normal_y) &&
+                  same(a.normal_z, b.normal_z) && same(a.curvature, b.curvature))
+        << "cell " << i << ": (" << a.normal_x << ", " << a.normal_y << ", " << a.normal_z
+        << ") against PCL's (" << b.normal_x << ", " << b.normal_y << ", " << b.normal_z << ")";
+      ++compared;
+      finite += std::isfinite(a.normal_x);
+    }
+  }
+  EXPECT_GT(finite, compared / 3); // most cells of the larger grids have a normal
+}
 
 TEST(AnyTable, NoisyFarTableIsOneSupport)
 {

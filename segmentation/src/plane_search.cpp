@@ -6,7 +6,6 @@
 #include <facyl/segmentation/support_planes.h>
 
 #include <pcl/ModelCoefficients.h>
-#include <pcl/features/integral_image_normal.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/sample_consensus/method_types.h>
 #include <pcl/sample_consensus/model_types.h>
@@ -18,6 +17,7 @@
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <unordered_map>
@@ -27,6 +27,168 @@
 #endif
 
 namespace facyl {
+
+namespace {
+
+/** One entry of the summed-area tables of averageGradientNormals: the sums of the horizontal
+ * and vertical differences above and left of it, and how many of each were finite. */
+struct GradientSums {
+  double dx[3], dy[3];
+  unsigned nx, ny;
+};
+
+/** PCL's depth-change map and its chamfer distance map (IntegralImageNormalEstimation::
+ * computeFeature), over the flat buffer as PCL reads it. */
+std::vector<float>
+depthDistanceMap(const pcl::PointCloud<pcl::PointXYZ>& cloud, float max_depth_change_factor)
+{
+  const std::size_t w = cloud.width, h = cloud.height, n = w * h;
+  std::vector<unsigned char> change(n, 255);
+  for (std::size_t ri = 0; ri + 1 < h; ++ri)
+    for (std::size_t ci = 0; ci + 1 < w; ++ci) {
+      const std::size_t index = ri * w + ci;
+      const float depth = cloud[index].z, right = cloud[index + 1].z, down = cloud[index + w].z;
+      const float allowed = max_depth_change_factor * (std::abs(depth) + 1.0f) * 2.0f;
+      if (std::fabs(depth - right) > allowed || !std::isfinite(depth) || !std::isfinite(right))
+        change[index] = change[index + 1] = 0;
+      if (std::fabs(depth - down) > allowed || !std::isfinite(depth) || !std::isfinite(down))
+        change[index] = change[index + w] = 0;
+    }
+  std::vector<float> d(n + 1); // PCL's passes read one past a row's end (the next row's start)
+  for (std::size_t i = 0; i < n; ++i)
+    d[i] = change[i] == 0 ? 0.0f : static_cast<float>(w + h);
+  for (std::size_t ri = 1; ri < h; ++ri) {
+    float* previous = d.data() + (ri - 1) * w;
+    float* current = previous + w;
+    for (std::size_t ci = 1; ci < w; ++ci) {
+      const float m = std::min(std::min(previous[ci - 1] + 1.4f, previous[ci] + 1.0f),
+                               std::min(current[ci - 1] + 1.0f, previous[ci + 1] + 1.4f));
+      if (m < current[ci])
+        current[ci] = m;
+    }
+  }
+  for (std::ptrdiff_t ri = static_cast<std::ptrdiff_t>(h) - 2; ri >= 0; --ri) {
+    float* current = d.data() + static_cast<std::size_t>(ri) * w;
+    float* next = current + w;
+    for (std::ptrdiff_t ci = static_cast<std::ptrdiff_t>(w) - 2; ci >= 0; --ci) {
+      // At ci = 0, next[-1] is the last of this row, as in PCL's flat buffer.
+      const float m = std::min(std::min(next[ci - 1] + 1.4f, next[ci] + 1.0f),
+                               std::min(current[ci + 1] + 1.0f, next[ci + 1] + 1.4f));
+      if (m < current[ci])
+        current[ci] = m;
+    }
+  }
+  d.pop_back();
+  return d;
+}
+
+/** PCL's summed-area tables (IntegralImage2D<float, 3>, first order) of the differences of
+ * initAverage3DGradientMethod: for interior cells right minus left and down minus up, zero
+ * (finite) elsewhere. (w + 1) x (h + 1) entries. */
+std::vector<GradientSums>
+gradientSums(const pcl::PointCloud<pcl::PointXYZ>& cloud)
+{
+  const std::size_t w = cloud.width, h = cloud.height, stride = w + 1;
+  std::vector<GradientSums> table(stride * (h + 1));
+  for (std::size_t c = 0; c <= w; ++c)
+    table[c] = GradientSums{{0, 0, 0}, {0, 0, 0}, 0, 0};
+  const auto add = [](double(&sum)[3], unsigned& count, const float(&e)[3]) {
+    if (std::isfinite((e[0] + e[1]) + e[2])) {
+      for (int k = 0; k < 3; ++k)
+        sum[k] += static_cast<double>(e[k]);
+      ++count;
+    }
+  };
+  for (std::size_t r = 0; r < h; ++r) {
+    const GradientSums* previous = table.data() + r * stride;
+    GradientSums* current = table.data() + (r + 1) * stride;
+    current[0] = GradientSums{{0, 0, 0}, {0, 0, 0}, 0, 0};
+    const bool row_inside = r >= 1 && r + 2 <= h;
+    for (std::size_t c = 0; c < w; ++c) {
+      GradientSums& e = current[c + 1];
+      for (int k = 0; k < 3; ++k) {
+        e.dx[k] = previous[c + 1].dx[k] + current[c].dx[k] - previous[c].dx[k];
+        e.dy[k] = previous[c + 1].dy[k] + current[c].dy[k] - previous[c].dy[k];
+      }
+      e.nx = previous[c + 1].nx + current[c].nx - previous[c].nx;
+      e.ny = previous[c + 1].ny + current[c].ny - previous[c].ny;
+      float dx[3] = {0.f, 0.f, 0.f}, dy[3] = {0.f, 0.f, 0.f};
+      if (row_inside && c >= 1 && c + 2 <= w) {
+        const pcl::PointXYZ &left = cloud[r * w + c - 1], &right = cloud[r * w + c + 1];
+        const pcl::PointXYZ &up = cloud[(r - 1) * w + c], &down = cloud[(r + 1) * w + c];
+        dx[0] = right.x - left.x, dx[1] = right.y - left.y, dx[2] = right.z - left.z;
+        dy[0] = down.x - up.x, dy[1] = down.y - up.y, dy[2] = down.z - up.z;
+      }
+      add(e.dx, e.nx, dx);
+      add(e.dy, e.ny, dy);
+    }
+  }
+  return table;
+}
+
+} // namespace
+
+void
+averageGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud, float max_depth_change_factor,
+                       float smoothing_size, pcl::PointCloud<pcl::Normal>& normals)
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  normals.header = cloud.header;
+  normals.sensor_origin_ = cloud.sensor_origin_;
+  normals.sensor_orientation_ = cloud.sensor_orientation_;
+  pcl::Normal bad;
+  bad.normal_x = bad.normal_y = bad.normal_z = bad.curvature = nan;
+  normals.points.assign(cloud.size(), bad);
+  normals.width = cloud.width;
+  normals.height = cloud.height;
+  normals.is_dense = false;
+  const std::size_t w = cloud.width, h = cloud.height;
+  const auto border = static_cast<std::size_t>(static_cast<int>(smoothing_size));
+  if (w < 2 * border + 1 || h < 2 * border + 1 || w < 3 || h < 3)
+    return;
+  const std::vector<float> distance = depthDistanceMap(cloud, max_depth_change_factor);
+  const std::vector<GradientSums> table = gradientSums(cloud);
+  const std::size_t stride = w + 1;
+  const float vx = cloud.sensor_origin_.coeff(0), vy = cloud.sensor_origin_.coeff(1),
+              vz = cloud.sensor_origin_.coeff(2);
+  for (std::size_t ri = border; ri < h - border; ++ri)
+    for (std::size_t ci = border; ci < w - border; ++ci) {
+      const std::size_t index = ri * w + ci;
+      if (!std::isfinite(cloud[index].z))
+        continue;
+      const float smoothing = std::min(distance[index], smoothing_size);
+      if (!(smoothing > 2.0f))
+        continue;
+      const auto rect = static_cast<unsigned>(static_cast<int>(smoothing));
+      const unsigned half = rect / 2;
+      const std::size_t upper_left = (ri - half) * stride + (ci - half);
+      const GradientSums& ul = table[upper_left];
+      const GradientSums& ur = table[upper_left + rect];
+      const GradientSums& ll = table[upper_left + rect * stride];
+      const GradientSums& lr = table[upper_left + rect * stride + rect];
+      const unsigned count_x = lr.nx + ul.nx - ur.nx - ll.nx;
+      const unsigned count_y = lr.ny + ul.ny - ur.ny - ll.ny;
+      if (count_x == 0 || count_y == 0)
+        continue;
+      Eigen::Vector3d gx, gy;
+      for (int k = 0; k < 3; ++k) {
+        gx[k] = lr.dx[k] + ul.dx[k] - ur.dx[k] - ll.dx[k];
+        gy[k] = lr.dy[k] + ul.dy[k] - ur.dy[k] - ll.dy[k];
+      }
+      Eigen::Vector3d n = gy.cross(gx);
+      const double length = n.squaredNorm();
+      if (length == 0.0)
+        continue;
+      n /= std::sqrt(length);
+      float nx = static_cast<float>(n[0]), ny = static_cast<float>(n[1]),
+            nz = static_cast<float>(n[2]);
+      pcl::flipNormalTowardsViewpoint(cloud[index], vx, vy, vz, nx, ny, nz);
+      pcl::Normal& out = normals[index];
+      out.normal_x = nx;
+      out.normal_y = ny;
+      out.normal_z = nz;
+    }
+}
 
 void
 finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid)
@@ -48,15 +210,11 @@ finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid)
   // Normals of the cells (integral images) and the cells as columns, with one raw pixel each
   // (for the bands).
   grid.normals.reset(new pcl::PointCloud<pcl::Normal>);
-  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-  ne.setNormalEstimationMethod(ne.AVERAGE_3D_GRADIENT);
   // Neighbouring cells may differ in depth by 8 % at VGA's spacing (4 pixels), in proportion
   // to their angular spacing at other resolutions.
-  ne.setMaxDepthChangeFactor(0.02f * static_cast<float>(step) * 640.f /
-                             static_cast<float>(image_width));
-  ne.setNormalSmoothingSize(std::max(4.f, 16.f / static_cast<float>(step)));
-  ne.setInputCloud(grid.small);
-  ne.compute(*grid.normals);
+  averageGradientNormals(small,
+                         0.02f * static_cast<float>(step) * 640.f / static_cast<float>(image_width),
+                         std::max(4.f, 16.f / static_cast<float>(step)), *grid.normals);
   const auto n = static_cast<Eigen::Index>(small.size());
   grid.cells.resize(3, n);
   grid.cell_normals.resize(3, n);

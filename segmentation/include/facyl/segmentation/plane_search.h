@@ -81,6 +81,18 @@ struct BlockMeans {
   std::vector<std::uint32_t> column_block; ///< u / step for each pixel column u
 };
 
+/** \brief The normals of pcl::IntegralImageNormalEstimation<PointXYZ, Normal> on the organized
+ * \a cloud with AVERAGE_3D_GRADIENT, BORDER_POLICY_IGNORE, a fixed \a smoothing_size
+ * (setNormalSmoothingSize), \a max_depth_change_factor (setMaxDepthChangeFactor) and the
+ * cloud's sensor origin as the viewpoint: the same floats in the same order, without what PCL
+ * sets up per call and this method does not use (a search tree, index lists, four-float
+ * difference images). Curvatures are NaN, as PCL's. Clouds too small for PCL's borders (fewer
+ * than 2 x smoothing_size rows or columns) get NaN normals everywhere.
+ * Reentrant: no state outside \a normals. */
+void averageGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                            float max_depth_change_factor, float smoothing_size,
+                            pcl::PointCloud<pcl::Normal>& normals);
+
 /** \brief The grid of \a blocks (of a frame \a image_width pixels wide): the cells (block
  * means; NaN without depth), their normals (integral images, depth changes scaled to the
  * grid's angular spacing), the columns and each cell's first pixel. Empties \a blocks. */
