@@ -19,6 +19,7 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/features/integral_image_normal.h>
 #include <pcl/io/pcd_io.h>
+#include <pcl/segmentation/organized_multi_plane_segmentation.h>
 
 #include <gtest/gtest.h>
 
@@ -334,6 +335,67 @@ TEST(PlaneGrid, AverageGradientNormalsArePcls)
     }
   }
   EXPECT_GT(finite, compared / 3); // most cells of the larger grids have a normal
+}
+
+TEST(PlaneGrid, PlanarRegionsArePcls)
+{
+  // Planes at several depths and tilts, a bent surface, noise, holes: the regions of
+  // pcl::OrganizedMultiPlaneSegmentation, the same cells in the same order, at the thresholds
+  // of the plane search and its two relaxations.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::normal_distribution<float> noise(0.f, 1.f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t regions = 0;
+  for (const int w : {160, 80, 41}) {
+    const int h = w * 3 / 4;
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+    for (int v = 0; v < h; ++v)
+      for (int c = 0; c < w; ++c) {
+        const float x = (static_cast<float>(c) - 0.5f * w) / (0.75f * w),
+                    y = (static_cast<float>(v) - 0.5f * h) / (0.75f * w);
+        float z = 1.2f + 0.4f * y; // a table seen from above
+        if (x > 0.2f && y < 0.1f)  // a box in front of it
+          z = 0.9f + 0.1f * x;
+        else if (x < -0.3f && y < -0.2f) // a bent wall
+          z = 1.6f + 0.3f * x * x;
+        z += 0.002f * z * z * noise(rng);
+        const bool hole = u(rng) < 0.01f || (c == w / 3 && v > h / 2);
+        cloud->push_back(hole ? pcl::PointXYZ(nan, nan, nan) : pcl::PointXYZ(x * z, y * z, z));
+      }
+    cloud->width = static_cast<std::uint32_t>(w);
+    cloud->height = static_cast<std::uint32_t>(h);
+    cloud->is_dense = false;
+    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+    facyl::averageGradientNormals(*cloud, 0.02f * 160.f / static_cast<float>(w), 4.f, *normals);
+    for (const float relax : {1.f, 2.f, 4.f}) {
+      const unsigned min_inliers = w == 41 ? 3 : 10;
+      const float angle = std::min(0.5f, relax * 0.1f), distance = relax * 0.02f;
+      const double curvature = relax * relax * 0.001;
+      const auto ours =
+        facyl::planarRegions(*cloud, *normals, min_inliers, angle, distance, curvature);
+      pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
+      mps.setMinInliers(min_inliers);
+      mps.setAngularThreshold(angle);
+      mps.setDistanceThreshold(distance);
+      mps.setMaximumCurvature(curvature);
+      mps.setInputNormals(normals);
+      mps.setInputCloud(cloud);
+      std::vector<pcl::ModelCoefficients> coefficients;
+      std::vector<pcl::PointIndices> pcls;
+      mps.segment(coefficients, pcls);
+      SCOPED_TRACE(std::to_string(w) + " cells wide, relaxed " + std::to_string(relax));
+      ASSERT_EQ(ours.size(), pcls.size());
+      for (std::size_t r = 0; r < ours.size(); ++r)
+        EXPECT_EQ(ours[r].indices, pcls[r].indices) << "region " << r;
+      regions += ours.size();
+    }
+  }
+  EXPECT_GE(regions, 9u); // the table and the box at least, at every size and threshold
+  pcl::PointCloud<pcl::PointXYZ> row;
+  row.push_back(pcl::PointXYZ(0.f, 0.f, 1.f));
+  EXPECT_TRUE(
+    facyl::planarRegions(row, pcl::PointCloud<pcl::Normal>(), 3, 0.1, 0.02, 0.001).empty());
 }
 
 TEST(AnyTable, NoisyFarTableIsOneSupport)

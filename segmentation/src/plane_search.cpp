@@ -6,6 +6,8 @@
 #include <facyl/segmentation/support_planes.h>
 
 #include <pcl/ModelCoefficients.h>
+#include <pcl/common/centroid.h>
+#include <pcl/common/eigen.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/sample_consensus/method_types.h>
 #include <pcl/sample_consensus/model_types.h>
@@ -13,7 +15,6 @@
 #include <pcl/segmentation/euclidean_cluster_comparator.h>
 #include <pcl/segmentation/extract_clusters.h>
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
-#include <pcl/segmentation/organized_multi_plane_segmentation.h>
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
@@ -231,6 +232,109 @@ finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid)
 }
 
 std::vector<pcl::PointIndices>
+planarRegions(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+              const pcl::PointCloud<pcl::Normal>& normals, unsigned min_inliers,
+              double angular_threshold, double distance_threshold, double maximum_curvature)
+{
+  const std::size_t w = cloud.width, h = cloud.height, n = cloud.size();
+  if (!cloud.isOrganized() || normals.size() != n || n == 0)
+    return {};
+  // pcl::PlaneCoefficientComparator as OrganizedMultiPlaneSegmentation sets it up: the
+  // offsets of each cell's tangent plane, cos of the angle, a threshold that grows with z^2.
+  std::vector<float> plane_d(n);
+  for (std::size_t i = 0; i < n; ++i)
+    plane_d[i] = cloud[i].getVector3fMap().dot(normals[i].getNormalVector3fMap());
+  const float cos_angle = std::cos(static_cast<float>(angular_threshold));
+  const auto distance = static_cast<float>(distance_threshold);
+  const Eigen::Vector3f z_axis(0.0f, 0.0f, 1.0f);
+  const auto same = [&](std::size_t a, std::size_t b) {
+    float threshold = distance;
+    const float z = cloud[a].getVector3fMap().dot(z_axis);
+    threshold *= z * z;
+    return std::fabs(plane_d[a] - plane_d[b]) < threshold &&
+           normals[a].getNormalVector3fMap().dot(normals[b].getNormalVector3fMap()) > cos_angle;
+  };
+  // pcl::OrganizedConnectedComponentSegmentation: runs labelled in one pass, joined by roots.
+  constexpr unsigned invalid = std::numeric_limits<unsigned>::max();
+  std::vector<unsigned> label(n, invalid), runs;
+  const auto root = [&](unsigned r) {
+    while (runs[r] != r)
+      r = runs[r];
+    return r;
+  };
+  const auto fresh = [&](std::size_t i) {
+    label[i] = static_cast<unsigned>(runs.size());
+    runs.push_back(label[i]);
+  };
+  if (std::isfinite(cloud[0].x))
+    fresh(0);
+  for (std::size_t c = 1; c < w; ++c) {
+    if (!std::isfinite(cloud[c].x))
+      continue;
+    if (same(c, c - 1))
+      label[c] = label[c - 1];
+    else
+      fresh(c);
+  }
+  for (std::size_t r = 1; r < h; ++r) {
+    const std::size_t row = r * w, previous = row - w;
+    if (std::isfinite(cloud[row].x)) {
+      if (same(row, previous))
+        label[row] = label[previous];
+      else
+        fresh(row);
+    }
+    for (std::size_t c = 1; c < w; ++c) {
+      const std::size_t i = row + c, up = previous + c;
+      if (!std::isfinite(cloud[i].x))
+        continue;
+      if (same(i, i - 1))
+        label[i] = label[i - 1];
+      if (same(i, up)) {
+        if (label[i] == invalid)
+          label[i] = label[up];
+        else if (label[up] != invalid) {
+          const unsigned a = root(label[i]), b = root(label[up]);
+          if (a < b)
+            runs[b] = a;
+          else
+            runs[a] = b;
+        }
+      }
+      if (label[i] == invalid)
+        fresh(i);
+    }
+  }
+  std::vector<unsigned> region(runs.size());
+  std::size_t regions = 0;
+  for (std::size_t k = 0; k < runs.size(); ++k)
+    region[k] =
+      runs[k] == k ? static_cast<unsigned>(regions++) : region[root(static_cast<unsigned>(k))];
+  std::vector<pcl::PointIndices> members(regions);
+  for (std::size_t i = 0; i < n; ++i)
+    if (label[i] != invalid)
+      members[region[label[i]]].indices.push_back(static_cast<pcl::index_t>(i));
+  // The regions larger than min_inliers that are flat enough (PCL also orients their planes,
+  // which does not decide which are kept).
+  std::vector<pcl::PointIndices> out;
+  Eigen::Vector4f centroid = Eigen::Vector4f::Zero();
+  Eigen::Matrix3f covariance;
+  for (auto& m : members) {
+    if (static_cast<unsigned>(m.indices.size()) <= min_inliers)
+      continue;
+    pcl::computeMeanAndCovarianceMatrix(cloud, m.indices, covariance, centroid);
+    float eigen_value;
+    Eigen::Vector3f eigen_vector;
+    pcl::eigen33(covariance, eigen_value, eigen_vector);
+    const float trace = covariance.coeff(0) + covariance.coeff(4) + covariance.coeff(8);
+    const float curvature = trace != 0 ? std::abs(eigen_value / trace) : 0.f;
+    if (curvature < maximum_curvature)
+      out.push_back(std::move(m));
+  }
+  return out;
+}
+
+std::vector<pcl::PointIndices>
 planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angle,
            float seed_distance)
 {
@@ -239,16 +343,9 @@ planeSeeds(const PlaneGrid& grid, std::size_t min_plane_points, float plane_angl
   std::vector<pcl::PointIndices> inliers;
   float relax = 1.f;
   for (int attempt = 0; attempt < 3; ++attempt, relax *= 2.f) {
-    pcl::OrganizedMultiPlaneSegmentation<pcl::PointXYZ, pcl::Normal, pcl::Label> mps;
-    mps.setMinInliers(static_cast<unsigned>(min_cells));
-    mps.setAngularThreshold(std::min(0.5f, relax * plane_angle));
-    mps.setDistanceThreshold(relax * seed_distance);
-    mps.setMaximumCurvature(relax * relax * 0.001);
-    mps.setInputNormals(grid.normals);
-    mps.setInputCloud(grid.small);
-    std::vector<pcl::ModelCoefficients> coefficients;
-    inliers.clear();
-    mps.segment(coefficients, inliers);
+    inliers = planarRegions(*grid.small, *grid.normals, static_cast<unsigned>(min_cells),
+                            std::min(0.5f, relax * plane_angle), relax * seed_distance,
+                            relax * relax * 0.001);
     if (std::any_of(inliers.begin(), inliers.end(), [&](const pcl::PointIndices& r) {
           return r.indices.size() * cell >= min_plane_points;
         }))

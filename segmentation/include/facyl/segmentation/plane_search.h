@@ -98,6 +98,17 @@ void averageGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
  * grid's angular spacing), the columns and each cell's first pixel. Empties \a blocks. */
 void finishPlaneGrid(BlockMeans& blocks, int image_width, PlaneGrid& grid);
 
+/** \brief The planar regions of pcl::OrganizedMultiPlaneSegmentation<PointXYZ, Normal, Label>
+ * (its comparator's defaults, the thresholds of setMinInliers, setAngularThreshold,
+ * setDistanceThreshold and setMaximumCurvature) on the organized \a cloud and its \a normals:
+ * the same regions, in the same order, without its per-call set-up (index lists, a label cloud,
+ * a virtual comparison per pair of neighbours). Empty when the sizes differ or the cloud is not
+ * organized. Reentrant. */
+std::vector<pcl::PointIndices> planarRegions(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                             const pcl::PointCloud<pcl::Normal>& normals,
+                                             unsigned min_inliers, double angular_threshold,
+                                             double distance_threshold, double maximum_curvature);
+
 /** \brief The seed regions (cells) of the plane search on \a grid, largest first:
  * pcl::OrganizedMultiPlaneSegmentation's regions of \a min_plane_points (in pixels) at \a
  * plane_angle (rad) and \a seed_distance (m). Its thresholds only make seeds (the band of each
