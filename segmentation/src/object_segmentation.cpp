@@ -277,6 +277,18 @@ acrossMeans(const Grid& grid, bool horizontal)
   return m;
 }
 
+/** std::lround(x), inline (lround is a library call): half away from zero in double, where
+ * x + 0.5 is exact for every float; NaN, infinity and |x| >= 9.2e18 give LONG_MIN, as lround
+ * does on x86-64 where a long does not hold the result. */
+long
+roundHalfAway(float x)
+{
+  if (!(std::abs(x) < 9.2e18f))
+    return std::numeric_limits<long>::min();
+  const double d = static_cast<double>(x);
+  return static_cast<long>(d >= 0.0 ? std::floor(d + 0.5) : std::ceil(d - 0.5));
+}
+
 /** Per valid pixel: 1 on a concave crease (see concaveCreases). */
 std::vector<std::uint8_t>
 creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
@@ -290,7 +302,7 @@ creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
   for (std::size_t c = 0; c < grid.size(); ++c) {
     const float range = grid.range(static_cast<int>(c));
     const float span = std::max(p.crease_span, p.crease_span_z2 * range * range);
-    const int k = std::clamp(static_cast<int>(std::lround(span * focal / range)), 2, 24);
+    const int k = std::clamp(static_cast<int>(roundHalfAway(span * focal / range)), 2, 24);
     int u, v;
     grid.position(static_cast<int>(c), u, v);
     for (int dir = 0; dir < 2 && !crease[c]; ++dir) {

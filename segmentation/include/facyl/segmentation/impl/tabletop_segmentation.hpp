@@ -952,7 +952,8 @@ template <typename PointT>
 TabletopCluster
 TabletopSegmentation<PointT>::makeCluster(pcl::Indices indices, int support) const
 {
-  std::sort(indices.begin(), indices.end());
+  if (!std::is_sorted(indices.begin(), indices.end())) // the segmentations give them ascending
+    std::sort(indices.begin(), indices.end());
   TabletopCluster c;
   c.indices.header = input_->header;
   c.indices.indices = std::move(indices);
