@@ -81,7 +81,7 @@ public:
        const ObjectSegmentationParameters& p, const DepthBand* noise = nullptr,
        const pcl::Indices* finite_pixels = nullptr)
       : Grid(static_cast<int>(cloud.width), static_cast<int>(cloud.height), focal, viewpoint, p,
-             noise, finite_pixels ? finite_pixels->size() : countFinite(cloud))
+             noise, finite_pixels ? finite_pixels->size() : countFinite(cloud), finite_pixels)
   {
     if (finite_pixels) {
       for (const auto idx : *finite_pixels) {
@@ -104,7 +104,7 @@ public:
   Grid(const Eigen::Matrix3Xf& points, const pcl::Indices& pixels, int width, int height,
        float focal, const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
        const DepthBand* noise)
-      : Grid(width, height, focal, viewpoint, p, noise, pixels.size())
+      : Grid(width, height, focal, viewpoint, p, noise, pixels.size(), &pixels)
   {
     for (std::size_t k = 0; k < pixels.size(); ++k) {
       const auto i = static_cast<std::size_t>(pixels[k]);
@@ -136,9 +136,9 @@ public:
   {
     // One unsigned comparison per coordinate: negative ones wrap beyond the size.
     if (static_cast<unsigned>(u) >= static_cast<unsigned>(w_) ||
-        static_cast<unsigned>(v) >= static_cast<unsigned>(h_))
+        static_cast<unsigned>(v - v0_) >= static_cast<unsigned>(rows_))
       return -1;
-    return slot_[static_cast<std::size_t>(v) * static_cast<std::size_t>(w_) +
+    return slot_[static_cast<std::size_t>(v - v0_) * static_cast<std::size_t>(w_) +
                  static_cast<std::size_t>(u)];
   }
   /** at() of the five pixels centred on the valid pixel (\a u, \a v) along a column
@@ -146,9 +146,9 @@ public:
   void across(int u, int v, bool vertical, int (&out)[5]) const
   {
     const std::ptrdiff_t step = vertical ? w_ : 1;
-    const int along = vertical ? v : u, size = vertical ? h_ : w_;
+    const int along = vertical ? v - v0_ : u, size = vertical ? rows_ : w_;
     const int* centre = slot_.data() +
-                        static_cast<std::ptrdiff_t>(v) * static_cast<std::ptrdiff_t>(w_) +
+                        static_cast<std::ptrdiff_t>(v - v0_) * static_cast<std::ptrdiff_t>(w_) +
                         static_cast<std::ptrdiff_t>(u);
     for (int d = -2; d <= 2; ++d)
       out[d + 2] =
@@ -188,12 +188,17 @@ public:
   }
 
 private:
-  /** An empty grid of a \a width x \a height image, with room for \a valid pixels. */
+  /** An empty grid of a \a width x \a height image, with room for \a valid pixels; given
+   * its \a pixels (ascending), its slots span only their rows. */
   Grid(int width, int height, float focal, const Eigen::Vector3f& viewpoint,
-       const ObjectSegmentationParameters& p, const DepthBand* noise, std::size_t valid)
+       const ObjectSegmentationParameters& p, const DepthBand* noise, std::size_t valid,
+       const pcl::Indices* pixels)
       : w_(width)
       , h_(height)
-      , slot_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1)
+      , v0_(pixels && !pixels->empty() && width > 0 ? pixels->front() / width : 0)
+      , rows_(pixels && width > 0 ? (pixels->empty() ? 0 : pixels->back() / width - v0_ + 1)
+                                  : height)
+      , slot_(static_cast<std::size_t>(width) * static_cast<std::size_t>(rows_), -1)
       , focal_(focal)
       , viewpoint_(viewpoint)
       , p_(p)
@@ -217,7 +222,8 @@ private:
   /** Pixel \a i at (\a u, \a v) with the point \a q. */
   void add(std::size_t i, int u, int v, const Eigen::Vector3f& q)
   {
-    slot_[i] = static_cast<int>(pixel_.size());
+    slot_[i - static_cast<std::size_t>(v0_) * static_cast<std::size_t>(w_)] =
+      static_cast<int>(pixel_.size());
     pixel_.push_back(i);
     xyz_.push_back(q);
     u_.push_back(u);
@@ -232,6 +238,7 @@ private:
     gap2_.push_back(gap * gap);
   }
   int w_, h_;
+  int v0_, rows_; ///< the rows that slot_ spans: [v0_, v0_ + rows_)
   std::vector<int> slot_;
   float focal_;
   Eigen::Vector3f viewpoint_;

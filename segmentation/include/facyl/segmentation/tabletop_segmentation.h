@@ -506,6 +506,9 @@ private:
     }
   };
   mutable SortBuffer on_buffer_;
+  /** classifyPoints' points above the candidates, kept between frames for its capacity (the
+   * list of a VGA frame grows to about 10^5 points). */
+  std::vector<Above> above_;
 };
 
 } // namespace facyl

@@ -156,7 +156,7 @@ TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>&
   has_noise_ = !candidates.empty();
   const double t_planes = ms(t0);
   std::vector<SupportPlane> all;
-  std::vector<Above> above;
+  std::vector<Above>& above = above_;
   classifyPoints(candidates, all, above);
   hulls_.assign(candidates.size(), Hulls{});
   const double t_points = ms(t0);
