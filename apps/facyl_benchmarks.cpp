@@ -2,7 +2,8 @@
  * facyl_benchmarks: speed of the estimator, of the per-point cues and of whole frames
  * (Google Benchmark).
  * Run: ./build/apps/facyl_benchmarks [--benchmark_filter=REGEX]
- * BM_Frame runs the tabletop recognizer with the shipped classifier on the bundled scene and,
+ * BM_Frame runs the tabletop recognizer with the shipped classifier on the bundled scene, on a
+ * simulated scene at 640 x 480 and at 1280 x 720 and,
  * when the shared data is there (FACYL_REAL_DATA, default ../shared/data/real beside the
  * sources), on every 4th mOSD learn frame; counters: the stages in ms per frame.
  */
@@ -13,6 +14,7 @@
 #include <facyl/segmentation/tabletop_geometry.h>
 #include <facyl/simulation/cylinder_simulation.h>
 #include <facyl/simulation/random.h>
+#include <facyl/simulation/tabletop_scene.h>
 #include <facyl/tracking/cylinder_tracker.h>
 
 #include <pcl/common/io.h>
@@ -30,6 +32,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -263,13 +266,8 @@ BENCHMARK(BM_TrackerUpdate)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMicrosec
 /** One frame through the recognizer, with the shipped classifier, as facyl_detect runs it
  * (buffers kept between frames as a stream would). */
 void
-BM_Frame(benchmark::State& state, const std::string& file)
+runFrames(benchmark::State& state, const pcl::PointCloud<pcl::PointXYZRGBA>::ConstPtr& cloud)
 {
-  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGBA>);
-  if (pcl::io::loadPCDFile(file, *cloud) < 0) {
-    state.SkipWithError(("cannot read " + file).c_str());
-    return;
-  }
   auto classifier = std::make_shared<facyl::CylinderClassifier>();
   classifier->load(facyl::CylinderClassifier::defaultModelPath());
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
@@ -300,13 +298,49 @@ BM_Frame(benchmark::State& state, const std::string& file)
   state.counters["objects"] = static_cast<double>(objects.size());
 }
 
-/** BM_Frame on the bundled scene and, when present, every 4th mOSD learn frame. */
+/** One frame of a PCD file (runFrames). */
+void
+BM_Frame(benchmark::State& state, const std::string& file)
+{
+  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGBA>);
+  if (pcl::io::loadPCDFile(file, *cloud) < 0) {
+    state.SkipWithError(("cannot read " + file).c_str());
+    return;
+  }
+  runFrames(state, cloud);
+}
+
+/** One simulated frame (runFrames): the same spread scene (seed 1) seen by a Kinect-like
+ * sensor of \a width x \a height pixels with the field of view of a 640-pixel-wide one at
+ * fx = 525 (a 16:9 frame sees less vertically). */
+void
+BM_SimulatedFrame(benchmark::State& state, int width, int height)
+{
+  facyl::TabletopSceneParameters params;
+  params.seed = 1;
+  params.camera.width = width;
+  params.camera.height = height;
+  params.camera.fx = params.camera.fy = 525.f * static_cast<float>(width) / 640.f;
+  params.camera.cx = 0.5f * static_cast<float>(width - 1);
+  params.camera.cy = 0.5f * static_cast<float>(height - 1);
+  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(
+    new pcl::PointCloud<pcl::PointXYZRGBA>(facyl::simulateTabletopScene(params).cloud));
+  runFrames(state, cloud);
+}
+
+/** BM_Frame on the bundled scene, a simulated scene at VGA and at 1280 x 720 and, when present,
+ * every 4th mOSD learn frame. */
 void
 registerFrames()
 {
   const std::string scene = std::string(FACYL_SOURCE_DIR) + "/data/default_scene.pcd";
   benchmark::RegisterBenchmark("BM_Frame/default_scene", BM_Frame, scene)
     ->Unit(benchmark::kMillisecond);
+  for (const auto& [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
+    benchmark::RegisterBenchmark(
+      ("BM_Frame/simulated_" + std::to_string(w) + "x" + std::to_string(h)).c_str(),
+      BM_SimulatedFrame, w, h)
+      ->Unit(benchmark::kMillisecond);
   const char* env = std::getenv("FACYL_REAL_DATA");
   const std::string real = env ? env : std::string(FACYL_SOURCE_DIR) + "/../shared/data/real";
   for (int k = 0; k <= 44; k += 4) {

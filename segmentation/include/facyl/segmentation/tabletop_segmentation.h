@@ -190,11 +190,12 @@ struct SupportPlane {
 
 /** \brief Supports (tables), objects above them, and object clusters (paper III-A).
  *
- * Candidate planes: organized clouds (at least 16 blocks wide and high) use
- * pcl::IntegralImageNormalEstimation and pcl::OrganizedMultiPlaneSegmentation on a grid of
- * blocks of plane_step pixels (each cell the mean of its pixels with depth, so missing pixels
- * do not break the normals) for seed regions; unorganized clouds (and narrower organized ones:
- * a LiDAR's few rings) use pcl::RandomSample, pcl::NormalEstimation and repeated
+ * Candidate planes: organized clouds (at least 16 blocks wide and high) use the normals of
+ * pcl::IntegralImageNormalEstimation and the regions of pcl::OrganizedMultiPlaneSegmentation
+ * (averageGradientNormals and planarRegions: the same results without PCL's per-call set-up)
+ * on a grid of blocks of plane_step pixels (each cell the mean of its pixels with depth, so
+ * missing pixels do not break the normals) for seed regions; unorganized clouds (and narrower
+ * organized ones: a LiDAR's few rings) use pcl::RandomSample, pcl::NormalEstimation and repeated
  * pcl::SACSegmentation for seeds. Each seed grows into a whole plane with its own band
  * (refinePlaneRegion: the noise and bias measured on it, by range; regions of one noisy or
  * slightly bent table are one plane). Objects are the points between the band and max_height
