@@ -461,7 +461,7 @@ public:
     std::vector<std::vector<int>> borders(groups.size());
     std::vector<Eigen::AlignedBox3f> boxes(groups.size());
     for (std::size_t k = 0; k < groups.size(); ++k) {
-      borders[k] = border(pixels[k], groups[k]);
+      borders[k] = border(pixels[k], groups[k], root);
       for (const int i : pixels[k])
         boxes[k].extend(grid_.point(i));
     }
@@ -569,14 +569,15 @@ private:
     return stats;
   }
 
-  /** Boundary pixels of a part (a 4-neighbour in another group or none), at most 100. */
-  std::vector<int> border(const std::vector<int>& px, int g) const
+  /** Boundary pixels of a part (a 4-neighbour in another group or none), at most 100; \a root:
+   * each pixel's group now. */
+  std::vector<int> border(const std::vector<int>& px, int g, const std::vector<int>& root) const
   {
     std::vector<int> out;
     for (const int i : px) {
       bool edge = false;
       grid_.forNeighbours(
-        i, [&](int j) { edge = edge || findConst(label_[static_cast<std::size_t>(j)]) != g; },
+        i, [&](int j) { edge = edge || root[static_cast<std::size_t>(j)] != g; },
         [&] { edge = true; });
       if (edge)
         out.push_back(i);
