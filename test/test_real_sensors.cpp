@@ -23,6 +23,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -107,6 +108,38 @@ TEST(DepthBand, RecoversNoiseThatGrowsWithRange)
     facyl::estimateDepthBand(ranges, std::vector<float>(ranges.size(), 0.f), 3.f, 1e-4f);
   EXPECT_FLOAT_EQ(flat.halfWidth(1.f), 3e-4f);
   EXPECT_FLOAT_EQ(facyl::estimateDepthBand({}, {}, 3.f, 1e-4f).halfWidth(1.f), 3e-4f);
+}
+
+TEST(DepthBand, HalfWidthFloorIsBelowTheBandEverywhere)
+{
+  // Measured bands (sigmas growing, and a hand-made one that shrinks between samples and whose
+  // interpolation rounds), a fixed band and an empty one: the floor is never above the
+  // half-width, at ranges before, between, on and beyond the samples.
+  Gauss gauss(5);
+  std::vector<float> ranges, residuals;
+  for (int i = 0; i < 8000; ++i) {
+    const float r = 0.4f + 3.f * static_cast<float>(i) / 8000.f;
+    ranges.push_back(r);
+    residuals.push_back(1.5e-3f * r * r * gauss());
+  }
+  facyl::DepthBand measured = facyl::estimateDepthBand(ranges, residuals, 3.f, 1e-4f);
+  facyl::DepthBand shrinking;
+  shrinking.factor = 2.5f;
+  shrinking.ranges = {0.5f, 0.7f, 1.3f, 2.9f};
+  shrinking.sigmas = {3e-3f, 1.1e-3f, 1.0000001e-3f, 4e-3f};
+  for (const facyl::DepthBand& band : {measured, shrinking}) {
+    const float floor = facyl::halfWidthFloor(band);
+    EXPECT_GT(floor,
+              0.9f * band.factor * *std::min_element(band.sigmas.begin(), band.sigmas.end()));
+    for (int k = 0; k <= 20000; ++k) {
+      const float r = 0.01f + 6.f * static_cast<float>(k) / 20000.f;
+      ASSERT_LE(floor, band.halfWidth(r)) << "range " << r;
+    }
+    for (const float r : band.ranges)
+      ASSERT_LE(floor, band.halfWidth(r));
+  }
+  EXPECT_EQ(facyl::halfWidthFloor(facyl::fixedBand(0.015f)), 0.015f);
+  EXPECT_EQ(facyl::halfWidthFloor(facyl::DepthBand{}), 0.f);
 }
 
 TEST(PlaneRegion, GrowsANoisyBentTableFromOnePieceAndStaysOffTheWall)

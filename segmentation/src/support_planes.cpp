@@ -33,6 +33,19 @@ DepthBand::sigma(float range) const
   return sigmas[lo] + t * (sigmas[hi] - sigmas[lo]);
 }
 
+float
+halfWidthFloor(const DepthBand& band)
+{
+  if (band.fixed > 0.f)
+    return band.fixed;
+  if (band.ranges.empty() || band.sigmas.size() != band.ranges.size())
+    return 0.f;
+  // sigma() never goes below its smallest sample: it interpolates between samples and grows
+  // beyond the last. The margin covers the rounding of the interpolation.
+  const float least = *std::min_element(band.sigmas.begin(), band.sigmas.end());
+  return least > 0.f ? band.factor * least * (1.f - 1e-5f) : 0.f;
+}
+
 DepthBand
 fixedBand(float half_width)
 {
@@ -272,15 +285,19 @@ refinePlaneRegion(const PlaneRegionCells& g, const std::vector<std::uint8_t>& se
   if (!(tolerance <= s.max_angle))
     return false; // normals that spread this much are not a plane's (a dome, a cylinder's top)
   const float cos_max = std::cos(tolerance);
-  // The usable cells on the plane within \a band (every other one: \a every_other).
+  // The usable cells on the plane within \a band (every other one: \a every_other). A cell
+  // within the band's narrowest half-width (halfWidthFloor) is in it at any range.
   const auto members = [&](const DepthBand& band, bool every_other) {
+    const float floor = halfWidthFloor(band);
     Members out;
     for (const std::uint32_t i : usable) {
       if (every_other && i % 2 != 0)
         continue;
       const auto c = static_cast<Eigen::Index>(i);
-      if (std::abs(g.normals.col(c).dot(plane.head<3>())) >= cos_max &&
-          std::abs(plane.head<3>().dot(g.cells.col(c)) + plane[3]) <= band.halfWidth(g.range[i]))
+      if (std::abs(g.normals.col(c).dot(plane.head<3>())) < cos_max)
+        continue;
+      const float distance = std::abs(plane.head<3>().dot(g.cells.col(c)) + plane[3]);
+      if (distance <= floor || distance <= band.halfWidth(g.range[i]))
         out.push_back(i);
     }
     return out;

@@ -40,6 +40,10 @@ struct DepthBand {
   }
 };
 
+/** \brief A value at or below \a band's half-width at every range (0 when it cannot tell):
+ * a residual within it is in the band without looking up its range. */
+float halfWidthFloor(const DepthBand& band);
+
 /** \brief A band of the same half-width \a half_width (> 0) at every range. */
 DepthBand fixedBand(float half_width);
 
