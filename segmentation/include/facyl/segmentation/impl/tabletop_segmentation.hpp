@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <chrono>
 #include <cstdint>
 #include <limits>
@@ -783,13 +784,22 @@ TabletopSegmentation<PointT>::supportHull(const Eigen::Affine3f& frame, const pc
     if (near_region(p))
       points.push_back(p);
   };
-  // Each image row: its first and last point near the region.
+  // Each image row: its first and last point near the region. The pixel sort of the whole
+  // frame writes the lists in image order: a row's end is then found by a binary search, not
+  // a walk over its points.
+  const bool ascending = fake_indices_;
+  assert(!ascending || std::is_sorted(idx.begin(), idx.end()));
   std::size_t k = 0;
   while (k < idx.size()) {
     const pcl::index_t row_end = (idx[k] / w + 1) * w;
     std::size_t end = k;
-    while (end < idx.size() && idx[end] < row_end)
-      ++end;
+    if (ascending)
+      end = static_cast<std::size_t>(
+        std::lower_bound(idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(), row_end) -
+        idx.begin());
+    else
+      while (end < idx.size() && idx[end] < row_end)
+        ++end;
     for (std::size_t j = k; j < end; ++j)
       if (near_region(flat(idx[j]))) {
         add(idx[j]);
