@@ -368,6 +368,13 @@ TEST(PlaneGrid, AverageGradientNormalsArePcls)
     }
   }
   EXPECT_GT(finite, compared / 3); // most cells of the larger grids have a normal
+  pcl::PointCloud<pcl::PointXYZ> grid(16, 16, pcl::PointXYZ(0.f, 0.f, 1.f));
+  pcl::PointCloud<pcl::Normal> out;
+  EXPECT_THROW(facyl::averageGradientNormals(grid, 0.02f, 0.f, out), std::invalid_argument);
+  EXPECT_THROW(facyl::averageGradientNormals(grid, 0.02f, nan, out), std::invalid_argument);
+  EXPECT_THROW(facyl::averageGradientNormals(grid, -1.f, 4.f, out), std::invalid_argument);
+  facyl::averageGradientNormals(pcl::PointCloud<pcl::PointXYZ>(), 0.02f, 4.f, out);
+  EXPECT_TRUE(out.empty());
 }
 
 TEST(PlaneGrid, PlanarRegionsArePcls)

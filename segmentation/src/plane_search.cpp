@@ -133,6 +133,12 @@ void
 averageGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud, float max_depth_change_factor,
                        float smoothing_size, pcl::PointCloud<pcl::Normal>& normals)
 {
+  if (!(smoothing_size > 0.f) || !(smoothing_size < 1e6f))
+    throw std::invalid_argument(
+      "facyl::averageGradientNormals: the smoothing size must be positive and finite");
+  if (!(max_depth_change_factor >= 0.f) || !std::isfinite(max_depth_change_factor))
+    throw std::invalid_argument(
+      "facyl::averageGradientNormals: the depth change factor must be finite and >= 0");
   const float nan = std::numeric_limits<float>::quiet_NaN();
   normals.header = cloud.header;
   normals.sensor_origin_ = cloud.sensor_origin_;

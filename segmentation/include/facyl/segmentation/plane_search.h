@@ -88,7 +88,9 @@ struct BlockMeans {
  * sets up per call and this method does not use (a search tree, index lists, four-float
  * difference images). Curvatures are NaN, as PCL's. Clouds too small for PCL's borders (fewer
  * than 2 x smoothing_size rows or columns) get NaN normals everywhere.
- * Reentrant: no state outside \a normals. */
+ * Reentrant: no state outside \a normals.
+ * \throws std::invalid_argument if \a smoothing_size is not positive and finite or
+ *         \a max_depth_change_factor is negative or not finite. */
 void averageGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                             float max_depth_change_factor, float smoothing_size,
                             pcl::PointCloud<pcl::Normal>& normals);
