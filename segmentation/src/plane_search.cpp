@@ -55,7 +55,7 @@ depthDistanceMap(const pcl::PointCloud<pcl::PointXYZ>& cloud, float max_depth_ch
       if (std::fabs(depth - down) > allowed || !std::isfinite(depth) || !std::isfinite(down))
         change[index] = change[index + w] = 0;
     }
-  std::vector<float> d(n + 1); // PCL's passes read one past a row's end (the next row's start)
+  std::vector<float> d(n);
   for (std::size_t i = 0; i < n; ++i)
     d[i] = change[i] == 0 ? 0.0f : static_cast<float>(w + h);
   for (std::size_t ri = 1; ri < h; ++ri) {
@@ -72,14 +72,14 @@ depthDistanceMap(const pcl::PointCloud<pcl::PointXYZ>& cloud, float max_depth_ch
     float* current = d.data() + static_cast<std::size_t>(ri) * w;
     float* next = current + w;
     for (std::ptrdiff_t ci = static_cast<std::ptrdiff_t>(w) - 2; ci >= 0; --ci) {
-      // At ci = 0, next[-1] is the last of this row, as in PCL's flat buffer.
+      // At ci = 0, next[-1] is the last of this row, and in the first pass previous[w] the
+      // first of the next: PCL's passes run over the flat buffer.
       const float m = std::min(std::min(next[ci - 1] + 1.4f, next[ci] + 1.0f),
                                std::min(current[ci + 1] + 1.0f, next[ci + 1] + 1.4f));
       if (m < current[ci])
         current[ci] = m;
     }
   }
-  d.pop_back();
   return d;
 }
 
@@ -90,9 +90,7 @@ std::vector<GradientSums>
 gradientSums(const pcl::PointCloud<pcl::PointXYZ>& cloud)
 {
   const std::size_t w = cloud.width, h = cloud.height, stride = w + 1;
-  std::vector<GradientSums> table(stride * (h + 1));
-  for (std::size_t c = 0; c <= w; ++c)
-    table[c] = GradientSums{{0, 0, 0}, {0, 0, 0}, 0, 0};
+  std::vector<GradientSums> table(stride * (h + 1)); // zeros: the first row and column stay so
   const auto add = [](double(&sum)[3], unsigned& count, const float(&e)[3]) {
     if (std::isfinite((e[0] + e[1]) + e[2])) {
       for (int k = 0; k < 3; ++k)
@@ -103,7 +101,6 @@ gradientSums(const pcl::PointCloud<pcl::PointXYZ>& cloud)
   for (std::size_t r = 0; r < h; ++r) {
     const GradientSums* previous = table.data() + r * stride;
     GradientSums* current = table.data() + (r + 1) * stride;
-    current[0] = GradientSums{{0, 0, 0}, {0, 0, 0}, 0, 0};
     const bool row_inside = r >= 1 && r + 2 <= h;
     for (std::size_t c = 0; c < w; ++c) {
       GradientSums& e = current[c + 1];
