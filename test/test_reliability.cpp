@@ -287,6 +287,42 @@ TEST(Reliability, ParallelForCoversEveryItemOnceAndRethrows)
                std::runtime_error);
 }
 
+TEST(Reliability, ParallelLoopsNestAndRunFromManyThreadsAtOnce)
+{
+  // Loops within loops (the recognizer fits clusters in parallel and each fit runs its retries
+  // in parallel) and loops started by several threads at once share the sleeping helpers; every
+  // item is still done once, and each block's worker number is in [0, parallelWorkers).
+  constexpr std::size_t kOuter = 24, kInner = 1000;
+  const auto nested = [&](int threads) {
+    std::vector<int> hits(kOuter * kInner, 0);
+    std::atomic<bool> numbered{true};
+    const int outer_workers = facyl::parallelWorkers(kOuter, threads, 1);
+    facyl::parallelForWorkers(kOuter, threads, 1, [&](std::size_t b, std::size_t e, int w) {
+      numbered = numbered && w >= 0 && w < outer_workers;
+      for (std::size_t o = b; o < e; ++o)
+        facyl::parallelForWorkers(kInner, threads, 64, [&](std::size_t ib, std::size_t ie, int iw) {
+          numbered = numbered && iw >= 0 && iw < facyl::parallelWorkers(kInner, threads, 64);
+          for (std::size_t i = ib; i < ie; ++i)
+            ++hits[o * kInner + i];
+        });
+    });
+    EXPECT_TRUE(numbered.load());
+    return static_cast<std::size_t>(std::count(hits.begin(), hits.end(), 1));
+  };
+  EXPECT_EQ(nested(4), kOuter * kInner);
+  std::vector<std::size_t> done(6, 0);
+  std::vector<std::thread> callers;
+  for (std::size_t t = 0; t < done.size(); ++t)
+    callers.emplace_back([&, t] {
+      for (int round = 0; round < 20; ++round)
+        done[t] += nested(3) == kOuter * kInner;
+    });
+  for (auto& c : callers)
+    c.join();
+  for (const std::size_t d : done)
+    EXPECT_EQ(d, 20u);
+}
+
 // ------------------------------------------------------ thread safety and determinism
 
 TEST(Reliability, EightThreadsWithTheirOwnRecognizersMatchTheSerialRun)

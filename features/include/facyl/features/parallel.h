@@ -1,18 +1,21 @@
 /*
  * facyl: fast cylinder detection for PCL.
- * A parallel loop that never spins: blocks of a range run on a few std::threads that are
- * joined at the end (a waiting thread sleeps in the kernel). facyl runs beside other processes
- * on few cores; OpenMP's default wait policy busy-waits there and multiplies the time of
- * short parallel regions (measured: 8x with two competing processes on two cores).
+ * A parallel loop that never spins: blocks of a range run on the calling thread and on a few
+ * helper threads that sleep in the kernel while there is no work (a condition variable, never
+ * a busy wait). facyl runs beside other processes on few cores; OpenMP's default wait policy
+ * busy-waits there and multiplies the time of short parallel regions (measured: 8x with two
+ * competing processes on two cores). The helpers are started on first use and kept, asleep,
+ * for the process's life: starting and joining threads for every loop cost about 40 us per
+ * loop on two cores, waking a sleeping helper a few microseconds (docs/speed.md).
  */
 #pragma once
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <exception>
 #include <mutex>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -38,6 +41,29 @@ parallelWorkers(std::size_t n, int threads, std::size_t grain)
     std::max<std::size_t>(1, std::min<std::size_t>(blocks, static_cast<std::size_t>(t))));
 }
 
+namespace detail {
+
+/** \brief A parallel loop's work offered to the helper threads: each helper that takes it calls
+ * run(context, worker) once, with its own worker number in [1, helpers]. */
+struct HelperJob {
+  void (*run)(void* context, int worker){nullptr};
+  void* context{nullptr};
+  int wanted{0};                ///< helpers still wanted (guarded by the pool's mutex)
+  int next_worker{1};           ///< the number the next helper gets
+  int active{0};                ///< helpers inside run
+  std::condition_variable done; ///< signalled when active drops to 0
+};
+
+/** \brief Offers \a job to \a helpers sleeping helper threads (started if fewer are idle) and
+ * returns at once. Thread-safe; callable from within a job (nested loops). */
+void offer(HelperJob& job, int helpers);
+
+/** \brief Takes \a job back: no helper starts it any more; returns when every helper that
+ * started it has returned from run. */
+void withdraw(HelperJob& job);
+
+} // namespace detail
+
 /** \brief Calls \a body(begin, end, worker) on blocks of at most \a grain items covering
  * [0, n), on parallelWorkers(n, threads, grain) threads (the caller's among them); blocks are
  * taken in order by whichever thread is free, and \a worker (in [0, parallelWorkers(...)))
@@ -59,7 +85,7 @@ parallelForWorkers(std::size_t n, int threads, std::size_t grain, Body&& body)
   std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex failure_mutex;
-  const auto work = [&](int worker) {
+  auto work = [&](int worker) {
     try {
       for (std::size_t b = next.fetch_add(grain); b < n; b = next.fetch_add(grain))
         body(b, std::min(n, b + grain), worker);
@@ -71,19 +97,12 @@ parallelForWorkers(std::size_t n, int threads, std::size_t grain, Body&& body)
       next = n; // the others stop after their block
     }
   };
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(workers - 1));
-  for (int w = 1; w < workers; ++w) {
-    try {
-      pool.emplace_back(work, w);
-    }
-    catch (const std::system_error&) { // no more threads: the ones running do the work
-      break;
-    }
-  }
+  detail::HelperJob job;
+  job.context = &work;
+  job.run = [](void* context, int worker) { (*static_cast<decltype(work)*>(context))(worker); };
+  detail::offer(job, workers - 1);
   work(0);
-  for (auto& t : pool)
-    t.join();
+  detail::withdraw(job); // returns when the helpers that took part are done
   if (failure)
     std::rethrow_exception(failure);
 }
