@@ -24,8 +24,7 @@ public:
     jobs_.push_back(&job);
     pending_ += helpers;
     // Idle helpers (some may be woken for other jobs already) against the helpers wanted.
-    while (static_cast<int>(threads_.size()) - busy_ < pending_ &&
-           threads_.size() < kMaxThreads) {
+    while (static_cast<int>(threads_.size()) - busy_ < pending_ && threads_.size() < kMaxThreads) {
       try {
         threads_.emplace_back([this] { serve(); });
       }

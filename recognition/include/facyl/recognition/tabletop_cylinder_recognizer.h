@@ -79,9 +79,10 @@ struct TabletopRecognizerParameters {
    * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
   float reject_below{0.1f};
   int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
-  /** Clusters fitted at once, each thread with a cue estimation and estimators of its own:
-   * 0 (default) the hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting
-   * threads sleep (parallelFor), and the results do not depend on it. */
+  /** Clusters fitted at once, each thread with a cue estimation and estimators of its own;
+   * threads that no cluster takes help with a cluster's cues and retries. 0 (default) the
+   * hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting threads sleep
+   * (parallelFor), and the results do not depend on it. */
   int threads{0};
 };
 

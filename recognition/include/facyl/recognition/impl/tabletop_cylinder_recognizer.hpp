@@ -53,9 +53,8 @@ TabletopCylinderRecognizer<PointT>::makeFitter() const
 {
   auto f = std::make_unique<Fitter>();
   f->cues.setKSearch(params_.neighbours);
-  // A cluster's cues are a millisecond of work: threads would cost more in start-up and, beside
-  // other busy processes, in waiting for each other than they save (clusters are fitted in
-  // parallel instead).
+  // One thread for a cluster's cues while clusters are fitted in parallel; fitClusters gives
+  // them the threads no cluster takes.
   f->cues.setNumberOfThreads(1);
   // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
   // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
@@ -220,8 +219,10 @@ TabletopCylinderRecognizer<PointT>::fitClusters(std::vector<TabletopCluster>& cl
   });
   // Threads the clusters leave idle run a cluster's retries at once.
   const int spare = std::max<int>(1, static_cast<int>(fitters_.size() / order.size()));
-  for (auto& f : fitters_)
+  for (auto& f : fitters_) {
     f->retry_threads = spare;
+    f->cues.setNumberOfThreads(static_cast<unsigned int>(spare));
+  }
   const auto t = std::chrono::steady_clock::now();
   parallelForWorkers(order.size(), static_cast<int>(fitters_.size()), 1,
                      [&](std::size_t begin, std::size_t end, int worker) {
