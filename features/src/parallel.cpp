@@ -55,6 +55,7 @@ private:
 
   void serve()
   {
+    pthread_setname_np(pthread_self(), "facyl-helper"); // as top and gdb show it
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
       wake_.wait(lock, [&] { return !jobs_.empty(); });
