@@ -152,13 +152,14 @@ TEST(Reliability, AFrameInWorldCoordinatesGivesTheSameAnswer)
   EXPECT_EQ(b.getInputCloud(), world);
 }
 
-TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
+/** The default scene with every 97th point beyond kMaxCoordinate (\a garbage), or NaN there
+ * (\a missing); both unorganized (one row) when \a organized is false. */
+void
+hugeCoordinates(bool organized, Cloud::Ptr& garbage, Cloud::Ptr& missing)
 {
-  // Found by fuzz_pcd: finite points near FLT_MAX made FLANN's k-d tree abort (an assertion in
-  // middleSplit) in the unorganized plane search. Now they count as missing pixels: the answer
-  // is the one for the same frame with those pixels NaN, organized or not.
   const Cloud::Ptr scene = defaultScene();
-  Cloud::Ptr garbage(new Cloud(*scene)), missing(new Cloud(*scene));
+  garbage.reset(new Cloud(*scene));
+  missing.reset(new Cloud(*scene));
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t i = 0; i < scene->size(); i += 97) {
     (*garbage)[i].x = (i % 2 ? 3.3e38f : -2e7f);
@@ -166,16 +167,24 @@ TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
     (*garbage)[i].z = (i % 3 ? 3.2e38f : 1.f);
     (*missing)[i].x = (*missing)[i].y = (*missing)[i].z = nan;
   }
-  EXPECT_EQ(facyl::countFarPoints(*garbage), (scene->size() + 96) / 97);
-  EXPECT_EQ(facyl::countFarPoints(*missing), 0u);
+  if (!organized)
+    for (auto* c : {garbage.get(), missing.get()}) {
+      c->width = static_cast<std::uint32_t>(c->size());
+      c->height = 1;
+    }
+}
+
+TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
+{
+  // Found by fuzz_pcd: finite points near FLT_MAX made FLANN's k-d tree abort (an assertion in
+  // middleSplit) in the unorganized plane search. Now they count as missing pixels: the answer
+  // is the one for the same frame with those pixels NaN, organized or not.
   for (const bool organized : {true, false}) {
     SCOPED_TRACE(organized ? "organized" : "unorganized");
-    Cloud::Ptr a(new Cloud(*garbage)), b(new Cloud(*missing));
-    if (!organized)
-      for (auto* c : {a.get(), b.get()}) {
-        c->width = static_cast<std::uint32_t>(c->size());
-        c->height = 1;
-      }
+    Cloud::Ptr a, b;
+    hugeCoordinates(organized, a, b);
+    EXPECT_EQ(facyl::countFarPoints(*a), (a->size() + 96) / 97);
+    EXPECT_EQ(facyl::countFarPoints(*b), 0u);
     bool ok_a = false, ok_b = false;
     const auto with_garbage = recognize(a, &ok_a);
     const auto with_holes = recognize(b, &ok_b);
@@ -183,6 +192,40 @@ TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
     EXPECT_EQ(ok_a, ok_b);
     EXPECT_EQ(fingerprint(with_garbage), fingerprint(with_holes));
     EXPECT_GE(with_garbage.size(), 5u);
+  }
+}
+
+TEST(Reliability, TheSegmentationTreatsHugeCoordinatesAsMissing)
+{
+  // The search meets such points in a pass it makes anyway, stops, and runs again on a copy
+  // without them: the segments of the frame with those pixels NaN. A segmentation reused
+  // across the two clouds, in both orders, keeps nothing of the stopped run.
+  for (const bool organized : {true, false}) {
+    SCOPED_TRACE(organized ? "organized" : "unorganized");
+    Cloud::Ptr garbage, missing;
+    hugeCoordinates(organized, garbage, missing);
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    std::vector<std::vector<std::vector<pcl::index_t>>> runs;
+    std::vector<std::vector<float>> tables;
+    for (const auto& cloud : {garbage, missing, garbage}) {
+      seg.setInputCloud(cloud);
+      std::vector<facyl::TabletopCluster> clusters;
+      ASSERT_TRUE(seg.segment(clusters));
+      runs.emplace_back();
+      for (const auto& c : clusters)
+        runs.back().push_back(c.indices.indices);
+      tables.push_back(seg.getTableCoefficients().values);
+    }
+    EXPECT_GE(runs[0].size(), 5u);
+    EXPECT_EQ(runs[0], runs[1]);
+    EXPECT_EQ(runs[2], runs[1]);
+    // The copy's results are moved back by the identity (rounding in the last bits).
+    for (const std::size_t r : {0, 2}) {
+      ASSERT_EQ(tables[r].size(), 4u);
+      ASSERT_EQ(tables[1].size(), 4u);
+      for (std::size_t k = 0; k < 4; ++k)
+        EXPECT_NEAR(tables[r][k], tables[1][k], 1e-6f);
+    }
   }
 }
 
