@@ -221,7 +221,7 @@ private:
     std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators;
     std::size_t upright{0};   ///< index of the estimator with the axis along the support's normal
     bool with_support{false}; ///< the cluster being fitted has a support
-    int retry_threads{1};     ///< threads that run the retries of one cluster at once
+    int retry_threads{1};     ///< threads that run a cluster's first fit and retries at once
   };
   /** Builds a fitter from the settings. */
   std::unique_ptr<Fitter> makeFitter() const;

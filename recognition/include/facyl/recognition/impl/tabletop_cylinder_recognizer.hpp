@@ -13,6 +13,7 @@
 #include <pcl/type_traits.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -793,24 +794,34 @@ typename TabletopCylinderRecognizer<PointT>::Fit
 TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInput& input,
                                                    const std::vector<std::uint8_t>& alive) const
 {
-  Fit best = fitOnce(fitter, input, alive, 0);
-  if (best.accepted)
-    return best;
   std::vector<std::size_t> retries;
   for (std::size_t e = 1; e < fitter.estimators.size(); ++e)
     if (e != fitter.upright || fitter.with_support)
       retries.push_back(e);
-  // Each retry has an estimator of its own: with threads to spare they all run at once (a
-  // retry after an accepted one is then wasted work); either way they are taken in order.
+  // Each fit has an estimator of its own. With threads to spare, the first fit and the retries
+  // run at once, started in order, and a fit not started yet is skipped once an earlier one is
+  // accepted (its answer would not be looked at). Either way they are judged in order: the
+  // answer of one fit after another.
   const bool at_once = fitter.retry_threads > 1;
-  std::vector<Fit> fits(at_once ? retries.size() : 0);
-  if (at_once)
-    parallelFor(retries.size(), fitter.retry_threads, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        fits[i] = fitOnce(fitter, input, alive, retries[i]);
+  std::vector<Fit> fits(retries.size() + 1);
+  if (at_once) {
+    std::atomic<std::size_t> accepted{fits.size()}; // the earliest fit accepted so far
+    parallelFor(fits.size(), fitter.retry_threads, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (accepted.load() < i)
+          continue;
+        fits[i] = fitOnce(fitter, input, alive, i == 0 ? 0 : retries[i - 1]);
+        for (std::size_t a = accepted.load(); fits[i].accepted && i < a;)
+          if (accepted.compare_exchange_weak(a, i))
+            break;
+      }
     });
+  }
+  else
+    fits[0] = fitOnce(fitter, input, alive, 0);
+  Fit best = std::move(fits[0]);
   for (std::size_t i = 0; i < retries.size() && !best.accepted; ++i) {
-    Fit f = at_once ? std::move(fits[i]) : fitOnce(fitter, input, alive, retries[i]);
+    Fit f = at_once ? std::move(fits[i + 1]) : fitOnce(fitter, input, alive, retries[i]);
     if (f.evidence.fitted &&
         (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
          !best.evidence.fitted))
