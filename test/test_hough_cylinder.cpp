@@ -187,11 +187,12 @@ TEST(HoughCylinderEstimation, HoldsAtHighNoiseBesideAPlane)
   // within a few sigma of the surface. 60 seeded clouds a level; never more failures than
   // facyl 0.1 on the same clouds. At 10% noise the issue's target (2%). At 20% the issue asks
   // for 10%; this draw has many short, wide cylinders (height ~ radius, whose tilt the points
-  // barely fix) and the fit fails 12 (20%): the bound holds that figure (contenders compared
-  // by their support alone, before settledScore, failed 14).
+  // barely fix) and the fit fails 8 (13%): the bound holds that figure (with coarse cues from
+  // half a radius instead of one, 12; contenders compared by their support alone, before
+  // settledScore, 14).
   constexpr int kRuns = 60;
   const std::size_t candidates = facyl::HoughCylinderParameters{}.point_candidates;
-  for (const auto& [noise, most] : {std::pair{0.10f, 1}, std::pair{0.20f, 12}}) {
+  for (const auto& [noise, most] : {std::pair{0.10f, 1}, std::pair{0.20f, 8}}) {
     const Sweep now = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns, true, candidates, true);
     const Sweep before = sweep(VotingMode::SoftCurvature, 0.f, noise, kRuns, true, 0, true);
     EXPECT_LE(now.failures, most) << "noise " << noise;

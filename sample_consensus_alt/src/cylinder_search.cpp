@@ -914,8 +914,8 @@ describeSettled(const CylinderCues& cues, const std::vector<int>& active, Candid
 
 /** One cylinder among the \a active points: the candidates of the cues (competeSeeds), the best
  * refined (with params.refine) and described. When the best candidate's normals are more noise
- * than cue, cues at a coarser scale (half its radius) propose candidates too, and these cues
- * judge them all. */
+ * than cue, cues at a coarser scale (params.coarse_scale of its radius) propose candidates too,
+ * and these cues judge them all. */
 std::optional<CylinderModel>
 fitOne(const CylinderCues& cues, const std::vector<int>& active,
        const std::vector<OrientationAccumulator>& accumulators,

@@ -48,9 +48,9 @@ enum class HoughFailure {
  * each axis with z and finds position and radius with a circle Hough transform. The best
  * candidates are then refined on the points themselves (robust least squares on the
  * point-to-surface distances) and compared on the points they explain; when the noise makes
- * the given normals useless, normals and curvatures are estimated again at half the radius
- * and propose candidates too (see HoughCylinderParameters::point_candidates). The goodness of
- * fit is the inlier ratio of eq. 4.
+ * the given normals useless, normals and curvatures are estimated again from neighbours
+ * within one radius and propose candidates too (see HoughCylinderParameters::point_candidates). The
+ * goodness of fit is the inlier ratio of eq. 4.
  *
  * \code
  * facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
@@ -300,7 +300,7 @@ public:
     return params_.noisy_cues_ratio;
   }
   /** \brief Neighbourhood of the cues estimated again at high noise, as a share of the
-   * radius, in [0, 2] (default 0.5; 0: never). */
+   * radius, in [0, 2] (default 1; 0: never). */
   void setCoarseScale(float share_of_radius)
   {
     params_.coarse_scale = share_of_radius;
