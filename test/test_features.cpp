@@ -71,6 +71,77 @@ TEST(NeighbourSearch, MatchesBruteForce)
   EXPECT_THROW(search.within(pts, -1.f), std::invalid_argument);
 }
 
+TEST(NeighbourSearch, GridNeighboursAreTheTreesNeighbours)
+{
+  // nearestOnGrid against the k-d tree on the shapes it meets: a cylinder with lids, a plane,
+  // a line, a filled box, coincident points; queries inside and far outside, not finite; k
+  // from 1 to more than the points. The same neighbours at the same distances, nearest first.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::normal_distribution<float> g(0.f, 0.003f);
+  const auto shape = [&](int kind, Eigen::Index n) {
+    Eigen::Matrix3Xf p(3, n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const float t = 6.2832f * u(rng), a = u(rng), b = u(rng);
+      switch (kind) {
+      case 0: // cylinder, half its points on the lids
+        p.col(i) = i % 2 ? Eigen::Vector3f(0.3f * std::cos(t), 0.3f * std::sin(t), a)
+                         : Eigen::Vector3f(0.3f * std::sqrt(b) * std::cos(t),
+                                           0.3f * std::sqrt(b) * std::sin(t), float(i % 4 == 0));
+        p.col(i) += Eigen::Vector3f(g(rng), g(rng), g(rng));
+        break;
+      case 1: // a plane without noise
+        p.col(i) = Eigen::Vector3f(2.f * a, b, 0.5f);
+        break;
+      case 2: // a line
+        p.col(i) = Eigen::Vector3f(a, 0.f, 0.f);
+        break;
+      case 3: // a filled box
+        p.col(i) = Eigen::Vector3f(a, b, u(rng));
+        break;
+      default: // ten places, each holding many coincident points
+        p.col(i) = Eigen::Vector3f(float(i % 10), 0.f, 1.f);
+      }
+    }
+    return p;
+  };
+  for (int kind = 0; kind < 5; ++kind) {
+    Eigen::Matrix3Xf pts = shape(kind, 700);
+    pts.col(5).setConstant(std::numeric_limits<float>::quiet_NaN());
+    Eigen::Matrix3Xf queries(3, 103);
+    for (Eigen::Index i = 0; i < 100; ++i)
+      queries.col(i) = pts.col(i * 7);
+    queries.col(100) = Eigen::Vector3f(40.f, -30.f, 7.f); // far outside
+    queries.col(101) = Eigen::Vector3f(0.5f, 0.5f, 0.5f);
+    queries.col(102).setConstant(std::numeric_limits<float>::infinity());
+    const facyl::NeighbourSearch search(pts);
+    for (const int k : {1, 12, 64, 1000}) {
+      const auto tree = search.nearest(queries, k, 1);
+      const auto grid = facyl::nearestOnGrid(pts, queries, k);
+      ASSERT_EQ(grid.size(), tree.size());
+      for (std::size_t i = 0; i < grid.size(); ++i) {
+        ASSERT_EQ(grid.count(i), tree.count(i)) << "shape " << kind << " k " << k << " query " << i;
+        const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
+        for (std::size_t j = 0; j < grid.count(i); ++j) {
+          const float dg = (pts.col(grid.begin(i)[j]) - q).squaredNorm();
+          EXPECT_FLOAT_EQ(dg, (pts.col(tree.begin(i)[j]) - q).squaredNorm())
+            << "shape " << kind << " k " << k << " query " << i << " rank " << j;
+          if (j > 0)
+            EXPECT_LE((pts.col(grid.begin(i)[j - 1]) - q).squaredNorm(), dg);
+        }
+      }
+      EXPECT_EQ(grid.count(102), 0u);
+      EXPECT_EQ(grid.count(0), std::min<std::size_t>(static_cast<std::size_t>(k), 699u));
+      if (kind != 4) // a surface point finds itself first (coincident points: any of them)
+        EXPECT_EQ(grid.begin(0)[0], 0);
+    }
+  }
+  const Eigen::Matrix3Xf none(3, 0), one = Eigen::Vector3f(1.f, 2.f, 3.f);
+  EXPECT_EQ(facyl::nearestOnGrid(none, one, 4).count(0), 0u);
+  EXPECT_EQ(facyl::nearestOnGrid(one, one, 4).count(0), 1u);
+  EXPECT_THROW(facyl::nearestOnGrid(one, one, 0), std::invalid_argument);
+}
+
 TEST(NeighbourSearch, NearestWithinIsNearestCutAtTheRadius)
 {
   std::mt19937 rng(5);

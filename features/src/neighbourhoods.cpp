@@ -12,6 +12,8 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace facyl {
 
@@ -151,6 +153,189 @@ NeighbourSearch::within(const Eigen::Matrix3Xf& queries, float radius, int threa
     }
   });
   return Neighbourhoods::fromLists(lists);
+}
+
+namespace {
+
+/** Points sorted into a uniform grid of cubic cells (a counting sort by cell). */
+class PointGrid {
+public:
+  PointGrid(const Eigen::Matrix3Xf& surface, int k)
+  {
+    lo_ = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f hi = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+    for (Eigen::Index i = 0; i < surface.cols(); ++i)
+      if (surface.col(i).allFinite()) {
+        columns_.push_back(static_cast<int>(i));
+        lo_ = lo_.cwiseMin(surface.col(i));
+        hi = hi.cwiseMax(surface.col(i));
+      }
+    if (columns_.empty())
+      return;
+    // Cells about as wide as a k-neighbourhood of points spread over a surface that fills the
+    // box's two largest extents, or over a line along its largest; at most about 4 cells a
+    // point. Any width gives the same neighbours; this one keeps the rings few and small.
+    const double m = static_cast<double>(columns_.size());
+    Eigen::Vector3d extent = (hi - lo_).cast<double>();
+    std::sort(extent.data(), extent.data() + 3);
+    const double reach =
+      std::max(std::sqrt(extent(1) * extent(2) * k / m), extent(2) * k / (2.0 * m));
+    cell_ = static_cast<float>(std::max(reach, 1e-6 * std::max(1.0, extent(2))));
+    for (;;) {
+      for (int d = 0; d < 3; ++d)
+        size_[d] = 1 + static_cast<int>((hi(d) - lo_(d)) / cell_);
+      if (static_cast<double>(size_[0]) * size_[1] * size_[2] <= 4.0 * m + 64.0)
+        break;
+      cell_ *= 1.26f;
+    }
+    const std::size_t cells = static_cast<std::size_t>(size_[0]) * size_[1] * size_[2];
+    std::vector<std::uint32_t> cell_of(columns_.size());
+    starts_.assign(cells + 1, 0);
+    for (std::size_t j = 0; j < columns_.size(); ++j) {
+      cell_of[j] = static_cast<std::uint32_t>(cellIndex(cellOf(surface.col(columns_[j]))));
+      ++starts_[cell_of[j] + 1];
+    }
+    for (std::size_t c = 0; c < cells; ++c)
+      starts_[c + 1] += starts_[c];
+    std::vector<std::uint32_t> next(starts_.begin(), starts_.end() - 1);
+    xyz_.resize(3 * columns_.size());
+    sorted_.resize(columns_.size());
+    for (std::size_t j = 0; j < columns_.size(); ++j) {
+      const std::uint32_t at = next[cell_of[j]]++;
+      sorted_[at] = columns_[j];
+      for (int d = 0; d < 3; ++d)
+        xyz_[3 * at + static_cast<std::size_t>(d)] = surface(d, columns_[j]);
+    }
+  }
+
+  std::size_t points() const
+  {
+    return columns_.size();
+  }
+
+  /** The \a kk nearest points of \a q (finite) into \a best, nearest first: rings of cells
+   * about q's cell (clamped to the grid), until no cell outside them can hold a nearer point. */
+  void nearest(const Eigen::Vector3f& q, std::size_t kk,
+               std::vector<std::pair<float, int>>& best) const
+  {
+    best.clear();
+    const Eigen::Vector3i c = cellOf(q);
+    for (int r = 0;; ++r) {
+      visitRing(c, r, q, kk, best);
+      // The nearest face of the block of rings 0..r beyond which cells remain.
+      float bound = std::numeric_limits<float>::max();
+      bool more = false;
+      for (int d = 0; d < 3; ++d) {
+        if (c(d) + r + 1 < size_[d]) {
+          more = true;
+          bound = std::min(bound, lo_(d) + static_cast<float>(c(d) + r + 1) * cell_ - q(d));
+        }
+        if (c(d) - r - 1 >= 0) {
+          more = true;
+          bound = std::min(bound, q(d) - (lo_(d) + static_cast<float>(c(d) - r) * cell_));
+        }
+      }
+      if (!more)
+        break;
+      bound = std::max(bound, 0.f);
+      if (best.size() == kk && best.back().first <= bound * bound)
+        break;
+    }
+  }
+
+private:
+  Eigen::Vector3i cellOf(const Eigen::Vector3f& p) const
+  {
+    Eigen::Vector3i c;
+    for (int d = 0; d < 3; ++d) {
+      const float t = (p(d) - lo_(d)) / cell_;
+      c(d) = t <= 0.f ? 0 : std::min(size_[d] - 1, static_cast<int>(std::min(t, 1e9f)));
+    }
+    return c;
+  }
+  std::size_t cellIndex(const Eigen::Vector3i& c) const
+  {
+    return (static_cast<std::size_t>(c(2)) * static_cast<std::size_t>(size_[1]) +
+            static_cast<std::size_t>(c(1))) *
+             static_cast<std::size_t>(size_[0]) +
+           static_cast<std::size_t>(c(0));
+  }
+  /** The cells of the grid at Chebyshev distance \a r from \a c. */
+  void visitRing(const Eigen::Vector3i& c, int r, const Eigen::Vector3f& q, std::size_t kk,
+                 std::vector<std::pair<float, int>>& best) const
+  {
+    int from[3], to[3];
+    for (int d = 0; d < 3; ++d) {
+      from[d] = std::max(-r, -c(d));
+      to[d] = std::min(r, size_[d] - 1 - c(d));
+    }
+    for (int dx = from[0]; dx <= to[0]; ++dx)
+      for (int dy = from[1]; dy <= to[1]; ++dy) {
+        if (std::abs(dx) == r || std::abs(dy) == r) {
+          for (int dz = from[2]; dz <= to[2]; ++dz)
+            visit(c + Eigen::Vector3i(dx, dy, dz), q, kk, best);
+          continue;
+        }
+        if (from[2] == -r)
+          visit(c + Eigen::Vector3i(dx, dy, -r), q, kk, best);
+        if (to[2] == r)
+          visit(c + Eigen::Vector3i(dx, dy, r), q, kk, best);
+      }
+  }
+  /** The points of cell \a c (inside the grid) offered to \a best. */
+  void visit(const Eigen::Vector3i& c, const Eigen::Vector3f& q, std::size_t kk,
+             std::vector<std::pair<float, int>>& best) const
+  {
+    const std::size_t cell = cellIndex(c);
+    for (std::uint32_t at = starts_[cell]; at < starts_[cell + 1]; ++at) {
+      const float* p = &xyz_[3 * static_cast<std::size_t>(at)];
+      const float ex = p[0] - q(0), ey = p[1] - q(1), ez = p[2] - q(2);
+      const float d2 = ex * ex + ey * ey + ez * ez;
+      if (best.size() == kk && !(d2 < best.back().first))
+        continue;
+      const std::pair<float, int> entry{d2, sorted_[at]};
+      if (best.size() == kk)
+        best.pop_back();
+      best.insert(std::upper_bound(best.begin(), best.end(), entry), entry);
+    }
+  }
+
+  std::vector<int> columns_;          // finite columns, in column order
+  std::vector<int> sorted_;           // the same, by cell
+  std::vector<float> xyz_;            // their coordinates, by cell
+  std::vector<std::uint32_t> starts_; // first point of each cell, and the end
+  Eigen::Vector3f lo_;
+  float cell_{1.f};
+  int size_[3]{1, 1, 1};
+};
+
+} // namespace
+
+Neighbourhoods
+nearestOnGrid(const Eigen::Matrix3Xf& surface, const Eigen::Matrix3Xf& queries, int k)
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::nearestOnGrid: k must be at least 1");
+  const std::size_t n = static_cast<std::size_t>(queries.cols());
+  Neighbourhoods out;
+  out.offsets.assign(n + 1, 0);
+  const PointGrid grid(surface, k);
+  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), grid.points());
+  if (kk == 0)
+    return out;
+  out.indices.reserve(n * kk);
+  std::vector<std::pair<float, int>> best;
+  best.reserve(kk + 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f q = queries.col(static_cast<Eigen::Index>(i));
+    if (q.allFinite()) {
+      grid.nearest(q, kk, best);
+      for (const auto& b : best)
+        out.indices.push_back(b.second);
+    }
+    out.offsets[i + 1] = out.indices.size();
+  }
+  return out;
 }
 
 } // namespace facyl
