@@ -151,10 +151,13 @@ TEST(HoughCylinderEstimation, SoftCurvatureBeatsRabbaniWithLids)
 {
   const Sweep rabbani = sweep(VotingMode::Rabbani, 3.f, 0.01f, 40);
   const Sweep soft = sweep(VotingMode::SoftCurvature, 3.f, 0.01f, 40);
-  // Planar lid points vote for the great circle orthogonal to the axis: hard votes fail.
-  EXPECT_GT(rabbani.failures, 20);
-  EXPECT_LT(soft.failures, rabbani.failures);
-  EXPECT_LT(quantile(soft.axis_deg, 0.5), quantile(rabbani.axis_deg, 0.5));
+  // Planar lid points vote for the great circle orthogonal to the axis: hard votes fail,
+  // but where the lids lie far apart along the axis (a tall cylinder) the points' own direction
+  // (addElongationSeed) gives it: 14 of these 40 fail (40 without that seed), none with soft
+  // curvature votes.
+  EXPECT_GT(rabbani.failures, 10);
+  EXPECT_EQ(soft.failures, 0);
+  EXPECT_LT(quantile(soft.axis_deg, 0.9), quantile(rabbani.axis_deg, 0.9));
 }
 
 TEST(HoughCylinderEstimation, HoldsAtHighNoise)
@@ -228,9 +231,11 @@ TEST(HoughCylinderEstimation, FindsANarrowSliverOfATallCylinder)
   // facyl_bench, random setting, occlusion 75%: a tall, thin cylinder seen over a quarter of its
   // circumference, 225 points over a metre or more. The normals of k = 16 neighbours span the
   // whole arc and point nearly one way, so the circle Hough may place no centre; the points'
-  // own circle then does (fitPosition). These 8 clouds: 6 found, 3 with the radius within 10%
-  // (without the points' circle: 4 found, 1 right). Not solved: runs 0, 2 and 6 keep a circle
-  // that the normals placed, 2-3 times too wide, on an axis 2 deg off; runs 4 and 5 none.
+  // own circle then does (fitPosition), and the points' own direction seeds the axis
+  // (addElongationSeed). These 8 clouds: 8 found, 5 with the radius within 10% (without the
+  // points' direction: 6 and 3, runs 4 and 5 none; without the points' circle either: 4 and 1).
+  // Not solved: runs 0, 2 and 6 keep a circle that the normals placed, 2-3 times too wide, on
+  // an axis 2 deg off.
   int found = 0, radius_right = 0;
   for (int run = 0; run < 8; ++run) {
     std::mt19937 rng(static_cast<unsigned>(run));
@@ -254,8 +259,35 @@ TEST(HoughCylinderEstimation, FindsANarrowSliverOfATallCylinder)
     EXPECT_LT(o.axis_deg, 3.f) << "run " << run;
     radius_right += o.radius_rel < 0.1f;
   }
-  EXPECT_GE(found, 6);
-  EXPECT_GE(radius_right, 3);
+  EXPECT_EQ(found, 8);
+  EXPECT_GE(radius_right, 5);
+}
+
+TEST(HoughCylinderEstimation, HoldsAtNinetyPercentOcclusion)
+{
+  // facyl_bench's paper setting at its last occlusion level: r = 0.3 m, an upright axis,
+  // height 0.05-2 m, a tenth of the side visible (90 points over a 36 deg arc). A tall such
+  // sliver has normals that all point one way; its points reach along the axis, and that
+  // direction is a seed (addElongationSeed). These 60 clouds: 2 failures (axis > 10 deg or
+  // none), 19 without that seed.
+  constexpr int kRuns = 60;
+  int failures = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    std::mt19937 rng(static_cast<unsigned>(run));
+    facyl::CylinderSimulationParameters p;
+    p.radius = 0.3f;
+    p.height = std::uniform_real_distribution<float>(0.05f, 2.f)(rng);
+    p.occlusion = 0.9f;
+    p.noise = 0.01f;
+    p.seed = 700 + static_cast<std::uint64_t>(run);
+    const auto sim = facyl::simulateCylinder(p);
+    Hough hough;
+    hough.setRadiusLimits(0.01f, 0.6f);
+    failures += fitOnce(sim.cloud.makeShared(), sim.truth, hough).axis_deg > 10.f;
+  }
+  std::printf("[ figures  ] 90%% occlusion, %d fits: %d off by > 10 deg or none\n", kRuns,
+              failures);
+  EXPECT_LE(failures, 2);
 }
 
 TEST(HoughCylinderEstimation, RefinementRemovesCellQuantisation)
