@@ -45,8 +45,9 @@ enum class HoughFailure {
  *
  * Step 1 votes for the axis direction on N_d cells drawn from an orientation prior (paper
  * eq. 1-3). The strongest peaks are refined below the cell size (refineAxis); points that
- * reach much further along one direction than across (a tall cylinder seen over a narrow arc)
- * also propose that direction. Step 2 aligns
+ * reach much further along one direction than across (a tall cylinder seen over a narrow arc;
+ * all the points, or those whose normals are off a dominant plane's) also propose that
+ * direction. Step 2 aligns
  * each axis with z and finds position and radius with a circle Hough transform. The best
  * candidates are then refined on the points themselves (robust least squares on the
  * point-to-surface distances) and compared on the points they explain; when the noise makes
