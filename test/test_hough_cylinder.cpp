@@ -47,6 +47,16 @@ fitOnce(const Cloud::ConstPtr& cloud, const facyl::CylinderGroundTruth& truth, H
   return o;
 }
 
+/** The points of \a cloud as the columns of a matrix. */
+Eigen::Matrix3Xf
+pointsOf(const Cloud& cloud)
+{
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(cloud.size()));
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    pts.col(static_cast<Eigen::Index>(i)) = cloud[i].getVector3fMap();
+  return pts;
+}
+
 /** The robustness setting: random axis, radius 0.02-0.3 m, height 0.05-2 m. */
 facyl::CylinderSimulationParameters
 randomCylinder(int run, float lid_ratio, float noise)
@@ -179,8 +189,9 @@ TEST(HoughCylinderEstimation, HoldsAtHighNoise)
       // The radius from 900 points with sigma = 0.1 r: well within 2% (median).
       EXPECT_LT(quantile(now.radius_rel, 0.5), 0.02f);
     }
-    if (noise == 0.30f) // the radius unbiased: its bias alone is 4.5% of it (unbiasedRadius)
+    if (noise == 0.30f) { // the radius unbiased: its bias alone is 4.5% of it (unbiasedRadius)
       EXPECT_LT(quantile(now.radius_rel, 0.5), 0.02f);
+    }
   }
 }
 
@@ -798,9 +809,7 @@ TEST(CylinderFitting, RefineCylinderConvergesFromAnOffStart)
   p.axis = Eigen::Vector3f(0.3f, -0.2f, 1.f);
   p.base = Eigen::Vector3f(1.f, 1.f, 1.f);
   const auto sim = facyl::simulateCylinder(p);
-  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(sim.cloud.size()));
-  for (std::size_t i = 0; i < sim.cloud.size(); ++i)
-    pts.col(static_cast<Eigen::Index>(i)) = sim.cloud[i].getVector3fMap();
+  const Eigen::Matrix3Xf pts = pointsOf(sim.cloud);
   Eigen::Vector3f point = p.base + Eigen::Vector3f(0.01f, -0.01f, 0.f);
   Eigen::Vector3f axis = (sim.truth.axis + Eigen::Vector3f(0.05f, 0.02f, 0.f)).normalized();
   float radius = 0.09f;
@@ -822,9 +831,7 @@ TEST(CylinderFitting, UnbiasedRadiusRemovesTheBiasOfTangentialNoise)
   p.lateral_points = 20000;
   p.seed = 5;
   const auto sim = facyl::simulateCylinder(p);
-  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(sim.cloud.size()));
-  for (std::size_t i = 0; i < sim.cloud.size(); ++i)
-    pts.col(static_cast<Eigen::Index>(i)) = sim.cloud[i].getVector3fMap();
+  const Eigen::Matrix3Xf pts = pointsOf(sim.cloud);
   facyl::RobustCylinder c;
   c.point_on_axis = sim.truth.base;
   c.axis = sim.truth.axis;

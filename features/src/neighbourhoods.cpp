@@ -164,18 +164,19 @@ public:
   {
     lo_ = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     Eigen::Vector3f hi = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+    std::vector<int> columns; // the finite columns
     for (Eigen::Index i = 0; i < surface.cols(); ++i)
       if (surface.col(i).allFinite()) {
-        columns_.push_back(static_cast<int>(i));
+        columns.push_back(static_cast<int>(i));
         lo_ = lo_.cwiseMin(surface.col(i));
         hi = hi.cwiseMax(surface.col(i));
       }
-    if (columns_.empty())
+    if (columns.empty())
       return;
     // Cells about as wide as a k-neighbourhood of points spread over a surface that fills the
     // box's two largest extents, or over a line along its largest; at most about 4 cells a
     // point. Any width gives the same neighbours; this one keeps the rings few and small.
-    const double m = static_cast<double>(columns_.size());
+    const double m = static_cast<double>(columns.size());
     Eigen::Vector3d extent = (hi - lo_).cast<double>();
     std::sort(extent.data(), extent.data() + 3);
     const double reach =
@@ -189,28 +190,28 @@ public:
       cell_ *= 1.26f;
     }
     const std::size_t cells = static_cast<std::size_t>(size_[0]) * size_[1] * size_[2];
-    std::vector<std::uint32_t> cell_of(columns_.size());
+    std::vector<std::uint32_t> cell_of(columns.size());
     starts_.assign(cells + 1, 0);
-    for (std::size_t j = 0; j < columns_.size(); ++j) {
-      cell_of[j] = static_cast<std::uint32_t>(cellIndex(cellOf(surface.col(columns_[j]))));
+    for (std::size_t j = 0; j < columns.size(); ++j) {
+      cell_of[j] = static_cast<std::uint32_t>(cellIndex(cellOf(surface.col(columns[j]))));
       ++starts_[cell_of[j] + 1];
     }
     for (std::size_t c = 0; c < cells; ++c)
       starts_[c + 1] += starts_[c];
     std::vector<std::uint32_t> next(starts_.begin(), starts_.end() - 1);
-    xyz_.resize(3 * columns_.size());
-    sorted_.resize(columns_.size());
-    for (std::size_t j = 0; j < columns_.size(); ++j) {
+    xyz_.resize(3 * columns.size());
+    sorted_.resize(columns.size());
+    for (std::size_t j = 0; j < columns.size(); ++j) {
       const std::uint32_t at = next[cell_of[j]]++;
-      sorted_[at] = columns_[j];
+      sorted_[at] = columns[j];
       for (int d = 0; d < 3; ++d)
-        xyz_[3 * at + static_cast<std::size_t>(d)] = surface(d, columns_[j]);
+        xyz_[3 * at + static_cast<std::size_t>(d)] = surface(d, columns[j]);
     }
   }
 
   std::size_t points() const
   {
-    return columns_.size();
+    return sorted_.size();
   }
 
   /** The \a kk nearest points of \a q (finite) into \a best, nearest first: rings of cells
@@ -300,8 +301,7 @@ private:
     }
   }
 
-  std::vector<int> columns_;          // finite columns, in column order
-  std::vector<int> sorted_;           // the same, by cell
+  std::vector<int> sorted_;           // the finite columns, by cell
   std::vector<float> xyz_;            // their coordinates, by cell
   std::vector<std::uint32_t> starts_; // first point of each cell, and the end
   Eigen::Vector3f lo_;
