@@ -8,6 +8,7 @@
  * sources), on every 4th mOSD learn frame; counters: the stages in ms per frame.
  */
 #include <facyl/features/normal_curvature_estimation.h>
+#include <facyl/features/point_cues.h>
 #include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
@@ -101,6 +102,22 @@ BENCHMARK_CAPTURE(BM_Fit, soft_curvature, facyl::VotingMode::SoftCurvature)
 BENCHMARK_CAPTURE(BM_Fit, rabbani, facyl::VotingMode::Rabbani)
   ->Args({900, 450})
   ->Unit(benchmark::kMillisecond);
+
+/** The points' own noise (estimateLocalNoise: 128 neighbourhoods of 12 points, found on a
+ * grid), as a fit measures it once its spread looks like noise: |P| / 2 lateral points and as
+ * many lid points. */
+void
+BM_LocalNoise(benchmark::State& state)
+{
+  const Scene s = makeScene(static_cast<std::size_t>(state.range(0)) / 2);
+  Eigen::Matrix3Xf points(3, static_cast<Eigen::Index>(s.cloud->size()));
+  for (std::size_t i = 0; i < s.cloud->size(); ++i)
+    points.col(static_cast<Eigen::Index>(i)) = (*s.cloud)[i].getVector3fMap();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(facyl::estimateLocalNoise(points, 12, 128));
+  state.counters["points"] = static_cast<double>(points.cols());
+}
+BENCHMARK(BM_LocalNoise)->Arg(1800)->Arg(7200)->Unit(benchmark::kMicrosecond);
 
 void
 BM_NormalsAndCurvatures(benchmark::State& state)
