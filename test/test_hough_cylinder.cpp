@@ -939,3 +939,29 @@ TEST(CylinderFitting, VotesPeakAtTheAxis)
   EXPECT_EQ(peaks[1], 1);
   EXPECT_EQ(peaks[2], 2);
 }
+
+TEST(HoughCylinderEstimation, HoldsWithLidsBesideAPlaneAtThreeQuartersOcclusion)
+{
+  // facyl_bench's clutter level in its practical setting: lids at 300% of the side, 75% of the
+  // side occluded, a plane beside. The lids hold twelve times the visible side's points and the
+  // plane four times. A slender cylinder's side is found by its points' direction once the
+  // lids' and the plane's normal directions are both peeled off (addElongationSeeds), and a
+  // loose fit through lids and plane no longer wins by the points its looseness admits
+  // (finalistsOf). These 60 clouds: 9 failures (axis > 10 deg or none); 10 without the second
+  // peel, 11 without the duel of the loose fit, 12 without both. Issue 17 asks for none: not
+  // met.
+  constexpr int kRuns = 60;
+  int failures = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    auto p = randomCylinder(run, 3.f, 0.01f);
+    p.occlusion = 0.75f;
+    const auto sim = facyl::simulateCylinder(p);
+    Hough hough;
+    hough.setRadiusLimits(0.01f, 0.5f);
+    const auto o = fitOnce(withPlaneBeside(sim, p, run), sim.truth, hough);
+    failures += !o.found || o.axis_deg > 10.f;
+  }
+  std::printf("[ figures  ] lids 300%%, plane beside, 75%% occlusion, %d fits: %d failed\n", kRuns,
+              failures);
+  EXPECT_LE(failures, 9);
+}
