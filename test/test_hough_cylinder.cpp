@@ -126,6 +126,26 @@ sweep(VotingMode mode, float lid_ratio, float noise, int runs, bool refine = tru
   return s;
 }
 
+/** Failures (axis off by > 10 deg, or none found) of default fits on \a runs seeded clouds:
+ * lids at \a lid_ratio, 1% noise, 75% of the side occluded, a plane beside. */
+int
+failuresBesideAPlane(float lid_ratio, int runs)
+{
+  int failures = 0;
+  for (int run = 0; run < runs; ++run) {
+    auto p = randomCylinder(run, lid_ratio, 0.01f);
+    p.occlusion = 0.75f;
+    const auto sim = facyl::simulateCylinder(p);
+    Hough hough;
+    hough.setRadiusLimits(0.01f, 0.5f);
+    const auto o = fitOnce(withPlaneBeside(sim, p, run), sim.truth, hough);
+    failures += !o.found || o.axis_deg > 10.f;
+  }
+  std::printf("[ figures  ] lids %.0f%%, plane beside, 75%% occlusion, %d fits: %d failed\n",
+              100.f * lid_ratio, runs, failures);
+  return failures;
+}
+
 } // namespace
 
 TEST(HoughCylinderEstimation, CleanCylinderIsExact)
@@ -223,20 +243,7 @@ TEST(HoughCylinderEstimation, HoldsBesideAPlaneAtThreeQuartersOcclusion)
   // whose normals are off the plane's propose their own direction (offDominantNormal,
   // addElongationSeed). These 60 clouds: no failure (axis > 10 deg or none); 2 without the
   // points' direction, 7 without the meeting either.
-  constexpr int kRuns = 60;
-  int failures = 0;
-  for (int run = 0; run < kRuns; ++run) {
-    auto p = randomCylinder(run, 0.f, 0.01f);
-    p.occlusion = 0.75f;
-    const auto sim = facyl::simulateCylinder(p);
-    Hough hough;
-    hough.setRadiusLimits(0.01f, 0.5f);
-    const auto o = fitOnce(withPlaneBeside(sim, p, run), sim.truth, hough);
-    failures += o.axis_deg > 10.f;
-  }
-  std::printf("[ figures  ] plane beside, 75%% occlusion, %d fits: %d off by > 10 deg\n", kRuns,
-              failures);
-  EXPECT_EQ(failures, 0);
+  EXPECT_EQ(failuresBesideAPlane(0.f, 60), 0);
 }
 
 TEST(HoughCylinderEstimation, FindsANarrowSliverOfATallCylinder)
@@ -950,18 +957,5 @@ TEST(HoughCylinderEstimation, HoldsWithLidsBesideAPlaneAtThreeQuartersOcclusion)
   // (finalistsOf). These 60 clouds: 9 failures (axis > 10 deg or none); 10 without the second
   // peel, 11 without the duel of the loose fit, 12 without both. Issue 17 asks for none: not
   // met.
-  constexpr int kRuns = 60;
-  int failures = 0;
-  for (int run = 0; run < kRuns; ++run) {
-    auto p = randomCylinder(run, 3.f, 0.01f);
-    p.occlusion = 0.75f;
-    const auto sim = facyl::simulateCylinder(p);
-    Hough hough;
-    hough.setRadiusLimits(0.01f, 0.5f);
-    const auto o = fitOnce(withPlaneBeside(sim, p, run), sim.truth, hough);
-    failures += !o.found || o.axis_deg > 10.f;
-  }
-  std::printf("[ figures  ] lids 300%%, plane beside, 75%% occlusion, %d fits: %d failed\n", kRuns,
-              failures);
-  EXPECT_LE(failures, 9);
+  EXPECT_LE(failuresBesideAPlane(3.f, 60), 9);
 }
