@@ -46,14 +46,16 @@ enum class HoughFailure {
  * Step 1 votes for the axis direction on N_d cells drawn from an orientation prior (paper
  * eq. 1-3). The strongest peaks are refined below the cell size (refineAxis); points that
  * reach much further along one direction than across (a tall cylinder seen over a narrow arc;
- * all the points, or those whose normals are off a dominant plane's) also propose that
- * direction. Step 2 aligns
- * each axis with z and finds position and radius with a circle Hough transform. The best
- * candidates are then refined on the points themselves (robust least squares on the
- * point-to-surface distances) and compared on the points they explain; when the noise makes
- * the given normals useless, normals and curvatures are estimated again from neighbours
- * within one radius and propose candidates too (see HoughCylinderParameters::point_candidates). The
- * goodness of fit is the inlier ratio of eq. 4.
+ * all the points, those whose normals are off a dominant plane's, or, when those are not
+ * elongated, those off a second plane's too: lids and a table) also propose that direction.
+ * Step 2 aligns each axis with z and finds position and radius with a circle Hough transform.
+ * Candidates compete on their inliers, each at the threshold its residuals give; a best whose
+ * residuals spread far wider than noise meets a runner-up at the runner-up's tighter
+ * threshold. The best candidates are then refined on the points themselves (robust least squares on
+ * the point-to-surface distances) and compared on the points they explain; when the noise makes the
+ * given normals useless, normals and curvatures are estimated again from neighbours within one
+ * radius and propose candidates too (see HoughCylinderParameters::point_candidates). The goodness
+ * of fit is the inlier ratio of eq. 4.
  *
  * \code
  * facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
