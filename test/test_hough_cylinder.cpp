@@ -910,6 +910,43 @@ TEST(CylinderFitting, NormalRotationSlopeOfTwoLidsAndAnArcIsThePlanes)
   EXPECT_GT(facyl::normalRotationSlope(arc, arc_n, origin, z), 0.9f);
 }
 
+TEST(CylinderFitting, NormalRotationSlopeOfPlanePiecesOverAWideArcIsMeasured)
+{
+  // A cylinder about z (radius 1) fitted across a short upright can seen from its side: a strip
+  // of each lid (the planes y = 1 and y = -1, normals +-y; 300 points each) and a narrower strip
+  // of the can's side (the plane x = 1, normal x; 100 points). Their angles about z spread over
+  // more than a quarter turn, as a real arc's do, but each piece's normal stays put while its
+  // angle turns (up to 46 deg off the radial direction): the slope is measured (0.66 here:
+  // the pieces' offsets bend the line; before, a spread this wide scored 1 unmeasured).
+  const Eigen::Index n = 300, m = 100;
+  Eigen::Matrix3Xf pts(3, 2 * n + m), nrm(3, 2 * n + m);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float t = -0.8f + 1.6f * static_cast<float>(i) / static_cast<float>(n - 1);
+    const float z = 0.01f * static_cast<float>(i % 10);
+    pts.col(i) = Eigen::Vector3f(std::sin(t), 1.f, z);
+    nrm.col(i) = Eigen::Vector3f::UnitY();
+    pts.col(n + i) = Eigen::Vector3f(std::sin(t), -1.f, z);
+    nrm.col(n + i) = -Eigen::Vector3f::UnitY();
+  }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const float t = -0.4f + 0.8f * static_cast<float>(i) / static_cast<float>(m - 1);
+    pts.col(2 * n + i) = Eigen::Vector3f(1.f, std::sin(t), 0.01f * static_cast<float>(i % 10));
+    nrm.col(2 * n + i) = Eigen::Vector3f::UnitX();
+  }
+  const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
+  EXPECT_LT(facyl::normalRotationSlope(pts, nrm, origin, z), 0.8f);
+  // A true half turn whose normals are 10 deg off their radial directions (alternating) still
+  // counts as a cylinder without measuring its turn.
+  Eigen::Matrix3Xf arc(3, n), arc_n(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float t = -1.5f + 3.f * static_cast<float>(i) / static_cast<float>(n - 1);
+    const float off = (i % 2 == 0 ? 1.f : -1.f) * 10.f * static_cast<float>(M_PI) / 180.f;
+    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.01f * static_cast<float>(i % 10));
+    arc_n.col(i) = Eigen::Vector3f(std::cos(t + off), std::sin(t + off), 0.f);
+  }
+  EXPECT_EQ(facyl::normalRotationSlope(arc, arc_n, origin, z), 1.f);
+}
+
 TEST(CylinderFitting, VotesPeakAtTheAxis)
 {
   // Normals and c_max of an ideal cylinder about z: every mode peaks at z.

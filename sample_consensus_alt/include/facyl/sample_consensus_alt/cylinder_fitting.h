@@ -176,7 +176,8 @@ float normalDeviation(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& no
  * between them is still a plane. Returns the slope's lower 2-sigma bound clamped to [0, 1],
  * so an arc too narrow for the normals' noise to show the turn scores 0; 1 when the inliers
  * spread over more than a quarter turn (modulo pi, about each side's mean; no plane strip
- * does) or are fewer than 3.
+ * does) with normals within 20 deg (rms) of their radial directions (pieces of several planes
+ * spread as wide, with normals far off: their turn is measured), or are fewer than 3.
  * \param normals unit normals of \a points (sign not needed)
  */
 float normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
