@@ -146,6 +146,32 @@ failuresBesideAPlane(float lid_ratio, int runs)
   return failures;
 }
 
+/** A point and its normal. */
+struct Sample {
+  Eigen::Vector3f point, normal;
+};
+
+/** Columns [first, first + n) of \a pts and \a nrm from \a at(t, i), t evenly over [t0, t1]. */
+template <typename At>
+void
+sampleAlong(Eigen::Matrix3Xf& pts, Eigen::Matrix3Xf& nrm, Eigen::Index first, Eigen::Index n,
+            float t0, float t1, At at)
+{
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float t = t0 + (t1 - t0) * static_cast<float>(i) / static_cast<float>(n - 1);
+    const Sample s = at(t, i);
+    pts.col(first + i) = s.point;
+    nrm.col(first + i) = s.normal;
+  }
+}
+
+/** The height of the \a i-th sample of a strip laid in ten rows 1 cm apart. */
+float
+rowHeight(Eigen::Index i)
+{
+  return 0.01f * static_cast<float>(i % 10);
+}
+
 } // namespace
 
 TEST(HoughCylinderEstimation, CleanCylinderIsExact)
@@ -860,14 +886,12 @@ TEST(CylinderFitting, NormalRotationSlopeTellsCylindersFromPlanes)
 {
   // A 40-degree arc of a cylinder of radius 1 about z, and a flat strip of the same width.
   Eigen::Matrix3Xf arc(3, 200), arc_n(3, 200), strip(3, 200), strip_n(3, 200);
-  for (Eigen::Index i = 0; i < 200; ++i) {
-    const float t = -0.35f + 0.7f * static_cast<float>(i) / 199.f;
-    const float z = 0.01f * static_cast<float>(i % 10);
-    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), z);
-    arc_n.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.f);
-    strip.col(i) = Eigen::Vector3f(1.f, std::sin(t), z);
-    strip_n.col(i) = Eigen::Vector3f::UnitX();
-  }
+  sampleAlong(arc, arc_n, 0, 200, -0.35f, 0.35f, [](float t, Eigen::Index i) {
+    return Sample{{std::cos(t), std::sin(t), rowHeight(i)}, {std::cos(t), std::sin(t), 0.f}};
+  });
+  sampleAlong(strip, strip_n, 0, 200, -0.35f, 0.35f, [](float t, Eigen::Index i) {
+    return Sample{{1.f, std::sin(t), rowHeight(i)}, Eigen::Vector3f::UnitX()};
+  });
   const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
   EXPECT_NEAR(facyl::normalRotationSlope(arc, arc_n, origin, z), 1.f, 1e-3f);
   EXPECT_LT(facyl::normalRotationSlope(strip, strip_n, origin, z), 0.05f);
@@ -881,30 +905,24 @@ TEST(CylinderFitting, NormalRotationSlopeOfTwoLidsAndAnArcIsThePlanes)
   // about one mean, the offset between the strips and the arc's leverage made this 0.5.
   const Eigen::Index n_strip = 400, n_arc = 40;
   Eigen::Matrix3Xf pts(3, 2 * n_strip + n_arc), nrm(3, 2 * n_strip + n_arc);
-  for (Eigen::Index i = 0; i < n_strip; ++i) {
-    const float t = -0.45f + 0.9f * static_cast<float>(i) / static_cast<float>(n_strip - 1);
-    const float z = 0.01f * static_cast<float>(i % 10);
-    pts.col(i) = Eigen::Vector3f(1.f, std::sin(t) + 0.15f, z);
-    nrm.col(i) = Eigen::Vector3f::UnitX();
-    pts.col(n_strip + i) = Eigen::Vector3f(-1.f, std::sin(t) - 0.1f, z);
-    nrm.col(n_strip + i) = -Eigen::Vector3f::UnitX();
-  }
-  for (Eigen::Index i = 0; i < n_arc; ++i) {
-    // The arc of a small cylinder about (0, 1.2), its normals radial to that axis.
-    const float t = -1.2f + 2.4f * static_cast<float>(i) / static_cast<float>(n_arc - 1);
+  sampleAlong(pts, nrm, 0, n_strip, -0.45f, 0.45f, [](float t, Eigen::Index i) {
+    return Sample{{1.f, std::sin(t) + 0.15f, rowHeight(i)}, Eigen::Vector3f::UnitX()};
+  });
+  sampleAlong(pts, nrm, n_strip, n_strip, -0.45f, 0.45f, [](float t, Eigen::Index i) {
+    return Sample{{-1.f, std::sin(t) - 0.1f, rowHeight(i)}, -Eigen::Vector3f::UnitX()};
+  });
+  // The arc of a small cylinder about (0, 1.2), its normals radial to that axis.
+  sampleAlong(pts, nrm, 2 * n_strip, n_arc, -1.2f, 1.2f, [](float t, Eigen::Index) {
     const Eigen::Vector3f radial(std::sin(t), -std::cos(t), 0.f);
-    pts.col(2 * n_strip + i) = Eigen::Vector3f(0.f, 1.2f, 0.05f) + 0.3f * radial;
-    nrm.col(2 * n_strip + i) = radial;
-  }
+    return Sample{Eigen::Vector3f(0.f, 1.2f, 0.05f) + 0.3f * radial, radial};
+  });
   const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
   EXPECT_LT(facyl::normalRotationSlope(pts, nrm, origin, z), 0.05f);
   // A true 80-degree arc with a few plane points (a lid's rim) still turns.
   Eigen::Matrix3Xf arc(3, n_strip + n_arc), arc_n(3, n_strip + n_arc);
-  for (Eigen::Index i = 0; i < n_strip; ++i) {
-    const float t = -0.7f + 1.4f * static_cast<float>(i) / static_cast<float>(n_strip - 1);
-    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.01f * static_cast<float>(i % 10));
-    arc_n.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.f);
-  }
+  sampleAlong(arc, arc_n, 0, n_strip, -0.7f, 0.7f, [](float t, Eigen::Index i) {
+    return Sample{{std::cos(t), std::sin(t), rowHeight(i)}, {std::cos(t), std::sin(t), 0.f}};
+  });
   arc.rightCols(n_arc) = pts.leftCols(n_arc);
   arc_n.rightCols(n_arc) = nrm.leftCols(n_arc);
   EXPECT_GT(facyl::normalRotationSlope(arc, arc_n, origin, z), 0.9f);
@@ -920,30 +938,25 @@ TEST(CylinderFitting, NormalRotationSlopeOfPlanePiecesOverAWideArcIsMeasured)
   // the pieces' offsets bend the line; before, a spread this wide scored 1 unmeasured).
   const Eigen::Index n = 300, m = 100;
   Eigen::Matrix3Xf pts(3, 2 * n + m), nrm(3, 2 * n + m);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const float t = -0.8f + 1.6f * static_cast<float>(i) / static_cast<float>(n - 1);
-    const float z = 0.01f * static_cast<float>(i % 10);
-    pts.col(i) = Eigen::Vector3f(std::sin(t), 1.f, z);
-    nrm.col(i) = Eigen::Vector3f::UnitY();
-    pts.col(n + i) = Eigen::Vector3f(std::sin(t), -1.f, z);
-    nrm.col(n + i) = -Eigen::Vector3f::UnitY();
-  }
-  for (Eigen::Index i = 0; i < m; ++i) {
-    const float t = -0.4f + 0.8f * static_cast<float>(i) / static_cast<float>(m - 1);
-    pts.col(2 * n + i) = Eigen::Vector3f(1.f, std::sin(t), 0.01f * static_cast<float>(i % 10));
-    nrm.col(2 * n + i) = Eigen::Vector3f::UnitX();
-  }
+  sampleAlong(pts, nrm, 0, n, -0.8f, 0.8f, [](float t, Eigen::Index i) {
+    return Sample{{std::sin(t), 1.f, rowHeight(i)}, Eigen::Vector3f::UnitY()};
+  });
+  sampleAlong(pts, nrm, n, n, -0.8f, 0.8f, [](float t, Eigen::Index i) {
+    return Sample{{std::sin(t), -1.f, rowHeight(i)}, -Eigen::Vector3f::UnitY()};
+  });
+  sampleAlong(pts, nrm, 2 * n, m, -0.4f, 0.4f, [](float t, Eigen::Index i) {
+    return Sample{{1.f, std::sin(t), rowHeight(i)}, Eigen::Vector3f::UnitX()};
+  });
   const Eigen::Vector3f origin = Eigen::Vector3f::Zero(), z = Eigen::Vector3f::UnitZ();
   EXPECT_LT(facyl::normalRotationSlope(pts, nrm, origin, z), 0.8f);
   // A true half turn whose normals are 10 deg off their radial directions (alternating) still
   // counts as a cylinder without measuring its turn.
   Eigen::Matrix3Xf arc(3, n), arc_n(3, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const float t = -1.5f + 3.f * static_cast<float>(i) / static_cast<float>(n - 1);
+  sampleAlong(arc, arc_n, 0, n, -1.5f, 1.5f, [](float t, Eigen::Index i) {
     const float off = (i % 2 == 0 ? 1.f : -1.f) * 10.f * static_cast<float>(M_PI) / 180.f;
-    arc.col(i) = Eigen::Vector3f(std::cos(t), std::sin(t), 0.01f * static_cast<float>(i % 10));
-    arc_n.col(i) = Eigen::Vector3f(std::cos(t + off), std::sin(t + off), 0.f);
-  }
+    return Sample{{std::cos(t), std::sin(t), rowHeight(i)},
+                  {std::cos(t + off), std::sin(t + off), 0.f}};
+  });
   EXPECT_EQ(facyl::normalRotationSlope(arc, arc_n, origin, z), 1.f);
 }
 
