@@ -10,19 +10,44 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
 
 namespace facyl {
 
+std::vector<int>
+sharedNeighbourhoods(const Eigen::Matrix3Xf& points, const std::vector<int>& centres,
+                     const Neighbourhoods& nb)
+{
+  const std::size_t n = static_cast<std::size_t>(points.cols());
+  std::vector<int> owner(n, -1);
+  std::vector<float> nearest(n, std::numeric_limits<float>::infinity());
+  for (std::size_t c = 0; c < centres.size() && c < nb.size(); ++c) {
+    const Eigen::Vector3f centre = points.col(centres[c]);
+    const int* list = nb.begin(c);
+    for (std::size_t j = 0; j < nb.count(c); ++j) {
+      const std::size_t col = static_cast<std::size_t>(list[j]);
+      const float d = (points.col(list[j]) - centre).squaredNorm();
+      if (d < nearest[col]) {
+        nearest[col] = d;
+        owner[col] = static_cast<int>(c);
+      }
+    }
+  }
+  return owner;
+}
+
 PointCues
 estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbours,
-                  const Eigen::Matrix3Xf& reference)
+                  const Eigen::Matrix3Xf& reference, int stride)
 {
   if (!(radius > 0.f) || !std::isfinite(radius))
     throw std::invalid_argument("estimatePointCues: the radius must be positive and finite");
   if (max_neighbours < 3)
     throw std::invalid_argument("estimatePointCues: a normal needs at least 3 neighbours");
+  if (stride < 1)
+    throw std::invalid_argument("estimatePointCues: the stride must be at least 1");
   const Eigen::Index n = points.cols();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   PointCues out;
@@ -31,34 +56,63 @@ estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbou
   out.weights.setZero(n);
   if (n == 0)
     return out;
+  // The centres: the columns whose neighbourhoods are searched.
+  std::vector<int> centres;
+  for (Eigen::Index i = 0; i < n; i += stride)
+    centres.push_back(static_cast<int>(i));
   // The k nearest within the radius: the cost stays that of k neighbours where the points
   // are dense, and that of the few within the radius where they are sparse.
   const NeighbourSearch search(points);
-  const Neighbourhoods nb = search.nearestWithin(points, max_neighbours, radius, 1);
-  const auto count = [&](Eigen::Index i) { return nb.count(static_cast<std::size_t>(i)); };
-  const bool oriented = reference.cols() == n;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const int* list = nb.begin(static_cast<std::size_t>(i));
+  const Neighbourhoods nb =
+    search.nearestWithin(stride == 1 ? points : Eigen::Matrix3Xf(points(Eigen::all, centres)),
+                         max_neighbours, radius, 1);
+  std::vector<int> owner;
+  if (stride == 1) {
+    owner.resize(static_cast<std::size_t>(n));
+    std::iota(owner.begin(), owner.end(), 0);
+  }
+  else
+    owner = sharedNeighbourhoods(points, centres, nb);
+  // A normal per centre, shared with the columns it holds (each with its own sign).
+  std::vector<Eigen::Vector3f> centre_normals(centres.size(), Eigen::Vector3f::Constant(nan));
+  for (std::size_t c = 0; c < centres.size(); ++c) {
+    const int* list = nb.begin(c);
     Eigen::Vector3f normal;
     float variation = 0.f;
-    if (count(i) < 3 ||
-        !estimateNormal(
-          count(i), [&](std::size_t j) { return Eigen::Vector3f(points.col(list[j])); }, normal,
+    if (nb.count(c) >= 3 &&
+        estimateNormal(
+          nb.count(c), [&](std::size_t j) { return Eigen::Vector3f(points.col(list[j])); }, normal,
           variation))
+      centre_normals[c] = normal;
+  }
+  const bool oriented = reference.cols() == n;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int c = owner[static_cast<std::size_t>(i)];
+    if (c < 0 || !centre_normals[static_cast<std::size_t>(c)].allFinite())
       continue;
+    Eigen::Vector3f normal = centre_normals[static_cast<std::size_t>(c)];
     if (oriented && normal.dot(reference.col(i)) < 0.f)
       normal = -normal;
     out.normals.col(i) = normal;
   }
-  for (Eigen::Index i = 0; i < n; ++i) {
+  // Principal curvatures at the centres, from their neighbours' normals, shared likewise.
+  std::vector<PrincipalCurvatures> centre_curvatures(centres.size());
+  std::vector<char> curved(centres.size(), 0);
+  for (std::size_t c = 0; c < centres.size(); ++c) {
+    const Eigen::Index i = centres[c];
     if (!out.normals.col(i).allFinite())
       continue;
-    const int* list = nb.begin(static_cast<std::size_t>(i));
-    PrincipalCurvatures pc;
-    if (!principalCurvaturesFromNormals(
-          out.normals.col(i), count(i),
-          [&](std::size_t j) { return Eigen::Vector3f(out.normals.col(list[j])); }, pc))
+    const int* list = nb.begin(c);
+    curved[c] = principalCurvaturesFromNormals(
+      out.normals.col(i), nb.count(c),
+      [&](std::size_t j) { return Eigen::Vector3f(out.normals.col(list[j])); },
+      centre_curvatures[c]);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int c = owner[static_cast<std::size_t>(i)];
+    if (c < 0 || !curved[static_cast<std::size_t>(c)])
       continue;
+    const PrincipalCurvatures& pc = centre_curvatures[static_cast<std::size_t>(c)];
     out.curvature_directions.col(i) = pc.direction;
     out.weights(i) = curvatureAnisotropy(pc.k_max, pc.k_min);
   }
