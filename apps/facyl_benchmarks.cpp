@@ -45,16 +45,17 @@ struct Scene {
   Cues::Ptr cues{new Cues};
 };
 
-/** |P| lateral points plus as many lid points (100% outliers, eq. 5), 1% noise, r = 0.3 m. */
+/** |P| lateral points plus \a lid_ratio times as many lid points (outliers, eq. 5), noise
+ * \a noise of the radius, r = 0.3 m. */
 Scene
-makeScene(std::size_t lateral, int k = 16)
+makeScene(std::size_t lateral, int k = 16, float noise = 0.01f, float lid_ratio = 1.f)
 {
   facyl::CylinderSimulationParameters p;
   p.radius = 0.3f;
   p.height = 1.f;
   p.lateral_points = lateral;
-  p.lid_ratio = 1.f;
-  p.noise = 0.01f;
+  p.lid_ratio = lid_ratio;
+  p.noise = noise;
   p.axis = Eigen::Vector3f(0.3f, 0.2f, 1.f);
   p.seed = 1;
   const auto sim = facyl::simulateCylinder(p);
@@ -102,6 +103,26 @@ BENCHMARK_CAPTURE(BM_Fit, soft_curvature, facyl::VotingMode::SoftCurvature)
 BENCHMARK_CAPTURE(BM_Fit, rabbani, facyl::VotingMode::Rabbani)
   ->Args({900, 450})
   ->Unit(benchmark::kMillisecond);
+
+/** Default settings on 900 points of a cylinder without lids at the noise of issue 17's levels
+ * (percent of the radius): the cues are then noise, and the fit settles on the points and
+ * votes again with coarse cues (see docs/benchmark.md, "Fit time at high noise"). */
+void
+BM_FitAtNoise(benchmark::State& state)
+{
+  const Scene s = makeScene(900, 16, 0.01f * static_cast<float>(state.range(0)), 0.f);
+  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
+  hough.setInputCloud(s.cloud);
+  hough.setInputNormals(s.cues);
+  std::vector<facyl::CylinderModel> models;
+  hough.segment(models); // draws the accumulator once
+  for (auto _ : state) {
+    hough.segment(models);
+    benchmark::DoNotOptimize(models);
+  }
+  state.counters["points"] = static_cast<double>(s.cloud->size());
+}
+BENCHMARK(BM_FitAtNoise)->Arg(1)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMillisecond);
 
 /** The points' own noise (estimateLocalNoise: 128 neighbourhoods of 12 points, found on a
  * grid), as a fit measures it once its spread looks like noise: |P| / 2 lateral points and as
