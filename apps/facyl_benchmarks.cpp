@@ -69,13 +69,12 @@ makeScene(std::size_t lateral, int k = 16, float noise = 0.01f, float lid_ratio 
   return s;
 }
 
+using Hough = facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature>;
+
+/** Times \a hough's segment() on \a s, the accumulator drawn once before. */
 void
-BM_Fit(benchmark::State& state, facyl::VotingMode mode)
+timeFits(benchmark::State& state, const Scene& s, Hough& hough)
 {
-  const Scene s = makeScene(static_cast<std::size_t>(state.range(0)));
-  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
-  hough.setVotingMode(mode);
-  hough.setNumberOfOrientations(static_cast<std::size_t>(state.range(1)));
   hough.setInputCloud(s.cloud);
   hough.setInputNormals(s.cues);
   std::vector<facyl::CylinderModel> models;
@@ -85,6 +84,15 @@ BM_Fit(benchmark::State& state, facyl::VotingMode mode)
     benchmark::DoNotOptimize(models);
   }
   state.counters["points"] = static_cast<double>(s.cloud->size());
+}
+
+void
+BM_Fit(benchmark::State& state, facyl::VotingMode mode)
+{
+  Hough hough;
+  hough.setVotingMode(mode);
+  hough.setNumberOfOrientations(static_cast<std::size_t>(state.range(1)));
+  timeFits(state, makeScene(static_cast<std::size_t>(state.range(0))), hough);
   state.counters["N_d"] = static_cast<double>(state.range(1));
 }
 // Default settings on 900 + 900 points, then growth with points and with N_d.
@@ -110,17 +118,8 @@ BENCHMARK_CAPTURE(BM_Fit, rabbani, facyl::VotingMode::Rabbani)
 void
 BM_FitAtNoise(benchmark::State& state)
 {
-  const Scene s = makeScene(900, 16, 0.01f * static_cast<float>(state.range(0)), 0.f);
-  facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
-  hough.setInputCloud(s.cloud);
-  hough.setInputNormals(s.cues);
-  std::vector<facyl::CylinderModel> models;
-  hough.segment(models); // draws the accumulator once
-  for (auto _ : state) {
-    hough.segment(models);
-    benchmark::DoNotOptimize(models);
-  }
-  state.counters["points"] = static_cast<double>(s.cloud->size());
+  Hough hough;
+  timeFits(state, makeScene(900, 16, 0.01f * static_cast<float>(state.range(0)), 0.f), hough);
 }
 BENCHMARK(BM_FitAtNoise)->Arg(1)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMillisecond);
 
