@@ -113,8 +113,9 @@ BENCHMARK_CAPTURE(BM_Fit, rabbani, facyl::VotingMode::Rabbani)
   ->Unit(benchmark::kMillisecond);
 
 /** Default settings on 900 points of a cylinder without lids at the noise of issue 17's levels
- * (percent of the radius): the cues are then noise, and the fit settles on the points and
- * votes again with coarse cues (see docs/benchmark.md, "Fit time at high noise"). */
+ * (percent of the radius): the cues are then noise, and the fit settles its candidates on the
+ * points (nothing lies beside this cylinder, so no coarse cues; see docs/benchmark.md, "Fit time
+ * at high noise"). */
 void
 BM_FitAtNoise(benchmark::State& state)
 {
