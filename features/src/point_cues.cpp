@@ -63,9 +63,10 @@ estimatePointCues(const Eigen::Matrix3Xf& points, float radius, int max_neighbou
   // The k nearest within the radius: the cost stays that of k neighbours where the points
   // are dense, and that of the few within the radius where they are sparse.
   const NeighbourSearch search(points);
+  const Eigen::Matrix3Xf centre_points =
+    stride == 1 ? Eigen::Matrix3Xf() : Eigen::Matrix3Xf(points(Eigen::all, centres));
   const Neighbourhoods nb =
-    search.nearestWithin(stride == 1 ? points : Eigen::Matrix3Xf(points(Eigen::all, centres)),
-                         max_neighbours, radius, 1);
+    search.nearestWithin(stride == 1 ? points : centre_points, max_neighbours, radius, 1);
   std::vector<int> owner;
   if (stride == 1) {
     owner.resize(static_cast<std::size_t>(n));

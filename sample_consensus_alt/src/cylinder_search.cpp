@@ -1084,10 +1084,9 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   const auto settled = settleOnPoints(cues, active, finalists, params);
   if (!settled) // no refinement on the points held
     return describe(cues, active, refined, params);
-  if (!(params.coarse_scale > 0.f) || !cuesAreNoise(*settled, local, params))
-    return describeSettled(cues, active, *settled, params);
   CylinderModel answer = describeSettled(cues, active, *settled, params);
-  if (explainsTheCloud(answer, active.size()))
+  if (!(params.coarse_scale > 0.f) || !cuesAreNoise(*settled, local, params) ||
+      explainsTheCloud(answer, active.size()))
     return answer;
   // The cues are more noise than cue, and structure beside the winner remains: cues at the
   // coarse scale propose candidates too, and the coarse cues judge them against the winner.
