@@ -882,6 +882,37 @@ TEST(CylinderFitting, UnbiasedRadiusRemovesTheBiasOfTangentialNoise)
                std::invalid_argument);
 }
 
+TEST(CylinderFitting, EndCapPointsAreTheLidsNearTheEnds)
+{
+  // A cylinder of radius 0.05 m and height 0.2 m about z with both lids; its model as its
+  // inliers would describe it, stopping 1 cm short of either lid (the rims' bent normals).
+  facyl::CylinderSimulationParameters p;
+  p.lid_ratio = 1.f;
+  const auto sim = facyl::simulateCylinder(p);
+  Eigen::Matrix3Xf pts = pointsOf(sim.cloud), nrm(3, pts.cols());
+  for (std::size_t i = 0; i < sim.cloud.size(); ++i)
+    nrm.col(static_cast<Eigen::Index>(i)) = sim.cloud[i].getNormalVector3fMap();
+  CylinderModel m;
+  m.axis = Eigen::Vector3f::UnitZ();
+  m.radius = p.radius;
+  m.distance_threshold = 0.002f;
+  m.base = p.base + 0.01f * m.axis;
+  m.height = p.height - 0.02f;
+  const auto caps = facyl::endCapPoints(pts, nrm, m, 0.6f);
+  std::size_t lids = 0;
+  for (const auto i : caps)
+    lids += sim.is_lid[static_cast<std::size_t>(i)];
+  EXPECT_EQ(lids, sim.truth.lid_points);
+  EXPECT_EQ(caps.size(), sim.truth.lid_points); // no side point: their normals are radial
+  // A plane one and a half radii beyond the top, or one with a normal across the axis, is no
+  // cap; nor is a lid point outside the radius.
+  Eigen::Matrix3Xf far(3, 3), far_n(3, 3);
+  far << 0.f, 0.f, 0.07f, 0.f, 0.f, 0.f, 1.075f, 1.f, 1.f;
+  far_n << 0.f, 1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f;
+  EXPECT_TRUE(facyl::endCapPoints(far, far_n, m, 0.6f).empty());
+  EXPECT_TRUE(facyl::endCapPoints(pts, Eigen::Matrix3Xf(), m, 0.6f).empty()); // sizes differ
+}
+
 TEST(CylinderFitting, NormalRotationSlopeTellsCylindersFromPlanes)
 {
   // A 40-degree arc of a cylinder of radius 1 about z, and a flat strip of the same width.
@@ -997,6 +1028,33 @@ TEST(CylinderFitting, VotesPeakAtTheAxis)
   EXPECT_EQ(peaks[2], 2);
 }
 
+TEST(HoughCylinderEstimation, ACylinderSeenMostlyByItsLidsCounts)
+{
+  // A can (r 3 cm, 30 cm tall) with lids at 300% of its side, 80% of the side occluded and a
+  // plane beside: its visible side holds 180 of the 3,780 points, under the 5% a cylinder
+  // needs (189). Its lids count too: it is found, on the right axis.
+  facyl::CylinderSimulationParameters p;
+  p.radius = 0.03f;
+  p.height = 0.3f;
+  p.axis = Eigen::Vector3f(0.3f, -0.2f, 1.f).normalized();
+  p.lid_ratio = 3.f;
+  p.occlusion = 0.8f;
+  p.noise = 0.01f;
+  p.seed = 5;
+  const auto sim = facyl::simulateCylinder(p);
+  const auto cloud = withPlaneBeside(sim, p, 5);
+  ASSERT_LT(20 * sim.truth.lateral_points, cloud->size());
+  Hough hough;
+  const auto o = fitOnce(cloud, sim.truth, hough);
+  ASSERT_TRUE(o.found) << hough.getFailureMessage();
+  EXPECT_LT(o.axis_deg, 1.f);
+  EXPECT_LT(o.radius_rel, 0.05f);
+  EXPECT_LE(o.model.inliers.size(), sim.truth.lateral_points);
+  // The caps are the lids, not the plane: more points than side and lids hold is too many.
+  hough.setMinInliers(sim.truth.lateral_points + sim.truth.lid_points + 1);
+  EXPECT_FALSE(fitOnce(cloud, sim.truth, hough).found);
+}
+
 TEST(HoughCylinderEstimation, HoldsWithLidsBesideAPlaneAtThreeQuartersOcclusion)
 {
   // facyl_bench's clutter level in its practical setting: lids at 300% of the side, 75% of the
@@ -1004,8 +1062,9 @@ TEST(HoughCylinderEstimation, HoldsWithLidsBesideAPlaneAtThreeQuartersOcclusion)
   // plane four times. A slender cylinder's side is found by its points' direction once the
   // lids' and the plane's normal directions are both peeled off (addElongationSeeds), and a
   // loose fit through lids and plane no longer wins by the points its looseness admits
-  // (finalistsOf). These 60 clouds: 9 failures (axis > 10 deg or none); 10 without the second
-  // peel, 11 without the duel of the loose fit, 12 without both. Issue 17 asks for none: not
-  // met.
-  EXPECT_LE(failuresBesideAPlane(3.f, 60), 9);
+  // (finalistsOf). A side too small for a cylinder on its own counts its lids too
+  // (endCapPoints). These 60 clouds: 7 failures (axis > 10 deg or none); 9 with the side alone
+  // counted, and with that, 10 without the second peel, 11 without the duel of the loose fit,
+  // 12 without both. Issue 17 asks for none: not met.
+  EXPECT_LE(failuresBesideAPlane(3.f, 60), 7);
 }

@@ -73,4 +73,44 @@ describeInliers(const Eigen::Matrix3Xf& points, CylinderModel& m)
   m.angular_coverage = static_cast<float>(std::count(sectors.begin(), sectors.end(), 1)) / 36.f;
 }
 
+std::vector<Eigen::Index>
+endCapPoints(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+             const CylinderModel& model, float normal_angle)
+{
+  std::vector<Eigen::Index> caps;
+  if (normals.cols() != points.cols() || !(model.radius > 0.f) || !model.axis.allFinite())
+    return caps;
+  const Eigen::Vector3f axis = model.axis.normalized();
+  const float reach = model.radius + model.distance_threshold;
+  const float cos_normal = std::cos(normal_angle);
+  // Per end: the points of its disc, and how many lie on the ring around it out to
+  // kRingReach times the reach (the same plane going on past the rim).
+  constexpr float kRingReach = 1.5f;
+  std::vector<Eigen::Index> disc[2];
+  std::size_t ring[2] = {0, 0};
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - model.base;
+    const float t = w.dot(axis);
+    const int end = t > -model.radius && t < model.distance_threshold ? 0
+                    : t > model.height - model.distance_threshold && t < model.height + model.radius
+                      ? 1
+                      : -1;
+    if (end < 0 || !(std::abs(normals.col(i).dot(axis)) > cos_normal))
+      continue;
+    const float rho = (w - t * axis).norm();
+    if (rho < reach)
+      disc[end].push_back(i);
+    else if (rho < kRingReach * reach)
+      ++ring[end];
+  }
+  // A lid ends at the rim; a plane there goes on: an end whose ring is at least half as dense
+  // as its disc is no lid.
+  const float ring_area = kRingReach * kRingReach - 1.f; // in units of the disc's
+  for (int end = 0; end < 2; ++end)
+    if (static_cast<float>(ring[end]) < 0.5f * ring_area * static_cast<float>(disc[end].size()))
+      caps.insert(caps.end(), disc[end].begin(), disc[end].end());
+  std::sort(caps.begin(), caps.end());
+  return caps;
+}
+
 } // namespace facyl

@@ -55,6 +55,13 @@ validate(const HoughCylinderParameters& p)
   return why.str();
 }
 
+std::size_t
+minimumInliers(const HoughCylinderParameters& params, std::size_t n)
+{
+  return params.min_inliers > 0 ? params.min_inliers
+                                : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+}
+
 namespace {
 
 /** Cues of the listed columns, as voting arrays. */
@@ -1102,6 +1109,31 @@ fitOne(const CylinderCues& cues, const std::vector<int>& active,
   return describeSettled(coarse, active, judged ? *judged : *settled, params);
 }
 
+/** Whether \a model has the \a min_inliers points a cylinder needs among the \a active ones:
+ * its inliers and the points of its end caps (endCapPoints; counted only when the inliers
+ * alone fall short), with at least 10 inliers (or min_inliers, if smaller) of its own. */
+bool
+enoughPoints(const CylinderCues& cues, const std::vector<int>& active, const CylinderModel& model,
+             std::size_t min_inliers, const HoughCylinderParameters& params)
+{
+  const std::size_t inliers = model.inliers.size();
+  if (inliers >= min_inliers)
+    return true;
+  if (inliers < std::min<std::size_t>(10, min_inliers))
+    return false;
+  // The caps among the active points that are not inliers.
+  std::vector<char> inlier(static_cast<std::size_t>(cues.points.cols()), 0);
+  for (const auto s : model.inliers)
+    inlier[static_cast<std::size_t>(s)] = 1;
+  std::vector<int> others;
+  for (const int s : active)
+    if (!inlier[static_cast<std::size_t>(s)])
+      others.push_back(s);
+  const auto caps = endCapPoints(cues.points(Eigen::all, others), cues.normals(Eigen::all, others),
+                                 model, params.normal_angle_threshold);
+  return inliers + caps.size() >= min_inliers;
+}
+
 } // namespace
 
 std::vector<CylinderModel>
@@ -1117,9 +1149,7 @@ fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>
   HoughCylinderParameters p = params;
   if (params.voting_mode == VotingMode::SoftCurvature && !curvature)
     p.voting_mode = VotingMode::SoftNormal; // the caller checks; this is a last guard
-  const std::size_t min_inliers = p.min_inliers > 0
-                                    ? p.min_inliers
-                                    : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+  const std::size_t min_inliers = minimumInliers(p, static_cast<std::size_t>(n));
   const double total_weight = curvature ? cues.weights.cast<double>().sum() : double(n);
 
   std::vector<char> alive(static_cast<std::size_t>(n), 1);
@@ -1131,7 +1161,7 @@ fitCylinders(const CylinderCues& cues, const std::vector<OrientationAccumulator>
     if (active.size() < min_inliers)
       break;
     auto model = fitOne(cues, active, accumulators, p);
-    if (!model || model->inliers.size() < min_inliers)
+    if (!model || !enoughPoints(cues, active, *model, min_inliers, p))
       break;
     double w = 0.0;
     for (const auto s : model->inliers)

@@ -188,6 +188,20 @@ float normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf
  * angular_coverage. Axis, a point on it and radius must be set; the axis is folded. */
 void describeInliers(const Eigen::Matrix3Xf& inlier_points, CylinderModel& model);
 
+/** \brief The points of \a model's end caps (its lids) among \a points (3 x N, unit
+ * \a normals): within the radius plus the distance threshold of the axis, with a normal within
+ * \a normal_angle (rad) of the axis, and along the axis from one radius outside either end to
+ * the distance threshold inside it. Beyond the ends because the inliers stop short of a lid's
+ * rim, where the normals of neighbourhoods across the rim bend (by less than a radius on a
+ * cylinder sampled densely enough for its curvature to show). A lid ends at the rim: an end
+ * whose ring out to 1.5 times that reach holds such points at least half as densely as the
+ * disc is a plane going on (a table under a fit), and has no cap points. \a model as
+ * describeInliers completes it (base, axis from base to top, height). \return column indices,
+ * ascending. */
+std::vector<Eigen::Index> endCapPoints(const Eigen::Matrix3Xf& points,
+                                       const Eigen::Matrix3Xf& normals, const CylinderModel& model,
+                                       float normal_angle);
+
 /** \brief Allowed range of HoughCylinderParameters::orientations (N_d); validate() checks it. */
 constexpr std::size_t kMinOrientations = 10;
 constexpr std::size_t kMaxOrientations = 100000;
@@ -234,8 +248,11 @@ struct HoughCylinderParameters {
    * of r, six seeds: 28 and 73 of 360 failures at 0.5, 17 and 52 at 1; random setting and
    * lids unchanged within a cloud or two). 0: cues are never estimated again. */
   float coarse_scale{1.f};
-  std::size_t max_cylinders{1};       ///< >= 1
-  std::size_t min_inliers{0};         ///< 0: max(10, 5% of the points)
+  std::size_t max_cylinders{1}; ///< >= 1
+  /** A cylinder needs this many points: its inliers and the points of its end caps
+   * (endCapPoints), so that a can seen mostly by its lids still counts; its inliers alone must
+   * reach 10 (or min_inliers, if smaller). 0: max(10, 5% of the points) (minimumInliers). */
+  std::size_t min_inliers{0};
   std::size_t max_voting_points{500}; ///< voters are subsampled above this; 0: all
   int circle_grid{48};                ///< CHT accumulator size per side, >= 8
   /** Inliers' normals must point away from the axis, as normals oriented towards a sensor
@@ -246,6 +263,10 @@ struct HoughCylinderParameters {
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
 std::string validate(const HoughCylinderParameters& params);
+
+/** \brief The points a cylinder needs among \a n (HoughCylinderParameters::min_inliers, or
+ * its automatic value when 0). */
+std::size_t minimumInliers(const HoughCylinderParameters& params, std::size_t n);
 
 /** \brief The cloud in the form the estimator works on: finite points with finite normals. */
 struct CylinderCues {
@@ -258,8 +279,9 @@ struct CylinderCues {
 /** \brief Fits up to params.max_cylinders cylinders to \a cues, one after another: vote with
  * every accumulator, refine the strongest peaks, fit position and radius, keep the candidate
  * with most inliers, remove its inliers and the points inside it, and repeat while a cylinder
- * has at least min_inliers inliers. Model inliers index the columns of cues.points.
- * \a total_points is N_cluster of eq. 4 (the points given, finite or not).
+ * has at least min_inliers points on its side and end caps (minimumInliers, endCapPoints). Model
+ * inliers index the columns of cues.points. \a total_points is N_cluster of eq. 4 (the points
+ * given, finite or not).
  */
 std::vector<CylinderModel> fitCylinders(const CylinderCues& cues,
                                         const std::vector<OrientationAccumulator>& accumulators,

@@ -239,7 +239,9 @@ public:
   {
     return params_.max_cylinders;
   }
-  /** \brief A cylinder needs this many inliers; 0 (default): max(10, 5% of the points). */
+  /** \brief A cylinder needs this many points: its inliers and the points of its end caps
+   * (endCapPoints), at least 10 (or \a n, if smaller) of them inliers; 0 (default): max(10, 5% of
+   * the points). */
   void setMinInliers(std::size_t n)
   {
     params_.min_inliers = n;

@@ -99,13 +99,11 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
   using detail::houghFormat;
   const Level level = diagnose_failures_ ? Level::Warn : Level::Debug;
   const std::size_t n = static_cast<std::size_t>(cues.points.cols());
-  const std::size_t min_inliers = params_.min_inliers > 0
-                                    ? params_.min_inliers
-                                    : std::max<std::size_t>(10, static_cast<std::size_t>(0.05 * n));
+  const std::size_t min_inliers = minimumInliers(params_, n);
   if (n < min_inliers)
     return fail(HoughFailure::TooFewPoints,
-                houghFormat("too few points: %zu usable of %zu, and a cylinder needs %zu inliers "
-                            "(setMinInliers)",
+                houghFormat("too few points: %zu usable of %zu, and a cylinder needs %zu points "
+                            "on its side and end caps (setMinInliers)",
                             n, total_points, min_inliers),
                 level);
   const bool limited = params_.radius_min > 0.f || std::isfinite(params_.radius_max);
@@ -133,7 +131,7 @@ HoughCylinderEstimation<PointT, PointNT>::explainNoCylinder(const CylinderCues& 
   }
   return fail(HoughFailure::NoCylinder,
               houghFormat("no cylinder found among %zu points (%zu usable; a cylinder needs %zu "
-                          "inliers)",
+                          "points on its side and end caps, setMinInliers)",
                           total_points, n, min_inliers),
               level);
 }
