@@ -339,11 +339,12 @@ normalRotationSlope(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
       continue;
     if (m.dot(d) < 0.0)
       m = -m;
-    const double angle = std::atan2(d.y(), d.x());
-    t.phi.push_back(angle);
+    t.phi.push_back(std::atan2(d.y(), d.x()));
     t.eps.push_back(std::atan2(d.x() * m.y() - d.y() * m.x(), d.dot(m)));
-    sum_sin += std::sin(2.0 * angle); // angles modulo pi: opposite strips (two lids) pool
-    sum_cos += std::cos(2.0 * angle);
+    // sin and cos of twice the angle (modulo pi: opposite strips, two lids, pool), from d.
+    const double d2 = d.squaredNorm();
+    sum_sin += 2.0 * d.x() * d.y() / d2;
+    sum_cos += (d.x() * d.x() - d.y() * d.y()) / d2;
   }
   const std::size_t count = t.phi.size();
   if (count < 3)
