@@ -145,6 +145,28 @@ TEST(TabletopGeometry, RowExtremesHoldThePlanesHull)
   EXPECT_NEAR(facyl::polygonArea(facyl::convexHull2D(flat(ends))), full, 1e-4f * full);
 }
 
+TEST(TabletopGeometry, LatticeAndItsBlocks)
+{
+  // A 5 x 3 image, every second pixel and row: a 3 x 2 lattice.
+  pcl::PointCloud<pcl::PointXYZ> image(5, 3), lattice;
+  for (std::size_t i = 0; i < image.size(); ++i)
+    image[i] = pcl::PointXYZ(static_cast<float>(i), 0.f, 1.f);
+  image.sensor_origin_ = Eigen::Vector4f(1.f, 2.f, 3.f, 0.f);
+  facyl::latticeOf(image, 2, lattice);
+  ASSERT_EQ(lattice.width, 3u);
+  ASSERT_EQ(lattice.height, 2u);
+  EXPECT_EQ(lattice.sensor_origin_, image.sensor_origin_);
+  const std::vector<float> x{0.f, 2.f, 4.f, 10.f, 12.f, 14.f};
+  for (std::size_t k = 0; k < lattice.size(); ++k)
+    EXPECT_EQ(lattice[k].x, x[k]);
+  // Lattice pixels (0, 0), (2, 0) and (1, 1): their 2 x 2 blocks, cut at the image's edges.
+  const auto all = [](pcl::index_t, pcl::index_t) { return true; };
+  EXPECT_EQ(facyl::blockPixels({0, 2, 4}, 5, 3, 2, all), (pcl::Indices{0, 1, 4, 5, 6, 9, 12, 13}));
+  const auto parents = [](pcl::index_t pixel, pcl::index_t parent) { return pixel == parent; };
+  EXPECT_EQ(facyl::blockPixels({0, 2, 4}, 5, 3, 2, parents), (pcl::Indices{0, 4, 12}));
+  EXPECT_TRUE(facyl::blockPixels({}, 5, 3, 2, all).empty());
+}
+
 TEST(TabletopGeometry, PinholeFromAnOrganizedCloud)
 {
   const auto s = scene(3);
@@ -377,6 +399,75 @@ TEST(TabletopSegmentation, FindsTheTableAndEveryObject)
   }
 }
 
+TEST(TabletopSegmentation, SegmentsALargeFrameOnALattice)
+{
+  // A 1280 x 720 frame (VGA's horizontal field of view) segmented on every pixel and on a
+  // lattice of every second pixel and row (lattice_width 640): the same table, the same
+  // objects, their pixels at full resolution.
+  for (std::uint64_t seed : {21u, 23u}) {
+    facyl::TabletopSceneParameters p;
+    p.seed = seed;
+    p.camera.fx *= 2.f;
+    p.camera.fy *= 2.f;
+    p.camera.cx = 639.5f;
+    p.camera.cy = 359.5f;
+    p.camera.width = 1280;
+    p.camera.height = 720;
+    const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+    Cloud::Ptr cloud(new Cloud(s.cloud));
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> every, lattice;
+    facyl::TabletopSegmentationParameters lp;
+    lp.lattice_width = 640;
+    lattice.setParameters(lp);
+    every.setInputCloud(cloud);
+    lattice.setInputCloud(cloud);
+    std::vector<facyl::TabletopCluster> a, b;
+    ASSERT_TRUE(every.segment(a));
+    ASSERT_TRUE(lattice.segment(b));
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    EXPECT_NEAR(lattice.getFocalLength(), every.getFocalLength(), 0.01f * every.getFocalLength());
+    const auto& ca = every.getTableCoefficients().values;
+    const auto& cb = lattice.getTableCoefficients().values;
+    ASSERT_EQ(ca.size(), 4u);
+    ASSERT_EQ(cb.size(), 4u);
+    EXPECT_GT(Eigen::Vector3f(ca[0], ca[1], ca[2]).dot(Eigen::Vector3f(cb[0], cb[1], cb[2])),
+              std::cos(0.01f));
+    EXPECT_NEAR(ca[3], cb[3], 0.002f);
+    // The table's inliers: full-resolution pixels, nearly the same ones.
+    const auto share = [](const pcl::Indices& x, const pcl::Indices& y) {
+      pcl::Indices both;
+      std::set_intersection(x.begin(), x.end(), y.begin(), y.end(), std::back_inserter(both));
+      return static_cast<float>(both.size()) / static_cast<float>(std::max(x.size(), y.size()));
+    };
+    const auto& ta = every.getTableIndices().indices;
+    const auto& tb = lattice.getTableIndices().indices;
+    ASSERT_TRUE(std::is_sorted(tb.begin(), tb.end()));
+    EXPECT_GT(share(ta, tb), 0.95f);
+    // Every object seen over 4,000 pixels is one cluster of each, most of its pixels shared.
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t k = 0; k < s.scene.objects.size(); ++k) {
+      if (s.visible_pixels[k] < 4000)
+        continue;
+      const int id = static_cast<int>(k + 2);
+      const auto of = [&](const std::vector<facyl::TabletopCluster>& cs) {
+        const facyl::TabletopCluster* found = nullptr;
+        int count = 0;
+        for (const auto& c : cs)
+          if (majorityId(s, c.indices.indices) == id)
+            found = &c, ++count;
+        EXPECT_EQ(count, 1) << "object " << k;
+        return found;
+      };
+      const auto* x = of(a);
+      const auto* y = of(b);
+      if (x && y) {
+        EXPECT_GT(share(x->indices.indices, y->indices.indices), 0.9f) << "object " << k;
+        EXPECT_EQ(x->support, y->support);
+      }
+    }
+  }
+}
+
 TEST(TabletopSegmentation, SortsTheWholeCloudAsItsIndices)
 {
   // The whole cloud is sorted onto the planes four points at a time (SSE); given indices go
@@ -500,6 +591,9 @@ TEST(TabletopSegmentation, ReportsBadInput)
   EXPECT_TRUE(seg.getSupports().empty());
   EXPECT_TRUE(seg.getTableCoefficients().values.empty());
   facyl::TabletopSegmentationParameters bad;
+  bad.lattice_width = 100;
+  EXPECT_NE(facyl::validate(bad).find("lattice width"), std::string::npos);
+  bad.lattice_width = 0;
   bad.min_height = 0.5f;
   bad.max_height = 0.1f;
   EXPECT_FALSE(facyl::validate(bad).empty());

@@ -32,6 +32,8 @@ validate(const TabletopSegmentationParameters& p)
     why << "min_hull_share " << p.min_hull_share << " must be in (0, 1]";
   else if (p.plane_step < 0 || p.plane_step > 16)
     why << "plane step " << p.plane_step << " must be in [0, 16] (0: automatic)";
+  else if (p.lattice_width != 0 && (p.lattice_width < 160 || p.lattice_width > 8192))
+    why << "lattice width " << p.lattice_width << " must be 0 (every pixel) or in [160, 8192]";
   else if (p.plane_samples < 100)
     why << "plane_samples " << p.plane_samples << " must be >= 100";
   else if (p.max_planes < 1 || p.max_planes > 8)

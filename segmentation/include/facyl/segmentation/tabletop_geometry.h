@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <pcl/point_cloud.h>
 #include <pcl/types.h>
 
 #include <Eigen/Geometry>
@@ -30,6 +31,60 @@ struct PinholeCamera {
     return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   }
 };
+
+/** \brief Every \a step-th pixel of every \a step-th row of the organized \a cloud, starting
+ * with the first: an organized cloud of ceil(width / step) x ceil(height / step) with the
+ * cloud's header and sensor pose. \a step >= 1. */
+template <typename PointT>
+void
+latticeOf(const pcl::PointCloud<PointT>& cloud, int step, pcl::PointCloud<PointT>& out)
+{
+  const auto w = static_cast<std::size_t>(cloud.width), h = static_cast<std::size_t>(cloud.height);
+  const auto s = static_cast<std::size_t>(step);
+  const std::size_t lw = (w + s - 1) / s, lh = (h + s - 1) / s;
+  out.header = cloud.header;
+  out.sensor_origin_ = cloud.sensor_origin_;
+  out.sensor_orientation_ = cloud.sensor_orientation_;
+  out.is_dense = cloud.is_dense;
+  out.resize(lw * lh);
+  out.width = static_cast<std::uint32_t>(lw);
+  out.height = static_cast<std::uint32_t>(lh);
+  for (std::size_t v = 0; v < lh; ++v)
+    for (std::size_t u = 0; u < lw; ++u)
+      out[v * lw + u] = cloud[v * s * w + u * s];
+}
+
+/** \brief The pixels of the \a step x \a step blocks of the lattice pixels \a lattice (strictly
+ * ascending indices into the lattice image of latticeOf, ceil(\a width / \a step) wide) in a
+ * \a width x \a height image, for which \a keep(pixel, the block's lattice pixel as an image
+ * index) holds; ascending. */
+template <typename Keep>
+pcl::Indices
+blockPixels(const pcl::Indices& lattice, int width, int height, int step, Keep keep)
+{
+  pcl::Indices out;
+  const int lw = (width + step - 1) / step;
+  std::size_t k = 0;
+  while (k < lattice.size()) {
+    // The lattice pixels of one lattice row, then the image rows of its blocks in order.
+    const int row = lattice[k] / lw;
+    std::size_t end = k;
+    while (end < lattice.size() && lattice[end] / lw == row)
+      ++end;
+    for (int dv = 0; dv < step && row * step + dv < height; ++dv)
+      for (std::size_t j = k; j < end; ++j) {
+        const int u0 = (lattice[j] % lw) * step;
+        const auto parent = static_cast<pcl::index_t>(row * step * width + u0);
+        for (int du = 0; du < step && u0 + du < width; ++du) {
+          const auto pixel = static_cast<pcl::index_t>((row * step + dv) * width + u0 + du);
+          if (keep(pixel, parent))
+            out.push_back(pixel);
+        }
+      }
+    k = end;
+  }
+  return out;
+}
 
 /** \brief True when \a camera's intrinsics are finite and positive and its image is at most
  * 8192 x 8192 pixels (the images facyl builds from it stay below half a gigabyte). */

@@ -85,6 +85,14 @@ struct TabletopSegmentationParameters {
    * (default): the image width / 160 (4 at VGA), so that the search sees the same angular
    * grid at every resolution. */
   int plane_step{0};
+  /** Speed for accuracy on large frames (0, the default: off). Organized frames wider than 1.5
+   * times this many pixels are segmented on a lattice of every s-th pixel and row, s =
+   * round(width / lattice_width) (640: a 1280 x 720 frame at 640 x 360, about as a VGA frame),
+   * and each object and support then takes the pixels of its lattice pixels' s x s blocks that
+   * continue its surface. On simulated 1280 x 720 frames it took the segmentation from 43-49 to
+   * 26-27 ms, and detected 37 cylinders instead of 41 on the realistic layout (docs/speed.md,
+   * "1280 x 720 frames"). 0 or in [160, 8192]. */
+  int lattice_width{0};
   std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
   std::size_t max_planes{6};        ///< support candidates examined, in [1, 8]
 };
@@ -379,8 +387,17 @@ private:
   /** True when the input is searched as an image (organized and at least 16 plane-grid cells
    * wide and high), else as a point set. */
   bool searchedAsImage() const;
-  /** segment() on a cloud in the sensor's frame (identity sensor pose). */
+  /** segment() on a cloud in the sensor's frame (identity sensor pose): on the lattice of
+   * latticeStep(), or on every pixel (segmentFrame). */
   bool segmentInSensorFrame(std::vector<TabletopCluster>& clusters);
+  /** segmentInSensorFrame on every pixel of the input. */
+  bool segmentFrame(std::vector<TabletopCluster>& clusters);
+  /** The lattice step of lattice_width for the input: 1 for point sets, given indices and
+   * frames up to 1.5 lattice_width wide. */
+  int latticeStep() const;
+  /** segmentFrame on the lattice of every \a step-th pixel and row (latticeOf), the clusters
+   * and supports then brought to full resolution (blockPixels). */
+  bool segmentOnLattice(std::vector<TabletopCluster>& clusters, int step);
   /** segment(); with \a check_pose false, the cloud is known to be in the sensor's frame and
    * within kMaxCoordinate (the recognizer's own checks, or its copy, made it so): its sensor
    * pose and far points are not looked for again (a pass over the frame). */

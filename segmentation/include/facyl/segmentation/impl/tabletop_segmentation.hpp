@@ -140,6 +140,122 @@ template <typename PointT>
 bool
 TabletopSegmentation<PointT>::segmentInSensorFrame(std::vector<TabletopCluster>& clusters)
 {
+  const int step = latticeStep();
+  return step > 1 ? segmentOnLattice(clusters, step) : segmentFrame(clusters);
+}
+
+template <typename PointT>
+int
+TabletopSegmentation<PointT>::latticeStep() const
+{
+  const int lattice = params_.lattice_width;
+  if (lattice <= 0 || !fake_indices_ || !searchedAsImage() ||
+      2 * input_->width <= static_cast<std::uint32_t>(3 * lattice))
+    return 1;
+  return static_cast<int>(std::lround(static_cast<double>(input_->width) / lattice));
+}
+
+template <typename PointT>
+bool
+TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clusters, int step)
+{
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const auto ms = [](Clock::time_point a) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+  };
+  const PointCloudConstPtr full = input_;
+  const auto full_indices = indices_;
+  const PinholeCamera full_camera = camera_;
+  const TabletopSegmentationParameters full_params = params_;
+  typename PointCloud::Ptr lattice(new PointCloud);
+  latticeOf(*full, step, *lattice);
+  // The lattice stands for step^2 pixels a point: counts of points scale down, the camera's
+  // pixels too; lengths stay.
+  const auto area = static_cast<std::size_t>(step * step);
+  params_.min_plane_points = std::max<std::size_t>(1, params_.min_plane_points / area);
+  params_.min_cluster_size = std::max<std::size_t>(1, params_.min_cluster_size / area);
+  params_.max_cluster_size = std::max(params_.min_cluster_size, params_.max_cluster_size / area);
+  params_.objects.min_fragment = std::max<std::size_t>(1, params_.objects.min_fragment / area);
+  if (params_.plane_step > 0)
+    params_.plane_step = std::max(1, params_.plane_step / step);
+  if (camera_.valid()) {
+    const float s = static_cast<float>(step);
+    camera_.fx /= s, camera_.fy /= s, camera_.cx /= s, camera_.cy /= s;
+    camera_.width = static_cast<int>(lattice->width);
+    camera_.height = static_cast<int>(lattice->height);
+  }
+  input_ = lattice;
+  indices_.reset(new pcl::Indices(lattice->size()));
+  std::iota(indices_->begin(), indices_->end(), 0);
+  const double t_lattice = ms(t0);
+  std::vector<TabletopCluster> coarse;
+  const bool found = segmentFrame(coarse);
+  input_ = full;
+  indices_ = full_indices;
+  camera_ = full_camera;
+  params_ = full_params;
+  const auto t1 = Clock::now();
+  // Full resolution: a cluster takes the pixels of its blocks within the lattice's connection
+  // gap (segmentObjectsOrganized's, for neighbours one lattice step apart) of the block's
+  // lattice pixel; a support the pixels of its blocks within its band.
+  const auto& op = params_.objects;
+  const Eigen::Vector3f viewpoint = full->sensor_origin_.head(3);
+  const int w = static_cast<int>(full->width), h = static_cast<int>(full->height);
+  const std::vector<float> half = has_noise_ ? tabulateHalfWidths(noise_) : std::vector<float>();
+  const auto continues = [&](pcl::index_t pixel, pcl::index_t parent) {
+    const auto& p = (*full)[pixel];
+    if (!pcl::isFinite(p))
+      return false;
+    if (pixel == parent)
+      return true;
+    const Eigen::Vector3f q = (*full)[parent].getVector3fMap();
+    const float range = (q - viewpoint).norm();
+    float gap = std::clamp(op.jump_factor * range / focal_, op.min_gap, op.max_gap);
+    if (!half.empty())
+      gap = std::max(
+        gap, half[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)]);
+    return (p.getVector3fMap() - q).squaredNorm() < gap * gap;
+  };
+  clusters.clear();
+  for (const auto& c : coarse) {
+    pcl::Indices pixels = blockPixels(c.indices.indices, w, h, step, continues);
+    if (pixels.size() >= params_.min_cluster_size && pixels.size() <= params_.max_cluster_size)
+      clusters.push_back(makeCluster(std::move(pixels), c.support));
+  }
+  std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
+    return a.indices.indices.size() > b.indices.indices.size();
+  });
+  for (auto& support : supports_) {
+    // The band by range as classifyPoints reads it: tabulated, and not looked up for points
+    // within its narrowest half-width.
+    const float floor = halfWidthFloor(support.band);
+    const std::vector<float> widths = tabulateHalfWidths(support.band);
+    const Eigen::Vector3f normal = support.plane.template head<3>();
+    const auto within = [&](pcl::index_t pixel, pcl::index_t) {
+      const auto& p = (*full)[pixel];
+      if (!pcl::isFinite(p))
+        return false;
+      const float distance = std::abs(normal.dot(p.getVector3fMap()) + support.plane[3]);
+      if (distance <= floor)
+        return true;
+      const float range = (p.getVector3fMap() - viewpoint).norm();
+      return distance <=
+             widths[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)];
+    };
+    support.inliers.indices = blockPixels(support.inliers.indices, w, h, step, within);
+    support.standing_points *= area;
+  }
+  focal_ *= static_cast<float>(step); // the full frame's, as getFocalLength says
+  timing_.planes += t_lattice;
+  timing_.objects += ms(t1);
+  return found;
+}
+
+template <typename PointT>
+bool
+TabletopSegmentation<PointT>::segmentFrame(std::vector<TabletopCluster>& clusters)
+{
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   const auto ms = [](Clock::time_point a) {
