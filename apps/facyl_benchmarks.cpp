@@ -302,13 +302,18 @@ BM_TrackerUpdate(benchmark::State& state)
 BENCHMARK(BM_TrackerUpdate)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMicrosecond);
 
 /** One frame through the recognizer, with the shipped classifier, as facyl_detect runs it
- * (buffers kept between frames as a stream would). */
+ * (buffers kept between frames as a stream would); segmented on the lattice of \a lattice_width
+ * (TabletopSegmentationParameters; 0: every pixel). */
 void
-runFrames(benchmark::State& state, const pcl::PointCloud<pcl::PointXYZRGBA>::ConstPtr& cloud)
+runFrames(benchmark::State& state, const pcl::PointCloud<pcl::PointXYZRGBA>::ConstPtr& cloud,
+          int lattice_width = 0)
 {
   auto classifier = std::make_shared<facyl::CylinderClassifier>();
   classifier->load(facyl::CylinderClassifier::defaultModelPath());
   facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
+  auto params = rec.getParameters();
+  params.segmentation.lattice_width = lattice_width;
+  rec.setParameters(params);
   rec.setClassifier(classifier);
   rec.setInputCloud(cloud);
   std::vector<facyl::RecognizedObject> objects;
@@ -352,7 +357,7 @@ BM_Frame(benchmark::State& state, const std::string& file)
  * sensor of \a width x \a height pixels with the field of view of a 640-pixel-wide one at
  * fx = 525 (a 16:9 frame sees less vertically). */
 void
-BM_SimulatedFrame(benchmark::State& state, int width, int height)
+BM_SimulatedFrame(benchmark::State& state, int width, int height, int lattice_width)
 {
   facyl::TabletopSceneParameters params;
   params.seed = 1;
@@ -363,11 +368,11 @@ BM_SimulatedFrame(benchmark::State& state, int width, int height)
   params.camera.cy = 0.5f * static_cast<float>(height - 1);
   pcl::PointCloud<pcl::PointXYZRGBA>::Ptr cloud(
     new pcl::PointCloud<pcl::PointXYZRGBA>(facyl::simulateTabletopScene(params).cloud));
-  runFrames(state, cloud);
+  runFrames(state, cloud, lattice_width);
 }
 
-/** BM_Frame on the bundled scene, a simulated scene at VGA and at 1280 x 720 and, when present,
- * every 4th mOSD learn frame. */
+/** BM_Frame on the bundled scene, a simulated scene at VGA and at 1280 x 720 (and at 1280 x 720
+ * on the lattice of lattice_width 640) and, when present, every 4th mOSD learn frame. */
 void
 registerFrames()
 {
@@ -377,8 +382,11 @@ registerFrames()
   for (const auto& [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
     benchmark::RegisterBenchmark(
       ("BM_Frame/simulated_" + std::to_string(w) + "x" + std::to_string(h)).c_str(),
-      BM_SimulatedFrame, w, h)
+      BM_SimulatedFrame, w, h, 0)
       ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("BM_Frame/simulated_1280x720_lattice640", BM_SimulatedFrame, 1280,
+                               720, 640)
+    ->Unit(benchmark::kMillisecond);
   const char* env = std::getenv("FACYL_REAL_DATA");
   const std::string real = env ? env : std::string(FACYL_SOURCE_DIR) + "/../shared/data/real";
   for (int k = 0; k <= 44; k += 4) {

@@ -89,9 +89,9 @@ struct TabletopSegmentationParameters {
    * times this many pixels are segmented on a lattice of every s-th pixel and row, s =
    * round(width / lattice_width) (640: a 1280 x 720 frame at 640 x 360, about as a VGA frame),
    * and each object and support then takes the pixels of its lattice pixels' s x s blocks that
-   * continue its surface. On simulated 1280 x 720 frames it took the segmentation from 43-49 to
-   * 26-27 ms, and detected 37 cylinders instead of 41 on the realistic layout (docs/speed.md,
-   * "1280 x 720 frames"). 0 or in [160, 8192]. */
+   * continue its surface. On simulated 1280 x 720 frames it took the segmentation from about
+   * 43 to 22-23 ms, and detected 38 cylinders instead of 41 on the realistic layout
+   * (docs/speed.md, "1280 x 720 frames"). 0 or in [160, 8192]. */
   int lattice_width{0};
   std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
   std::size_t max_planes{6};        ///< support candidates examined, in [1, 8]

@@ -203,22 +203,74 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
   const Eigen::Vector3f viewpoint = full->sensor_origin_.head(3);
   const int w = static_cast<int>(full->width), h = static_cast<int>(full->height);
   const std::vector<float> half = has_noise_ ? tabulateHalfWidths(noise_) : std::vector<float>();
-  const auto continues = [&](pcl::index_t pixel, pcl::index_t parent) {
-    const auto& p = (*full)[pixel];
-    if (!pcl::isFinite(p))
-      return false;
-    if (pixel == parent)
-      return true;
-    const Eigen::Vector3f q = (*full)[parent].getVector3fMap();
-    const float range = (q - viewpoint).norm();
-    float gap = std::clamp(op.jump_factor * range / focal_, op.min_gap, op.max_gap);
-    if (!half.empty())
-      gap = std::max(
-        gap, half[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)]);
-    return (p.getVector3fMap() - q).squaredNorm() < gap * gap;
+  const auto bin = [](float range) {
+    return std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1);
   };
+  // Each support's band by range as classifyPoints reads it: tabulated, and not looked up for
+  // points within its narrowest half-width.
+  struct Band {
+    Eigen::Vector4f plane;
+    float floor;
+    std::vector<float> widths;
+  };
+  std::vector<Band> bands;
+  for (const auto& support : supports_)
+    bands.push_back(
+      {support.plane, halfWidthFloor(support.band), tabulateHalfWidths(support.band)});
+  // Signed distance of \a p above band \a b's plane, and the band's half-width there.
+  const auto above = [&](const Band& b, const Eigen::Vector3f& p, float& half_width) {
+    const float distance = b.plane.template head<3>().dot(p) + b.plane[3];
+    half_width = std::abs(distance) <= b.floor ? b.floor : b.widths[bin((p - viewpoint).norm())];
+    return distance;
+  };
+  // Each lattice pixel's object (-1: none).
+  const int lw = static_cast<int>(lattice->width), lh = static_cast<int>(lattice->height);
+  std::vector<int> label(lattice->size(), -1);
+  for (std::size_t k = 0; k < coarse.size(); ++k)
+    for (const auto i : coarse[k].indices.indices)
+      label[static_cast<std::size_t>(i)] = static_cast<int>(k);
   clusters.clear();
-  for (const auto& c : coarse) {
+  for (std::size_t k = 0; k < coarse.size(); ++k) {
+    const auto& c = coarse[k];
+    // A block's pixel joins its lattice pixel's object when it continues its surface (within
+    // the lattice's connection gap), the nearest lattice pixel of its lattice cell's corners
+    // is this object's (a pixel between an object's foot and what it stands on goes to the
+    // nearer), and it is an object point (above its support's band, as classifyPoints has
+    // it).
+    const Band* band = c.support >= 0 ? &bands[static_cast<std::size_t>(c.support)] : nullptr;
+    const auto continues = [&](pcl::index_t pixel, pcl::index_t parent) {
+      const auto& p = (*full)[pixel];
+      if (!pcl::isFinite(p))
+        return false;
+      if (pixel == parent)
+        return true;
+      const Eigen::Vector3f q = (*full)[parent].getVector3fMap();
+      const float range = (q - viewpoint).norm();
+      float gap = std::clamp(op.jump_factor * range / focal_, op.min_gap, op.max_gap);
+      if (!half.empty())
+        gap = std::max(gap, half[bin(range)]);
+      if (!((p.getVector3fMap() - q).squaredNorm() < gap * gap))
+        return false;
+      const int u = pixel % w, v = pixel / w, lu = u / step, lv = v / step;
+      float best = std::numeric_limits<float>::infinity();
+      int owner = -1;
+      for (int dv = 0; dv <= (v % step ? 1 : 0); ++dv)
+        for (int du = 0; du <= (u % step ? 1 : 0); ++du) {
+          if (lu + du >= lw || lv + dv >= lh)
+            continue;
+          const std::size_t l = static_cast<std::size_t>((lv + dv) * lw + lu + du);
+          const auto& corner = (*lattice)[l];
+          if (!pcl::isFinite(corner))
+            continue;
+          const float d2 = (corner.getVector3fMap() - p.getVector3fMap()).squaredNorm();
+          if (d2 < best)
+            best = d2, owner = label[l];
+        }
+      if (owner != static_cast<int>(k))
+        return false;
+      float half_width = 0.f;
+      return !band || above(*band, p.getVector3fMap(), half_width) > half_width;
+    };
     pcl::Indices pixels = blockPixels(c.indices.indices, w, h, step, continues);
     if (pixels.size() >= params_.min_cluster_size && pixels.size() <= params_.max_cluster_size)
       clusters.push_back(makeCluster(std::move(pixels), c.support));
@@ -226,22 +278,14 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
   });
-  for (auto& support : supports_) {
-    // The band by range as classifyPoints reads it: tabulated, and not looked up for points
-    // within its narrowest half-width.
-    const float floor = halfWidthFloor(support.band);
-    const std::vector<float> widths = tabulateHalfWidths(support.band);
-    const Eigen::Vector3f normal = support.plane.template head<3>();
+  for (std::size_t s = 0; s < supports_.size(); ++s) {
+    auto& support = supports_[s];
     const auto within = [&](pcl::index_t pixel, pcl::index_t) {
       const auto& p = (*full)[pixel];
       if (!pcl::isFinite(p))
         return false;
-      const float distance = std::abs(normal.dot(p.getVector3fMap()) + support.plane[3]);
-      if (distance <= floor)
-        return true;
-      const float range = (p.getVector3fMap() - viewpoint).norm();
-      return distance <=
-             widths[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)];
+      float half_width = 0.f;
+      return std::abs(above(bands[s], p.getVector3fMap(), half_width)) <= half_width;
     };
     support.inliers.indices = blockPixels(support.inliers.indices, w, h, step, within);
     support.standing_points *= area;
