@@ -190,11 +190,26 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
   std::iota(indices_->begin(), indices_->end(), 0);
   const double t_lattice = ms(t0);
   std::vector<TabletopCluster> coarse;
-  const bool found = segmentFrame(coarse);
-  input_ = full;
-  indices_ = full_indices;
-  camera_ = full_camera;
-  params_ = full_params;
+  bool found = false;
+  {
+    // The input, indices, camera and settings are the caller's again however segmentFrame
+    // ends (an exception included).
+    struct Restore {
+      TabletopSegmentation& seg;
+      const PointCloudConstPtr& input;
+      const pcl::IndicesPtr& indices;
+      const PinholeCamera& camera;
+      const TabletopSegmentationParameters& params;
+      ~Restore()
+      {
+        seg.input_ = input;
+        seg.indices_ = indices;
+        seg.camera_ = camera;
+        seg.params_ = params;
+      }
+    } restore{*this, full, full_indices, full_camera, full_params};
+    found = segmentFrame(coarse);
+  }
   const auto t1 = Clock::now();
   // Full resolution: a cluster takes the pixels of its blocks within the lattice's connection
   // gap (segmentObjectsOrganized's, for neighbours one lattice step apart) of the block's
