@@ -398,6 +398,16 @@ private:
   /** segmentFrame on the lattice of every \a step-th pixel and row (latticeOf), the clusters
    * and supports then brought to full resolution (blockPixels). */
   bool segmentOnLattice(std::vector<TabletopCluster>& clusters, int step);
+  /** The settings on the lattice of \a step: counts of points scaled by 1 / step^2. */
+  TabletopSegmentationParameters latticeParameters(int step) const;
+  /** The clusters \a coarse of the \a lattice of \a step, with the pixels of the (full) input
+   * that continue them, as \a clusters (largest first). */
+  void clustersAtFullResolution(const std::vector<TabletopCluster>& coarse,
+                                const PointCloud& lattice, int step,
+                                std::vector<TabletopCluster>& clusters) const;
+  /** The supports' inliers of the lattice of \a step, as the pixels of their blocks within
+   * their bands. */
+  void supportsAtFullResolution(int step);
   /** segment(); with \a check_pose false, the cloud is known to be in the sensor's frame and
    * within kMaxCoordinate (the recognizer's own checks, or its copy, made it so): its sensor
    * pose and far points are not looked for again (a pass over the frame). */

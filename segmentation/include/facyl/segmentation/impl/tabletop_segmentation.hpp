@@ -155,6 +155,50 @@ TabletopSegmentation<PointT>::latticeStep() const
   return static_cast<int>(std::lround(static_cast<double>(input_->width) / lattice));
 }
 
+namespace detail {
+/** A support's band as classifyPoints reads it: tabulated by range, and not looked up for points
+ * within its narrowest half-width. */
+struct TabulatedBand {
+  explicit TabulatedBand(const SupportPlane& support)
+      : plane(support.plane)
+      , floor(halfWidthFloor(support.band))
+      , widths(tabulateHalfWidths(support.band))
+  {
+  }
+  /** Signed distance of \a p above the plane; \a half_width: the band's there (range from
+   * \a viewpoint). */
+  float above(const Eigen::Vector3f& p, const Eigen::Vector3f& viewpoint, float& half_width) const
+  {
+    const float distance = plane.head<3>().dot(p) + plane[3];
+    half_width =
+      std::abs(distance) <= floor
+        ? floor
+        : widths[std::min(static_cast<std::size_t>((p - viewpoint).norm() / kHalfWidthBin),
+                          kHalfWidthBins - 1)];
+    return distance;
+  }
+  Eigen::Vector4f plane;
+  float floor;
+  std::vector<float> widths;
+};
+} // namespace detail
+
+template <typename PointT>
+TabletopSegmentationParameters
+TabletopSegmentation<PointT>::latticeParameters(int step) const
+{
+  // A lattice point stands for step^2 pixels: counts of points scale down; lengths stay.
+  TabletopSegmentationParameters p = params_;
+  const auto area = static_cast<std::size_t>(step * step);
+  p.min_plane_points = std::max<std::size_t>(1, p.min_plane_points / area);
+  p.min_cluster_size = std::max<std::size_t>(1, p.min_cluster_size / area);
+  p.max_cluster_size = std::max(p.min_cluster_size, p.max_cluster_size / area);
+  p.objects.min_fragment = std::max<std::size_t>(1, p.objects.min_fragment / area);
+  if (p.plane_step > 0)
+    p.plane_step = std::max(1, p.plane_step / step);
+  return p;
+}
+
 template <typename PointT>
 bool
 TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clusters, int step)
@@ -170,15 +214,7 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
   const TabletopSegmentationParameters full_params = params_;
   typename PointCloud::Ptr lattice(new PointCloud);
   latticeOf(*full, step, *lattice);
-  // The lattice stands for step^2 pixels a point: counts of points scale down, the camera's
-  // pixels too; lengths stay.
-  const auto area = static_cast<std::size_t>(step * step);
-  params_.min_plane_points = std::max<std::size_t>(1, params_.min_plane_points / area);
-  params_.min_cluster_size = std::max<std::size_t>(1, params_.min_cluster_size / area);
-  params_.max_cluster_size = std::max(params_.min_cluster_size, params_.max_cluster_size / area);
-  params_.objects.min_fragment = std::max<std::size_t>(1, params_.objects.min_fragment / area);
-  if (params_.plane_step > 0)
-    params_.plane_step = std::max(1, params_.plane_step / step);
+  params_ = latticeParameters(step);
   if (camera_.valid()) {
     const float s = static_cast<float>(step);
     camera_.fx /= s, camera_.fy /= s, camera_.cx /= s, camera_.cy /= s;
@@ -211,80 +247,78 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
     found = segmentFrame(coarse);
   }
   const auto t1 = Clock::now();
-  // Full resolution: a cluster takes the pixels of its blocks within the lattice's connection
-  // gap (segmentObjectsOrganized's, for neighbours one lattice step apart) of the block's
-  // lattice pixel; a support the pixels of its blocks within its band.
+  clustersAtFullResolution(coarse, *lattice, step, clusters);
+  supportsAtFullResolution(step);
+  focal_ *= static_cast<float>(step); // the full frame's, as getFocalLength says
+  timing_.planes += t_lattice;
+  timing_.objects += ms(t1);
+  return found;
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::clustersAtFullResolution(const std::vector<TabletopCluster>& coarse,
+                                                       const PointCloud& lattice, int step,
+                                                       std::vector<TabletopCluster>& clusters) const
+{
+  const PointCloud& full = *input_;
   const auto& op = params_.objects;
-  const Eigen::Vector3f viewpoint = full->sensor_origin_.head(3);
-  const int w = static_cast<int>(full->width), h = static_cast<int>(full->height);
+  const Eigen::Vector3f viewpoint = full.sensor_origin_.head(3);
+  const int w = static_cast<int>(full.width), h = static_cast<int>(full.height);
+  const int lw = static_cast<int>(lattice.width), lh = static_cast<int>(lattice.height);
   const std::vector<float> half = has_noise_ ? tabulateHalfWidths(noise_) : std::vector<float>();
-  const auto bin = [](float range) {
-    return std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1);
-  };
-  // Each support's band by range as classifyPoints reads it: tabulated, and not looked up for
-  // points within its narrowest half-width.
-  struct Band {
-    Eigen::Vector4f plane;
-    float floor;
-    std::vector<float> widths;
-  };
-  std::vector<Band> bands;
+  std::vector<detail::TabulatedBand> bands;
   for (const auto& support : supports_)
-    bands.push_back(
-      {support.plane, halfWidthFloor(support.band), tabulateHalfWidths(support.band)});
-  // Signed distance of \a p above band \a b's plane, and the band's half-width there.
-  const auto above = [&](const Band& b, const Eigen::Vector3f& p, float& half_width) {
-    const float distance = b.plane.template head<3>().dot(p) + b.plane[3];
-    half_width = std::abs(distance) <= b.floor ? b.floor : b.widths[bin((p - viewpoint).norm())];
-    return distance;
-  };
-  // Each lattice pixel's object (-1: none).
-  const int lw = static_cast<int>(lattice->width), lh = static_cast<int>(lattice->height);
-  std::vector<int> label(lattice->size(), -1);
+    bands.emplace_back(support);
+  std::vector<int> label(lattice.size(), -1); // each lattice pixel's object
   for (std::size_t k = 0; k < coarse.size(); ++k)
     for (const auto i : coarse[k].indices.indices)
       label[static_cast<std::size_t>(i)] = static_cast<int>(k);
+  // The object of the lattice pixel nearest to \a p among the corners of its lattice cell.
+  const auto nearest = [&](int u, int v, const Eigen::Vector3f& p) {
+    const int lu = u / step, lv = v / step;
+    float best = std::numeric_limits<float>::infinity();
+    int owner = -1;
+    for (int dv = 0; dv <= (v % step ? 1 : 0); ++dv)
+      for (int du = 0; du <= (u % step ? 1 : 0); ++du) {
+        if (lu + du >= lw || lv + dv >= lh)
+          continue;
+        const auto l = static_cast<std::size_t>((lv + dv) * lw + lu + du);
+        if (!pcl::isFinite(lattice[l]))
+          continue;
+        const float d2 = (lattice[l].getVector3fMap() - p).squaredNorm();
+        if (d2 < best)
+          best = d2, owner = label[l];
+      }
+    return owner;
+  };
   clusters.clear();
   for (std::size_t k = 0; k < coarse.size(); ++k) {
     const auto& c = coarse[k];
     // A block's pixel joins its lattice pixel's object when it continues its surface (within
-    // the lattice's connection gap), the nearest lattice pixel of its lattice cell's corners
-    // is this object's (a pixel between an object's foot and what it stands on goes to the
-    // nearer), and it is an object point (above its support's band, as classifyPoints has
-    // it).
-    const Band* band = c.support >= 0 ? &bands[static_cast<std::size_t>(c.support)] : nullptr;
+    // the lattice's connection gap, as segmentObjectsOrganized has it for neighbours one lattice
+    // step apart), the nearest lattice pixel of its lattice cell's corners is this object's (a
+    // pixel between an object's foot and what it stands on goes to the nearer), and it is an
+    // object point (above its support's band, as classifyPoints has it).
+    const detail::TabulatedBand* band =
+      c.support >= 0 ? &bands[static_cast<std::size_t>(c.support)] : nullptr;
     const auto continues = [&](pcl::index_t pixel, pcl::index_t parent) {
-      const auto& p = (*full)[pixel];
+      const auto& p = full[pixel];
       if (!pcl::isFinite(p))
         return false;
       if (pixel == parent)
         return true;
-      const Eigen::Vector3f q = (*full)[parent].getVector3fMap();
+      const Eigen::Vector3f q = full[parent].getVector3fMap();
       const float range = (q - viewpoint).norm();
       float gap = std::clamp(op.jump_factor * range / focal_, op.min_gap, op.max_gap);
       if (!half.empty())
-        gap = std::max(gap, half[bin(range)]);
-      if (!((p.getVector3fMap() - q).squaredNorm() < gap * gap))
-        return false;
-      const int u = pixel % w, v = pixel / w, lu = u / step, lv = v / step;
-      float best = std::numeric_limits<float>::infinity();
-      int owner = -1;
-      for (int dv = 0; dv <= (v % step ? 1 : 0); ++dv)
-        for (int du = 0; du <= (u % step ? 1 : 0); ++du) {
-          if (lu + du >= lw || lv + dv >= lh)
-            continue;
-          const std::size_t l = static_cast<std::size_t>((lv + dv) * lw + lu + du);
-          const auto& corner = (*lattice)[l];
-          if (!pcl::isFinite(corner))
-            continue;
-          const float d2 = (corner.getVector3fMap() - p.getVector3fMap()).squaredNorm();
-          if (d2 < best)
-            best = d2, owner = label[l];
-        }
-      if (owner != static_cast<int>(k))
+        gap = std::max(
+          gap, half[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)]);
+      if (!((p.getVector3fMap() - q).squaredNorm() < gap * gap) ||
+          nearest(pixel % w, pixel / w, p.getVector3fMap()) != static_cast<int>(k))
         return false;
       float half_width = 0.f;
-      return !band || above(*band, p.getVector3fMap(), half_width) > half_width;
+      return !band || band->above(p.getVector3fMap(), viewpoint, half_width) > half_width;
     };
     pcl::Indices pixels = blockPixels(c.indices.indices, w, h, step, continues);
     if (pixels.size() >= params_.min_cluster_size && pixels.size() <= params_.max_cluster_size)
@@ -293,22 +327,27 @@ TabletopSegmentation<PointT>::segmentOnLattice(std::vector<TabletopCluster>& clu
   std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
     return a.indices.indices.size() > b.indices.indices.size();
   });
-  for (std::size_t s = 0; s < supports_.size(); ++s) {
-    auto& support = supports_[s];
+}
+
+template <typename PointT>
+void
+TabletopSegmentation<PointT>::supportsAtFullResolution(int step)
+{
+  const PointCloud& full = *input_;
+  const Eigen::Vector3f viewpoint = full.sensor_origin_.head(3);
+  const int w = static_cast<int>(full.width), h = static_cast<int>(full.height);
+  for (auto& support : supports_) {
+    const detail::TabulatedBand band(support);
     const auto within = [&](pcl::index_t pixel, pcl::index_t) {
-      const auto& p = (*full)[pixel];
+      const auto& p = full[pixel];
       if (!pcl::isFinite(p))
         return false;
       float half_width = 0.f;
-      return std::abs(above(bands[s], p.getVector3fMap(), half_width)) <= half_width;
+      return std::abs(band.above(p.getVector3fMap(), viewpoint, half_width)) <= half_width;
     };
     support.inliers.indices = blockPixels(support.inliers.indices, w, h, step, within);
-    support.standing_points *= area;
+    support.standing_points *= static_cast<std::size_t>(step * step);
   }
-  focal_ *= static_cast<float>(step); // the full frame's, as getFocalLength says
-  timing_.planes += t_lattice;
-  timing_.objects += ms(t1);
-  return found;
 }
 
 template <typename PointT>
