@@ -230,11 +230,7 @@ private:
     v_.push_back(v);
     const float r = (q - viewpoint_).norm();
     range_.push_back(r);
-    float gap = std::clamp(p_.jump_factor * r / focal_, p_.min_gap, p_.max_gap);
-    if (!noise_half_.empty()) // neighbours on one surface differ by the sensor's noise
-      gap = std::max(
-        gap,
-        noise_half_[std::min(static_cast<std::size_t>(r / kHalfWidthBin), kHalfWidthBins - 1)]);
+    const float gap = connectionGap(p_, r, focal_, noise_half_);
     gap2_.push_back(gap * gap);
   }
   int w_, h_;
@@ -689,6 +685,15 @@ private:
 };
 
 } // namespace
+
+float
+connectionGap(const ObjectSegmentationParameters& params, float range, float focal,
+              const std::vector<float>& noise_half)
+{
+  const float gap = std::clamp(params.jump_factor * range / focal, params.min_gap, params.max_gap);
+  // Neighbours on one surface differ by the sensor's noise.
+  return noise_half.empty() ? gap : std::max(gap, tabulatedHalfWidth(noise_half, range));
+}
 
 float
 estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud)

@@ -51,6 +51,13 @@ struct ObjectSegmentationParameters {
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
 std::string validate(const ObjectSegmentationParameters& params);
 
+/** \brief segmentObjectsOrganized's depth discontinuity at \a range: 4-neighbours farther apart
+ * are not connected. jump_factor times a pixel's footprint (range / \a focal), clamped to
+ * [min_gap, max_gap], and at least the sensor's noise there: \a noise_half, the half-widths of
+ * its band (tabulateHalfWidths; empty: not known). */
+float connectionGap(const ObjectSegmentationParameters& params, float range, float focal,
+                    const std::vector<float>& noise_half);
+
 /** \brief Focal length in pixels of an organized cloud taken by a pinhole camera: the median
  * of x / (u - cx) over finite pixels, with cx = (width - 1) / 2. 0 when it cannot tell. */
 float estimateFocalLength(const pcl::PointCloud<pcl::PointXYZ>& cloud);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -56,6 +57,14 @@ constexpr std::size_t kHalfWidthBins = 2400;
  * entry b is halfWidth((b + 0.5) kHalfWidthBin), for a point at range r in bin r /
  * kHalfWidthBin. */
 std::vector<float> tabulateHalfWidths(const DepthBand& band);
+
+/** \brief The half-width of tabulateHalfWidths' table \a half_widths at \a range (the last bin
+ * beyond it). */
+inline float
+tabulatedHalfWidth(const std::vector<float>& half_widths, float range)
+{
+  return half_widths[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)];
+}
 
 /** \brief The DepthBand of signed \a residuals (distances from a plane) measured at \a
  * ranges (at most 4000 of them, evenly): up to 8 bins of equal counts (at least 150 samples

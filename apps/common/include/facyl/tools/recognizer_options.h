@@ -181,9 +181,8 @@ applyRecognizerOptions(const Arguments& args, facyl::TabletopRecognizerParameter
   auto& g = p.segmentation;
   g.plane_distance =
     static_cast<float>(args.number("--plane-distance", g.plane_distance, 0.0, 1.0));
+  // Its range (0, or 160..8192) is validate's, checked below.
   g.lattice_width = static_cast<int>(args.integer("--lattice-width", g.lattice_width, 0, 8192));
-  if (g.lattice_width > 0 && g.lattice_width < 160)
-    throw std::invalid_argument("--lattice-width: expected 0 (every pixel) or 160..8192");
   const auto heights = pairOption(args, "--height-limits", g.min_height, g.max_height);
   if (!(heights.first >= -10 && heights.second <= 10))
     throw std::invalid_argument("--height-limits: expected -10 <= A < B <= 10 (m)");

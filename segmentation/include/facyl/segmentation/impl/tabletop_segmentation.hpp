@@ -156,8 +156,8 @@ TabletopSegmentation<PointT>::latticeStep() const
 }
 
 namespace detail {
-/** A support's band as classifyPoints reads it: tabulated by range, and not looked up for points
- * within its narrowest half-width. */
+/** A support's band, tabulated by range (tabulateHalfWidths) as classifyPoints reads it, and
+ * not looked up for points within its narrowest half-width. */
 struct TabulatedBand {
   explicit TabulatedBand(const SupportPlane& support)
       : plane(support.plane)
@@ -171,10 +171,7 @@ struct TabulatedBand {
   {
     const float distance = plane.head<3>().dot(p) + plane[3];
     half_width =
-      std::abs(distance) <= floor
-        ? floor
-        : widths[std::min(static_cast<std::size_t>((p - viewpoint).norm() / kHalfWidthBin),
-                          kHalfWidthBins - 1)];
+      std::abs(distance) <= floor ? floor : tabulatedHalfWidth(widths, (p - viewpoint).norm());
     return distance;
   }
   Eigen::Vector4f plane;
@@ -302,6 +299,9 @@ TabletopSegmentation<PointT>::clustersAtFullResolution(const std::vector<Tableto
     // object point (above its support's band, as classifyPoints has it).
     const detail::TabulatedBand* band =
       c.support >= 0 ? &bands[static_cast<std::size_t>(c.support)] : nullptr;
+    // The gap of the block's lattice pixel, computed once for the pixels of its block's row.
+    pcl::index_t gap_of = -1;
+    float gap2 = 0.f;
     const auto continues = [&](pcl::index_t pixel, pcl::index_t parent) {
       const auto& p = full[pixel];
       if (!pcl::isFinite(p))
@@ -309,12 +309,12 @@ TabletopSegmentation<PointT>::clustersAtFullResolution(const std::vector<Tableto
       if (pixel == parent)
         return true;
       const Eigen::Vector3f q = full[parent].getVector3fMap();
-      const float range = (q - viewpoint).norm();
-      float gap = std::clamp(op.jump_factor * range / focal_, op.min_gap, op.max_gap);
-      if (!half.empty())
-        gap = std::max(
-          gap, half[std::min(static_cast<std::size_t>(range / kHalfWidthBin), kHalfWidthBins - 1)]);
-      if (!((p.getVector3fMap() - q).squaredNorm() < gap * gap) ||
+      if (parent != gap_of) {
+        const float gap = connectionGap(op, (q - viewpoint).norm(), focal_, half);
+        gap2 = gap * gap;
+        gap_of = parent;
+      }
+      if (!((p.getVector3fMap() - q).squaredNorm() < gap2) ||
           nearest(pixel % w, pixel / w, p.getVector3fMap()) != static_cast<int>(k))
         return false;
       float half_width = 0.f;
