@@ -28,9 +28,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -161,6 +164,61 @@ BENCHMARK(BM_NormalsAndCurvatures)
   ->Args({1800, 16, 0})
   ->Args({1800, 10, 0})
   ->Args({7200, 16, 0})
+  ->Unit(benchmark::kMillisecond);
+
+/** An organized view of a can (r 6 cm, axis along the image's columns, 0.8 m away; focal
+ * length 525 px): \a rows image rows of 84 pixels, about 79 of them on the can (NaN beside),
+ * depth noise 1% of the radius. */
+Cloud::Ptr
+organizedCan(int rows)
+{
+  const float f = 525.f, r = 0.06f, z0 = 0.8f, noise = 0.01f * r;
+  const int width = 84;
+  facyl::Random random(1);
+  Cloud::Ptr cloud(new Cloud(width, static_cast<std::uint32_t>(rows)));
+  for (int v = 0; v < rows; ++v)
+    for (int u = 0; u < width; ++u) {
+      // The ray t (x, y, 1) meets x^2 + (z - z0)^2 = r^2 first at the smaller root.
+      const float x = (static_cast<float>(u) - 0.5f * width) / f;
+      const float y = (static_cast<float>(v) - 0.5f * static_cast<float>(rows)) / f;
+      const float a = x * x + 1.f, b = -2.f * z0, c = z0 * z0 - r * r;
+      const float disc = b * b - 4.f * a * c;
+      pcl::PointXYZ& p = cloud->at(u, v);
+      if (disc < 0.f) {
+        p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      const float t = (-b - std::sqrt(disc)) / (2.f * a) + noise * random.normal();
+      p = pcl::PointXYZ(t * x, t * y, t);
+    }
+  cloud->is_dense = false;
+  return cloud;
+}
+
+void
+BM_NormalsAndCurvaturesOrganized(benchmark::State& state)
+{
+  // The can's pixels: 23 rows hold about 1,800.
+  const Cloud::Ptr cloud = organizedCan(static_cast<int>(state.range(0)) / 79);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(static_cast<int>(state.range(1)));
+  ne.setNumberOfThreads(static_cast<unsigned>(state.range(2)));
+  ne.setImageNeighbourhoods(state.range(3) != 0);
+  Cues out;
+  for (auto _ : state) {
+    ne.compute(out);
+    benchmark::DoNotOptimize(out);
+  }
+  state.counters["points"] = static_cast<double>(std::count_if(
+    cloud->begin(), cloud->end(), [](const pcl::PointXYZ& p) { return pcl::isFinite(p); }));
+}
+// points, k, threads (0: all cores), image neighbourhoods (0: the kd-tree)
+BENCHMARK(BM_NormalsAndCurvaturesOrganized)
+  ->Args({1800, 16, 1, 1})
+  ->Args({1800, 16, 0, 1})
+  ->Args({1800, 16, 1, 0})
+  ->Args({1800, 16, 0, 0})
   ->Unit(benchmark::kMillisecond);
 
 void

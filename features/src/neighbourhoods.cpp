@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -335,6 +336,146 @@ nearestOnGrid(const Eigen::Matrix3Xf& surface, const Eigen::Matrix3Xf& queries, 
     }
     out.offsets[i + 1] = out.indices.size();
   }
+  return out;
+}
+
+int
+imageWindowRadius(int k)
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::imageWindowRadius: k must be at least 1");
+  int r = 1;
+  while ((2 * r + 1) * (2 * r + 1) < 3 * k)
+    ++r;
+  return r;
+}
+
+namespace {
+
+/** The window of nearestInImage on an image \a width pixels wide: its offsets, nearest the
+ * centre first (the centre first), and each as a step in the pixel index. */
+struct ImageWindow {
+  ImageWindow(int radius, int width)
+      : r(radius)
+  {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx)
+        offsets.emplace_back(dx, dy);
+    std::stable_sort(offsets.begin(), offsets.end(), [](const auto& a, const auto& b) {
+      return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+    });
+    for (const auto& [dx, dy] : offsets)
+      steps.push_back(dy * width + dx);
+  }
+  int r;
+  std::vector<std::pair<int, int>> offsets;
+  std::vector<int> steps;
+};
+
+/** Squared distances from pixel \a q (at \a u, \a v, finite) to the pixels of \a window in
+ * \a d2, in the window's order; infinite for a pixel outside the image or without depth. */
+void
+windowDistances(const Eigen::Matrix3Xf& surface, int width, int height, const ImageWindow& window,
+                int q, int u, int v, std::vector<float>& d2)
+{
+  const Eigen::Vector3f p = surface.col(q);
+  const float* data = surface.data();
+  const bool inside =
+    u >= window.r && u + window.r < width && v >= window.r && v + window.r < height;
+  const float far = std::numeric_limits<float>::infinity();
+  for (std::size_t o = 0; o < window.steps.size(); ++o) {
+    d2[o] = far;
+    if (!inside) {
+      const int x = u + window.offsets[o].first, y = v + window.offsets[o].second;
+      if (x < 0 || x >= width || y < 0 || y >= height)
+        continue;
+    }
+    const float* c = data + 3 * static_cast<std::ptrdiff_t>(q + window.steps[o]);
+    const float d = (c[0] - p.x()) * (c[0] - p.x()) + (c[1] - p.y()) * (c[1] - p.y()) +
+                    (c[2] - p.z()) * (c[2] - p.z());
+    d2[o] = d < far ? d : far; // a pixel without depth (NaN): far
+  }
+}
+
+/** The places in the window of the \a k smallest of \a d2 that are finite, smallest first
+ * (ties to the earlier place), in \a nearest (resized to their count). The k smallest are no
+ * larger than the largest of the first k finite ones, so only those within it compete; each
+ * one's rank among them, counted without a branch, is its place in the answer. */
+void
+smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>& near_d2,
+                 std::vector<std::uint32_t>& near_at, std::vector<std::uint32_t>& nearest)
+{
+  const float far = std::numeric_limits<float>::infinity();
+  float reach = far;
+  for (std::size_t o = 0, seen = 0; o < d2.size(); ++o)
+    if (d2[o] < far && ++seen == k) {
+      reach = 0.f;
+      for (std::size_t b = 0; b <= o; ++b)
+        reach = d2[b] < far ? std::max(reach, d2[b]) : reach;
+      break;
+    }
+  std::size_t c = 0;
+  for (std::size_t o = 0; o < d2.size(); ++o)
+    if (d2[o] <= reach && d2[o] < far) {
+      near_d2[c] = d2[o];
+      near_at[c++] = static_cast<std::uint32_t>(o);
+    }
+  nearest.resize(std::min(k, c));
+  const float* nd = near_d2.data();
+  for (std::size_t a = 0; a < c; ++a) {
+    const float da = nd[a];
+    unsigned rank = 0;
+    for (std::size_t b = 0; b < a; ++b)
+      rank += nd[b] <= da ? 1u : 0u;
+    for (std::size_t b = a + 1; b < c; ++b)
+      rank += nd[b] < da ? 1u : 0u;
+    if (rank < k)
+      nearest[rank] = near_at[a];
+  }
+}
+
+} // namespace
+
+Neighbourhoods
+nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries, int k,
+               int threads)
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::nearestInImage: k must be at least 1");
+  if (width < 1 || surface.cols() % width != 0)
+    throw std::invalid_argument("facyl::nearestInImage: " + std::to_string(surface.cols()) +
+                                " pixels are not rows of width " + std::to_string(width));
+  const Eigen::Index pixels = surface.cols();
+  if (std::any_of(queries.begin(), queries.end(), [&](int q) { return q < 0 || q >= pixels; }))
+    throw std::invalid_argument("facyl::nearestInImage: a query is not a pixel of the surface");
+  const int height = static_cast<int>(pixels / width);
+  const ImageWindow window(imageWindowRadius(k), width);
+  const std::size_t n = queries.size(), size = window.steps.size();
+  const auto kk = static_cast<std::size_t>(k);
+  std::vector<std::uint32_t> found(n * kk);
+  std::vector<std::uint32_t> counts(n, 0);
+  parallelFor(n, threads, kQueryGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<float> d2(size), near_d2(size);
+    std::vector<std::uint32_t> near_at(size), nearest;
+    for (std::size_t i = begin; i < end; ++i) {
+      const int q = queries[i];
+      if (!surface.col(q).allFinite())
+        continue;
+      windowDistances(surface, width, height, window, q, q % width, q / width, d2);
+      smallestInWindow(d2, kk, near_d2, near_at, nearest);
+      for (std::size_t j = 0; j < nearest.size(); ++j)
+        found[i * kk + j] = static_cast<std::uint32_t>(q + window.steps[nearest[j]]);
+      counts[i] = static_cast<std::uint32_t>(nearest.size());
+    }
+  });
+  Neighbourhoods out;
+  out.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    out.offsets[i + 1] = out.offsets[i] + counts[i];
+  out.indices.resize(out.offsets[n]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < counts[i]; ++j)
+      out.indices[out.offsets[i] + j] = static_cast<int>(found[i * kk + j]);
   return out;
 }
 

@@ -92,4 +92,29 @@ private:
 Neighbourhoods nearestOnGrid(const Eigen::Matrix3Xf& surface, const Eigen::Matrix3Xf& queries,
                              int k);
 
+/** \brief Half-width of the image window that nearestInImage searches for \a k neighbours:
+ * the smallest r whose (2r + 1)^2 pixels are at least three times k (k = 16: r = 3, 7 x 7
+ * pixels). On a surface seen at an angle the pixels lie further apart along one image axis
+ * than along the other; a window of 3k pixels still holds the k nearest while that ratio stays
+ * below about 3 (a surface inclined up to about 70 degrees to the line of sight).
+ * \throws std::invalid_argument if k < 1. */
+int imageWindowRadius(int k);
+
+/** \brief The \a k nearest finite pixels to each query pixel among those of the window of
+ * half-width imageWindowRadius(k) centred on it, nearest first (the query itself first), in an
+ * organized cloud: \a surface holds its pixels row by row, \a width to a row, a pixel without
+ * depth not finite. Neighbourhoods from the image grid, without a tree (as
+ * pcl::search::OrganizedNeighbor for organized input): where the window holds the k nearest
+ * points these are NeighbourSearch::nearest's neighbours. Where it does not, the
+ * neighbourhood stays compact in the image: across a depth edge the window holds fewer points
+ * of the query's surface (a tree reaches further along it), and on a surface seen at a
+ * grazing angle (a far floor) a tree takes a strip of the row, the window a patch. Ties go to
+ * the pixel nearer in the image. A query that is not finite gets no neighbour. Runs on
+ * \a threads threads as
+ * NeighbourSearch does; thread-safe (no shared state).
+ * \throws std::invalid_argument if k < 1, width < 1, surface.cols() is not a multiple of
+ * width, or a query is not a pixel of the surface. */
+Neighbourhoods nearestInImage(const Eigen::Matrix3Xf& surface, int width,
+                              const std::vector<int>& queries, int k, int threads = 0);
+
 } // namespace facyl

@@ -24,7 +24,11 @@ namespace facyl {
  * Usage is that of any pcl::Feature: setInputCloud, optionally setIndices and
  * setSearchSurface, then setKSearch(k) or setRadiusSearch(r), then compute(output). Unless a
  * search method is given with setSearchMethod, neighbours come from an internal nanoflann
- * kd-tree (exact, and several times faster than pcl::search::KdTree on small clouds). Points that
+ * kd-tree (exact, and several times faster than pcl::search::KdTree on small clouds), or, for
+ * an organized input (height > 1) searched by k without a search surface, from the image grid
+ * (facyl::nearestInImage: the k nearest pixels of a window around each point, no tree; as PCL
+ * features take pcl::search::OrganizedNeighbor for organized input; see
+ * setImageNeighbourhoods). Points that
  * are not finite or have fewer than 3 finite neighbours get NaN output and make
  * output.is_dense false. Runs in parallel on std::threads (see setNumberOfThreads and
  * facyl::parallelFor: blocks of 256 points, waiting threads sleep rather than spin); the result
@@ -93,6 +97,19 @@ public:
     return threads_;
   }
 
+  /** \brief Whether an organized input (height > 1) searched by k (setKSearch) without a search
+   * surface or search method takes its neighbours from the image grid (nearestInImage);
+   * default true. false: the kd-tree, whatever the input's layout. */
+  void setImageNeighbourhoods(bool use)
+  {
+    image_neighbourhoods_ = use;
+  }
+  /** \brief Whether organized input takes its neighbours from the image grid. */
+  bool getImageNeighbourhoods() const
+  {
+    return image_neighbourhoods_;
+  }
+
 protected:
   bool initCompute() override;
 
@@ -100,13 +117,16 @@ private:
   void computeFeature(PointCloudOut& output) override;
 
   /** Neighbour lists of surface_queries (indices into the input if queries_are_input, else
-   * into the surface), from the PCL search method or the internal kd-tree. */
+   * into the surface), from the PCL search method, the image grid or the internal kd-tree. */
   Neighbourhoods neighbourhoods(const std::vector<int>& surface_queries, bool queries_are_input,
                                 int threads) const;
 
   Eigen::Vector3f view_point_{Eigen::Vector3f::Zero()};
   bool use_sensor_origin_{true};
   bool use_pcl_search_{false};
+  bool image_neighbourhoods_{true};
+  bool use_image_{false};           ///< this compute: neighbours from the image grid
+  Eigen::Matrix3Xf surface_points_; ///< this compute: the surface as columns (own search)
   std::unique_ptr<NeighbourSearch> search_;
   NormalCloudConstPtr input_normals_;
   unsigned int threads_{0};

@@ -71,6 +71,8 @@ NormalCurvatureEstimation<PointInT, PointOutT>::initCompute()
     this->deinitCompute();
     return false;
   }
+  use_image_ = image_neighbourhoods_ && !use_pcl_search_ && this->k_ != 0 &&
+               this->surface_ == this->input_ && this->input_->isOrganized();
   return true;
 }
 
@@ -102,6 +104,9 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
     });
     return Neighbourhoods::fromLists(lists);
   }
+  if (use_image_) // queries are input pixels either way: the surface is the input
+    return nearestInImage(surface_points_, static_cast<int>(surface.width), surface_queries,
+                          this->k_, threads);
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
   for (std::size_t i = 0; i < n; ++i)
     queries.col(static_cast<Eigen::Index>(i)) = query_point(i).getVector3fMap();
@@ -122,12 +127,12 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(nan);
   const int threads = static_cast<int>(threads_); // 0: the hardware's concurrency
 
-  Eigen::Matrix3Xf surface_points;
   if (!use_pcl_search_) {
-    surface_points.resize(3, static_cast<Eigen::Index>(surface.size()));
+    surface_points_.resize(3, static_cast<Eigen::Index>(surface.size()));
     for (std::size_t j = 0; j < surface.size(); ++j)
-      surface_points.col(static_cast<Eigen::Index>(j)) = surface[j].getVector3fMap();
-    search_ = std::make_unique<NeighbourSearch>(surface_points);
+      surface_points_.col(static_cast<Eigen::Index>(j)) = surface[j].getVector3fMap();
+    if (!use_image_)
+      search_ = std::make_unique<NeighbourSearch>(surface_points_);
   }
 
   // Normals oriented towards the view point, so that neighbouring normals agree in sign.
@@ -236,6 +241,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   });
   output.is_dense = dense.load();
   search_.reset();
+  surface_points_.resize(3, 0);
 }
 
 } // namespace facyl
