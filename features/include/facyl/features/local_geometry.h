@@ -118,9 +118,19 @@ principalCurvaturesFromNormals(const Eigen::Vector3f& normal, std::size_t count,
   const float radius = std::sqrt(0.25f * (a - c) * (a - c) + b * b);
   out.k_max = std::max(0.f, half_trace + radius);
   out.k_min = std::max(0.f, half_trace - radius);
-  // Eigenvector of k_max: angle of the major axis.
-  const float angle = 0.5f * std::atan2(2.f * b, a - c);
-  out.direction = (std::cos(angle) * t1 + std::sin(angle) * t2).normalized();
+  // Eigenvector of k_max, from the row of [[a b] [b c]] - k_max I that is best conditioned
+  // (no angle: an atan2, a sine and a cosine were a fifth of the cues' time), signed so that
+  // its t1 component is not negative; t1 when the two curvatures are equal.
+  float x = 1.f, y = 0.f;
+  if (radius > 0.f) {
+    x = a >= c ? 0.5f * (a - c) + radius : b;
+    y = a >= c ? b : 0.5f * (c - a) + radius;
+    if (x < 0.f) {
+      x = -x;
+      y = -y;
+    }
+  }
+  out.direction = (x * t1 + y * t2).normalized();
   return true;
 }
 
