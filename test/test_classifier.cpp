@@ -12,10 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <random>
 
 namespace {
 
@@ -100,6 +103,94 @@ TEST(ClassifierInput, DepthImageHasTheMaskAndTheRelativeDepth)
   EXPECT_TRUE(facyl::classifierImage(empty, {facyl::ClassifierChannels::Depth, 16}).empty());
   EXPECT_TRUE(facyl::classifierImage(empty, {facyl::ClassifierChannels::Rgb, 16}).empty());
   EXPECT_TRUE(facyl::classifierImage(view, {facyl::ClassifierChannels::Depth, 4}).empty());
+}
+
+TEST(ClassifierInput, DepthImageSamplesTheSquaresPixelCentres)
+{
+  // Against the definition (the square's depth per pixel, the last point on a pixel winning,
+  // sampled at size x size pixel centres): a box smaller than the image (each pixel sampled
+  // several times), one larger (pixels skipped), a tall one (padded), points on the same
+  // pixel, holes.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> z01(0.8f, 1.2f);
+  for (const auto& [w, h] : {std::pair<int, int>{9, 9}, {150, 97}, {12, 40}}) {
+    facyl::ObjectView view;
+    std::vector<Eigen::Vector3f> points;
+    std::vector<Eigen::Vector2i> pixels;
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        if ((u * 7 + v * 3) % 11 == 0)
+          continue; // holes
+        for (int again = 0; again < ((u + v) % 5 == 0 ? 2 : 1); ++again) {
+          points.emplace_back(0.001f * static_cast<float>(u), 0.001f * static_cast<float>(v),
+                              z01(rng));
+          pixels.emplace_back(100 + u, 50 + v);
+        }
+      }
+    view.points.resize(3, static_cast<Eigen::Index>(points.size()));
+    view.pixels.resize(2, static_cast<Eigen::Index>(points.size()));
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      view.points.col(static_cast<Eigen::Index>(k)) = points[k];
+      view.pixels.col(static_cast<Eigen::Index>(k)) = pixels[k];
+    }
+    facyl::viewBox(view);
+    ASSERT_EQ(view.box, (facyl::PixelBox{100, 50, 100 + w - 1, 50 + h - 1}));
+    const int size = 32;
+    const auto image = facyl::classifierImage(view, {facyl::ClassifierChannels::Depth, size});
+    ASSERT_EQ(image.size(), 2u * size * size);
+    // The definition.
+    const int side = std::max(w, h), u0 = 100 - (side - w) / 2, v0 = 50 - (side - h) / 2;
+    std::vector<float> square(static_cast<std::size_t>(side * side),
+                              std::numeric_limits<float>::quiet_NaN());
+    std::vector<float> zs;
+    float lo_x = 1e9f, lo_y = 1e9f, hi_x = -1e9f, hi_y = -1e9f;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      square[static_cast<std::size_t>((pixels[k].y() - v0) * side + pixels[k].x() - u0)] =
+        points[k].z();
+      zs.push_back(points[k].z());
+      lo_x = std::min(lo_x, points[k].x());
+      lo_y = std::min(lo_y, points[k].y());
+      hi_x = std::max(hi_x, points[k].x());
+      hi_y = std::max(hi_y, points[k].y());
+    }
+    std::nth_element(zs.begin(), zs.begin() + static_cast<std::ptrdiff_t>(zs.size() / 2), zs.end());
+    const float median = zs[zs.size() / 2];
+    const float extent = std::max(0.01f, std::max(hi_x - lo_x, hi_y - lo_y));
+    const auto source = [&](int i) { return ((2 * i + 1) * side) / (2 * size); };
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const float d = square[static_cast<std::size_t>(source(y) * side + source(x))];
+        const std::size_t o = static_cast<std::size_t>(y * size + x);
+        const int mask = std::isfinite(d) ? 255 : 0;
+        const int relative = std::isfinite(d)
+                               ? static_cast<int>(std::lround(
+                                   128.f + 127.f * std::clamp((d - median) / extent, -1.f, 1.f)))
+                               : 128;
+        ASSERT_EQ(image[o], mask) << w << " x " << h << " at " << x << ", " << y;
+        ASSERT_EQ(image[static_cast<std::size_t>(size * size) + o], relative)
+          << w << " x " << h << " at " << x << ", " << y;
+      }
+  }
+}
+
+TEST(ClassifierInput, ADepthModelGetsViewsWithoutTheCrop)
+{
+  std::vector<int> idx;
+  const Cloud::Ptr cloud = cylinderPatch(idx);
+  const facyl::ObjectView with = facyl::objectView(*cloud, idx, facyl::PinholeCamera{});
+  const facyl::ObjectView without = facyl::objectView(*cloud, idx, facyl::PinholeCamera{}, false);
+  EXPECT_FALSE(with.crop.empty());
+  EXPECT_TRUE(without.crop.empty());
+  EXPECT_EQ(without.box, with.box);
+  const facyl::ClassifierInputSpec depth{facyl::ClassifierChannels::Depth, 64};
+  EXPECT_EQ(facyl::classifierImage(without, depth), facyl::classifierImage(with, depth));
+  // The shipped model reads depth only; a classifier that says nothing gets crops.
+  facyl::CylinderClassifier shipped;
+  EXPECT_TRUE(shipped.usesCrop()); // nothing loaded yet
+  const std::string path = facyl::CylinderClassifier::defaultModelPath();
+  ASSERT_FALSE(path.empty());
+  shipped.load(path);
+  EXPECT_FALSE(shipped.usesCrop());
 }
 
 TEST(ClassifierInput, RgbImageIsTheCropPaddedToASquare)

@@ -147,6 +147,21 @@ depthImage(const ObjectView& view, const Square& sq, int size)
 
 } // namespace
 
+void
+viewBox(ObjectView& view)
+{
+  PixelBox& b = view.box;
+  b = {-1, -1, -1, -1};
+  for (Eigen::Index k = 0; k < view.pixels.cols(); ++k) {
+    const int u = view.pixels(0, k), v = view.pixels(1, k);
+    if (u < 0)
+      continue;
+    if (b[0] < 0)
+      b = {u, v, u, v};
+    b = {std::min(b[0], u), std::min(b[1], v), std::max(b[2], u), std::max(b[3], v)};
+  }
+}
+
 std::vector<std::uint8_t>
 classifierImage(const ObjectView& view, const ClassifierInputSpec& spec)
 {

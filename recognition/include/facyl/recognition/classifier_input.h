@@ -52,11 +52,17 @@ struct ClassifierInputSpec {
 std::vector<std::uint8_t> classifierImage(const ObjectView& view, const ClassifierInputSpec& spec);
 
 /** \brief The view of the points \a indices of \a cloud: box, points, pixels and (for point
- * types with colour) the RGB crop of the box. Organized clouds: pixels from the indices; else
- * projected with \a camera when it is valid (no pixels, box or crop otherwise). */
+ * types with colour, \a with_crop) the RGB crop of the box. Organized clouds: pixels from the
+ * indices; else projected with \a camera when it is valid (no pixels, box or crop otherwise).
+ * A depth-only classifier reads no crop (ShapeClassifier::usesCrop): copying a box of a VGA
+ * frame's points costs more than the classifier's input image. */
 template <typename PointT>
 ObjectView objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-                      const PinholeCamera& camera);
+                      const PinholeCamera& camera, bool with_crop = true);
+
+/** \brief Sets \a view's box from its pixels (-1: unknown); [-1, -1, -1, -1] when it has
+ * none. */
+void viewBox(ObjectView& view);
 
 /** \brief Sets \a view's box from its pixels (-1: unknown) and, for point types with colour,
  * its RGB crop: the box's pixels of an organized \a cloud, else the points \a indices drawn at
@@ -74,17 +80,17 @@ void viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud,
  * box and crop as in objectView. An empty view (no box) when no point is in front. */
 template <typename PointT>
 ObjectView lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-                            const Eigen::Vector3f& viewpoint);
+                            const Eigen::Vector3f& viewpoint, bool with_crop = true);
 
 } // namespace facyl
 
 #define FACYL_INSTANTIATE_objectView(T)                                                            \
   template facyl::ObjectView facyl::objectView<T>(const pcl::PointCloud<T>&, const pcl::Indices&,  \
-                                                  const facyl::PinholeCamera&);                    \
+                                                  const facyl::PinholeCamera&, bool);              \
   template void facyl::viewBoxAndCrop<T>(facyl::ObjectView&, const pcl::PointCloud<T>&,            \
                                          const pcl::Indices&);                                     \
   template facyl::ObjectView facyl::lookAtObjectView<T>(                                           \
-    const pcl::PointCloud<T>&, const pcl::Indices&, const Eigen::Vector3f&);
+    const pcl::PointCloud<T>&, const pcl::Indices&, const Eigen::Vector3f&, bool);
 
 #ifdef PCL_NO_PRECOMPILE
 #include <facyl/recognition/impl/classifier_input.hpp>

@@ -96,6 +96,12 @@ public:
    * see classifierImage); for tests and training checks. */
   std::vector<float> probabilitiesOfImages(const std::vector<std::vector<std::uint8_t>>& images);
   std::string name() const override;
+  /** \brief Whether the loaded model reads colour (channels rgb or depthrgb); true before a
+   * load. */
+  bool usesCrop() const override
+  {
+    return !loaded() || info_.input.channels != ClassifierChannels::Depth;
+  }
 
 private:
   struct Network;

@@ -70,6 +70,12 @@ public:
   }
   /** \brief A short name for reports. */
   virtual std::string name() const = 0;
+  /** \brief Whether cylinderProbability reads the views' RGB crop (ObjectView::crop); false
+   * lets the recognizer skip copying it (the default: true). */
+  virtual bool usesCrop() const
+  {
+    return true;
+  }
 };
 
 } // namespace facyl

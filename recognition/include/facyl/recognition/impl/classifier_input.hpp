@@ -16,7 +16,7 @@ namespace facyl {
 template <typename PointT>
 ObjectView
 objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-           const PinholeCamera& camera)
+           const PinholeCamera& camera, bool with_crop)
 {
   ObjectView view;
   const auto n = static_cast<Eigen::Index>(indices.size());
@@ -40,7 +40,10 @@ objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
       }
     }
   }
-  viewBoxAndCrop(view, cloud, indices);
+  if (with_crop)
+    viewBoxAndCrop(view, cloud, indices);
+  else
+    viewBox(view);
   return view;
 }
 
@@ -49,19 +52,12 @@ void
 viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices)
 {
   const auto n = static_cast<Eigen::Index>(indices.size());
-  view.box = {-1, -1, -1, -1};
   view.crop = RgbImage{};
-  if (view.pixels.cols() != n)
+  if (view.pixels.cols() != n) {
+    view.box = {-1, -1, -1, -1};
     return;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const int u = view.pixels(0, k), v = view.pixels(1, k);
-    if (u < 0)
-      continue;
-    auto& b = view.box;
-    if (b[0] < 0)
-      b = {u, v, u, v};
-    b = {std::min(b[0], u), std::min(b[1], v), std::max(b[2], u), std::max(b[3], v)};
   }
+  viewBox(view);
   if constexpr (pcl::traits::has_color_v<PointT>) {
     const PixelBox& b = view.box;
     if (b[0] < 0)
@@ -93,7 +89,7 @@ viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl
 template <typename PointT>
 ObjectView
 lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
-                 const Eigen::Vector3f& viewpoint)
+                 const Eigen::Vector3f& viewpoint, bool with_crop)
 {
   ObjectView view;
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
@@ -138,7 +134,10 @@ lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indic
     view.pixels(0, k) = static_cast<int>(std::lround(f * (c.x() / c.z() - tangent.min().x())));
     view.pixels(1, k) = static_cast<int>(std::lround(f * (c.y() / c.z() - tangent.min().y())));
   }
-  viewBoxAndCrop(view, cloud, indices);
+  if (with_crop)
+    viewBoxAndCrop(view, cloud, indices);
+  else
+    viewBox(view);
   return view;
 }
 

@@ -407,9 +407,10 @@ template <typename PointT>
 ObjectView
 TabletopCylinderRecognizer<PointT>::viewOf(const pcl::Indices& indices) const
 {
+  const bool with_crop = !classifier_ || classifier_->usesCrop();
   if (input_->isOrganized() || camera_.valid())
-    return objectView(*input_, indices, camera_);
-  return lookAtObjectView(*input_, indices, input_->sensor_origin_.head(3));
+    return objectView(*input_, indices, camera_, with_crop);
+  return lookAtObjectView(*input_, indices, input_->sensor_origin_.head(3), with_crop);
 }
 
 template <typename PointT>
