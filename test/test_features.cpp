@@ -332,6 +332,29 @@ TEST(NormalCurvatureEstimation, OrganizedInputTakesTheImagesNeighbours)
   }
 }
 
+TEST(NormalCurvatureEstimation, AMisshapenOrganizedCloudGetsTheTree)
+{
+  // width x height that is not the cloud's size (fields set by hand): no image grid, no
+  // exception; the kd-tree's cues.
+  const auto cloud = cylinderXYZ(0.01f, 6);
+  const std::size_t n = cloud->size();
+  cloud->width = static_cast<std::uint32_t>((n - 1) / 2);
+  cloud->height = 2; // one point more than 2 rows
+  ASSERT_NE(static_cast<std::size_t>(cloud->width) * cloud->height, n);
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
+  ne.setInputCloud(cloud);
+  ne.setKSearch(16);
+  Cues image, tree;
+  ASSERT_NO_THROW(ne.compute(image));
+  ne.setImageNeighbourhoods(false);
+  ne.compute(tree);
+  ASSERT_EQ(image.size(), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(image[i].normal_x, tree[i].normal_x);
+    EXPECT_EQ(image[i].pc1, tree[i].pc1);
+  }
+}
+
 TEST(NormalCurvatureEstimation, CylinderNormalsAreRadialAndCurvatureCircumferential)
 {
   const auto cloud = cylinderXYZ(0.f, 1);

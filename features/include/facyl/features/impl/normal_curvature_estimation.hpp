@@ -71,8 +71,11 @@ NormalCurvatureEstimation<PointInT, PointOutT>::initCompute()
     this->deinitCompute();
     return false;
   }
+  // An organized cloud whose size is not width x height (built by hand) gets the tree.
   use_image_ = image_neighbourhoods_ && !use_pcl_search_ && this->k_ != 0 &&
-               this->surface_ == this->input_ && this->input_->isOrganized();
+               this->surface_ == this->input_ && this->input_->isOrganized() &&
+               this->input_->size() == static_cast<std::size_t>(this->input_->width) *
+                                         static_cast<std::size_t>(this->input_->height);
   return true;
 }
 
