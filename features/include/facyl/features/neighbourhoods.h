@@ -110,8 +110,7 @@ int imageWindowRadius(int k);
  * of the query's surface (a tree reaches further along it), and on a surface seen at a
  * grazing angle (a far floor) a tree takes a strip of the row, the window a patch. Ties go to
  * the pixel nearer in the image. A query that is not finite gets no neighbour. Runs on
- * \a threads threads as
- * NeighbourSearch does; thread-safe (no shared state).
+ * \a threads threads as NeighbourSearch does; thread-safe (no shared state).
  * \throws std::invalid_argument if k < 1, width < 1, surface.cols() is not a multiple of
  * width, or a query is not a pixel of the surface. */
 Neighbourhoods nearestInImage(const Eigen::Matrix3Xf& surface, int width,

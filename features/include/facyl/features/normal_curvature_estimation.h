@@ -28,11 +28,10 @@ namespace facyl {
  * an organized input (height > 1) searched by k without a search surface, from the image grid
  * (facyl::nearestInImage: the k nearest pixels of a window around each point, no tree; as PCL
  * features take pcl::search::OrganizedNeighbor for organized input; see
- * setImageNeighbourhoods). Points that
- * are not finite or have fewer than 3 finite neighbours get NaN output and make
- * output.is_dense false. Runs in parallel on std::threads (see setNumberOfThreads and
- * facyl::parallelFor: blocks of 256 points, waiting threads sleep rather than spin); the result
- * does not depend on the number of threads.
+ * setImageNeighbourhoods). Points that are not finite or have fewer than 3 finite neighbours
+ * get NaN output and make output.is_dense false. Runs in parallel on std::threads (see
+ * setNumberOfThreads and facyl::parallelFor: blocks of 256 points, waiting threads sleep rather
+ * than spin); the result does not depend on the number of threads.
  *
  * If the normals are known already, give them with setInputNormals (one per point of the
  * search surface): only the curvatures are then computed.
@@ -97,9 +96,9 @@ public:
     return threads_;
   }
 
-  /** \brief Whether an organized input (height > 1) searched by k (setKSearch) without a search
-   * surface or search method takes its neighbours from the image grid (nearestInImage);
-   * default true. false: the kd-tree, whatever the input's layout. */
+  /** \brief Whether an organized input (height > 1, width x height points) searched by k
+   * (setKSearch) without a search surface or search method takes its neighbours from the image
+   * grid (nearestInImage); default true. false: the kd-tree, whatever the input's layout. */
   void setImageNeighbourhoods(bool use)
   {
     image_neighbourhoods_ = use;
