@@ -406,13 +406,14 @@ smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>
                  std::vector<std::uint32_t>& near_at, std::vector<std::uint32_t>& nearest)
 {
   const float far = std::numeric_limits<float>::infinity();
-  float reach = far;
+  float reach = far, furthest = 0.f;
   for (std::size_t o = 0, seen = 0; o < d2.size(); ++o)
-    if (d2[o] < far && ++seen == k) {
-      reach = 0.f;
-      for (std::size_t b = 0; b <= o; ++b)
-        reach = d2[b] < far ? std::max(reach, d2[b]) : reach;
-      break;
+    if (d2[o] < far) {
+      furthest = std::max(furthest, d2[o]);
+      if (++seen == k) {
+        reach = furthest;
+        break;
+      }
     }
   std::size_t c = 0;
   for (std::size_t o = 0; o < d2.size(); ++o)

@@ -64,13 +64,13 @@ ObjectView objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& 
  * none. */
 void viewBox(ObjectView& view);
 
-/** \brief Sets \a view's box from its pixels (-1: unknown) and, for point types with colour,
- * its RGB crop: the box's pixels of an organized \a cloud, else the points \a indices drawn at
- * their pixels (black elsewhere). For views whose pixels come from elsewhere (a file's
- * image coordinates). */
+/** \brief Sets \a view's box from its pixels (-1: unknown) and, for point types with colour
+ * and \a with_crop, its RGB crop: the box's pixels of an organized \a cloud, else the points
+ * \a indices drawn at their pixels (black elsewhere); without \a with_crop the crop stays
+ * empty. For views whose pixels come from elsewhere (a file's image coordinates). */
 template <typename PointT>
 void viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud,
-                    const pcl::Indices& indices);
+                    const pcl::Indices& indices, bool with_crop = true);
 
 /** \brief The view of the points \a indices of \a cloud by a virtual pinhole camera at \a
  * viewpoint looking at their centroid (its x axis along the cloud's x as far as possible):
@@ -88,7 +88,7 @@ ObjectView lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Ind
   template facyl::ObjectView facyl::objectView<T>(const pcl::PointCloud<T>&, const pcl::Indices&,  \
                                                   const facyl::PinholeCamera&, bool);              \
   template void facyl::viewBoxAndCrop<T>(facyl::ObjectView&, const pcl::PointCloud<T>&,            \
-                                         const pcl::Indices&);                                     \
+                                         const pcl::Indices&, bool);                               \
   template facyl::ObjectView facyl::lookAtObjectView<T>(                                           \
     const pcl::PointCloud<T>&, const pcl::Indices&, const Eigen::Vector3f&, bool);
 

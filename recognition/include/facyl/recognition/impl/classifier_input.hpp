@@ -40,16 +40,14 @@ objectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
       }
     }
   }
-  if (with_crop)
-    viewBoxAndCrop(view, cloud, indices);
-  else
-    viewBox(view);
+  viewBoxAndCrop(view, cloud, indices, with_crop);
   return view;
 }
 
 template <typename PointT>
 void
-viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices)
+viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+               bool with_crop)
 {
   const auto n = static_cast<Eigen::Index>(indices.size());
   view.crop = RgbImage{};
@@ -58,6 +56,8 @@ viewBoxAndCrop(ObjectView& view, const pcl::PointCloud<PointT>& cloud, const pcl
     return;
   }
   viewBox(view);
+  if (!with_crop)
+    return;
   if constexpr (pcl::traits::has_color_v<PointT>) {
     const PixelBox& b = view.box;
     if (b[0] < 0)
@@ -134,10 +134,7 @@ lookAtObjectView(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indic
     view.pixels(0, k) = static_cast<int>(std::lround(f * (c.x() / c.z() - tangent.min().x())));
     view.pixels(1, k) = static_cast<int>(std::lround(f * (c.y() / c.z() - tangent.min().y())));
   }
-  if (with_crop)
-    viewBoxAndCrop(view, cloud, indices);
-  else
-    viewBox(view);
+  viewBoxAndCrop(view, cloud, indices, with_crop);
   return view;
 }
 
