@@ -41,6 +41,54 @@ cylinderXYZ(float noise, std::uint64_t seed)
     cloud->push_back(pcl::PointXYZ(q.x, q.y, q.z));
   return cloud;
 }
+
+/** An organized view (\a width x \a height pixels) of a noisy bump on a slanted plane, a
+ * tenth of the pixels without depth. */
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+organizedBump(int width, int height, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.f, 0.001f);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(
+    static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      const float x = 0.004f * static_cast<float>(u - width / 2);
+      const float y = 0.004f * static_cast<float>(v - height / 2);
+      const float z = 1.f + 0.3f * y + 0.05f * std::exp(-(x * x + y * y) / 0.002f) + noise(rng);
+      cloud->at(u, v) = u01(rng) < 0.1f ? pcl::PointXYZ(nan, nan, nan) : pcl::PointXYZ(x, y, z);
+    }
+  cloud->is_dense = false;
+  return cloud;
+}
+
+/** Whether two float fields are the same value (NaN equals NaN). */
+bool
+same(float a, float b)
+{
+  return a == b || (std::isnan(a) && std::isnan(b));
+}
+
+/** Whether \a a and \a b hold the same normals and curvatures, bit for bit but for NaNs. */
+bool
+sameCues(const Cues& a, const Cues& b)
+{
+  if (a.size() != b.size() || a.is_dense != b.is_dense)
+    return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto &p = a[i], &q = b[i];
+    if (!same(p.normal_x, q.normal_x) || !same(p.normal_y, q.normal_y) ||
+        !same(p.normal_z, q.normal_z) || !same(p.curvature, q.curvature) ||
+        !same(p.principal_curvature_x, q.principal_curvature_x) ||
+        !same(p.principal_curvature_y, q.principal_curvature_y) ||
+        !same(p.principal_curvature_z, q.principal_curvature_z) || !same(p.pc1, q.pc1) ||
+        !same(p.pc2, q.pc2))
+      return false;
+  }
+  return true;
+}
 } // namespace
 
 TEST(NeighbourSearch, MatchesBruteForce)
@@ -225,6 +273,16 @@ TEST(NeighbourSearch, ImageNeighboursAreTheWindowsNearest)
     EXPECT_EQ(nb.begin(i)[0], q); // the query first
     for (std::size_t j = 0; j < nb.count(i); ++j)
       EXPECT_EQ(nb.begin(i)[j], window[j].second) << "pixel " << q << ", neighbour " << j;
+  }
+  // Lists written into a reused Neighbourhoods (which held more queries, then fewer) are the
+  // lists of a fresh one.
+  facyl::Neighbourhoods reused = facyl::nearestInImage(pixels, width, queries, k, 2);
+  for (const std::size_t count : {queries.size() / 3, queries.size()}) {
+    const std::vector<int> some(queries.begin(), queries.begin() + static_cast<long>(count));
+    facyl::nearestInImage(pixels, width, some, k, reused, 2);
+    const facyl::Neighbourhoods fresh = facyl::nearestInImage(pixels, width, some, k, 1);
+    EXPECT_EQ(reused.offsets, fresh.offsets);
+    EXPECT_EQ(reused.indices, fresh.indices);
   }
   EXPECT_THROW(facyl::nearestInImage(pixels, width, queries, 0), std::invalid_argument);
   EXPECT_THROW(facyl::nearestInImage(pixels, 22, queries, k), std::invalid_argument);
@@ -469,6 +527,42 @@ TEST(NormalCurvatureEstimation, ThreadsAndSearchMethodsAgree)
     EXPECT_EQ(one[i].pc1, two[i].pc1);
     EXPECT_NEAR(one[i].normal_x, pcl_tree[i].normal_x, 1e-5f);
     EXPECT_NEAR(one[i].pc1, pcl_tree[i].pc1, 1e-5f + 1e-4f * one[i].pc1);
+  }
+}
+
+TEST(NormalCurvatureEstimation, OneEstimatorGivesEachCloudItsOwnCues)
+{
+  // compute() keeps its working buffers between calls (a stream allocates nothing): one
+  // estimator over clouds of other sizes and layouts, with and without indices, gives what a
+  // fresh estimator gives each.
+  const auto big = organizedBump(60, 40, 1), small = organizedBump(30, 20, 2);
+  const auto scattered = cylinderXYZ(0.01f, 3);
+  pcl::IndicesPtr some(new pcl::Indices);
+  for (int i = 0; i < static_cast<int>(big->size()); i += 3)
+    some->push_back(i);
+  struct Run {
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+    pcl::IndicesPtr indices;
+  };
+  const std::vector<Run> runs = {{big, nullptr}, {small, nullptr}, {scattered, nullptr},
+                                 {big, some},    {small, nullptr}, {big, nullptr}};
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ> reused;
+  reused.setKSearch(16);
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    facyl::NormalCurvatureEstimation<pcl::PointXYZ> fresh;
+    fresh.setKSearch(16);
+    for (auto* ne : {&reused, &fresh}) {
+      ne->setInputCloud(runs[r].cloud);
+      if (runs[r].indices)
+        ne->setIndices(runs[r].indices);
+      else
+        ne->setIndices(pcl::IndicesPtr());
+    }
+    Cues a, b;
+    reused.compute(a);
+    fresh.compute(b);
+    ASSERT_FALSE(a.empty()) << "run " << r;
+    EXPECT_TRUE(sameCues(a, b)) << "run " << r;
   }
 }
 

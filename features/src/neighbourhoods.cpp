@@ -437,9 +437,9 @@ smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>
 
 } // namespace
 
-Neighbourhoods
+void
 nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries, int k,
-               int threads)
+               Neighbourhoods& out, int threads)
 {
   if (k < 1)
     throw std::invalid_argument("facyl::nearestInImage: k must be at least 1");
@@ -453,8 +453,11 @@ nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int
   const ImageWindow window(imageWindowRadius(k), width);
   const std::size_t n = queries.size(), size = window.steps.size();
   const auto kk = static_cast<std::size_t>(k);
-  std::vector<std::uint32_t> found(n * kk);
-  std::vector<std::uint32_t> counts(n, 0);
+  // Query i's neighbours first go to indices[i * k ...] and its count to offsets[i + 1]; the
+  // lists are then packed in place (each moves towards the front, in order), so a reused
+  // \a out allocates nothing.
+  out.indices.resize(n * kk);
+  out.offsets.assign(n + 1, 0);
   parallelFor(n, threads, kQueryGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<float> d2(size), near_d2(size);
     std::vector<std::uint32_t> near_at(size), nearest;
@@ -465,18 +468,25 @@ nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int
       windowDistances(surface, width, height, window, q, q % width, q / width, d2);
       smallestInWindow(d2, kk, near_d2, near_at, nearest);
       for (std::size_t j = 0; j < nearest.size(); ++j)
-        found[i * kk + j] = static_cast<std::uint32_t>(q + window.steps[nearest[j]]);
-      counts[i] = static_cast<std::uint32_t>(nearest.size());
+        out.indices[i * kk + j] = q + window.steps[nearest[j]];
+      out.offsets[i + 1] = nearest.size();
     }
   });
-  Neighbourhoods out;
-  out.offsets.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    out.offsets[i + 1] = out.offsets[i] + counts[i];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t count = out.offsets[i + 1];
+    out.offsets[i + 1] = out.offsets[i] + count;
+    std::copy_n(out.indices.begin() + static_cast<std::ptrdiff_t>(i * kk), count,
+                out.indices.begin() + static_cast<std::ptrdiff_t>(out.offsets[i]));
+  }
   out.indices.resize(out.offsets[n]);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < counts[i]; ++j)
-      out.indices[out.offsets[i] + j] = static_cast<int>(found[i * kk + j]);
+}
+
+Neighbourhoods
+nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries, int k,
+               int threads)
+{
+  Neighbourhoods out;
+  nearestInImage(surface, width, queries, k, out, threads);
   return out;
 }
 

@@ -116,4 +116,10 @@ int imageWindowRadius(int k);
 Neighbourhoods nearestInImage(const Eigen::Matrix3Xf& surface, int width,
                               const std::vector<int>& queries, int k, int threads = 0);
 
+/** \brief nearestInImage into \a out, whose storage is reused: a caller that keeps \a out
+ * between frames allocates nothing once it has held the largest frame's lists.
+ * \throws std::invalid_argument as nearestInImage. */
+void nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries,
+                    int k, Neighbourhoods& out, int threads = 0);
+
 } // namespace facyl

@@ -80,9 +80,10 @@ NormalCurvatureEstimation<PointInT, PointOutT>::initCompute()
 }
 
 template <typename PointInT, typename PointOutT>
-Neighbourhoods
+void
 NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
-  const std::vector<int>& surface_queries, bool queries_are_input, int threads) const
+  const std::vector<int>& surface_queries, bool queries_are_input, int threads,
+  Neighbourhoods& out) const
 {
   const auto& input = *this->input_;
   const auto& surface = *this->surface_;
@@ -105,17 +106,19 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
                                    distances);
       }
     });
-    return Neighbourhoods::fromLists(lists);
+    out = Neighbourhoods::fromLists(lists);
+    return;
   }
-  if (use_image_) // queries are input pixels either way: the surface is the input
-    return nearestInImage(surface_points_, static_cast<int>(surface.width), surface_queries,
-                          this->k_, threads);
+  if (use_image_) { // queries are input pixels either way: the surface is the input
+    nearestInImage(surface_points_, static_cast<int>(surface.width), surface_queries, this->k_, out,
+                   threads);
+    return;
+  }
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
   for (std::size_t i = 0; i < n; ++i)
     queries.col(static_cast<Eigen::Index>(i)) = query_point(i).getVector3fMap();
-  return this->k_ != 0
-           ? search_->nearest(queries, this->k_, threads)
-           : search_->within(queries, static_cast<float>(this->search_radius_), threads);
+  out = this->k_ != 0 ? search_->nearest(queries, this->k_, threads)
+                      : search_->within(queries, static_cast<float>(this->search_radius_), threads);
 }
 
 template <typename PointInT, typename PointOutT>
@@ -153,11 +156,15 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
     return true;
   };
 
-  // 1. One neighbourhood query per point, and the query points' normals.
-  const std::vector<int> query_indices(indices.begin(), indices.end());
-  const Neighbourhoods nb = neighbourhoods(query_indices, true, threads);
-  std::vector<Eigen::Vector3f> normals(n, nan3);
-  std::vector<float> variation(n, nan);
+  // 1. One neighbourhood query per point, and the query points' normals. The working buffers
+  //    are members: a stream of frames allocates nothing once they hold the largest frame.
+  query_indices_.assign(indices.begin(), indices.end());
+  neighbourhoods(query_indices_, true, threads, nb_);
+  const Neighbourhoods& nb = nb_;
+  std::vector<Eigen::Vector3f>& normals = normals_;
+  std::vector<float>& variation = variation_;
+  normals.assign(n, nan3);
+  variation.assign(n, nan);
   if (input_normals_) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto& m = (*input_normals_)[indices[i]];
@@ -181,7 +188,8 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
 
   // 2. A normal at every neighbour. In the common case (no search surface, no indices) the
   //    neighbours are the query points; otherwise the others get their own PCA normal.
-  std::vector<Eigen::Vector3f> surface_normals(surface.size(), nan3);
+  std::vector<Eigen::Vector3f>& surface_normals = surface_normals_;
+  surface_normals.assign(surface.size(), nan3);
   if (input_normals_) {
     for (std::size_t j = 0; j < surface.size(); ++j) {
       const auto& m = (*input_normals_)[j];
@@ -189,20 +197,23 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
     }
   }
   else {
-    std::vector<char> known(surface.size(), 0);
+    std::vector<char>& known = known_;
+    known.assign(surface.size(), 0);
     if (this->fake_surface_)
       for (std::size_t i = 0; i < n; ++i) {
         surface_normals[indices[i]] = normals[i];
         known[indices[i]] = 1;
       }
-    std::vector<int> missing;
+    std::vector<int>& missing = missing_;
+    missing.clear();
     for (const int j : nb.indices)
       if (!known[j]) {
         known[j] = 1;
         missing.push_back(j);
       }
     if (!missing.empty()) {
-      const Neighbourhoods extra = neighbourhoods(missing, false, threads);
+      neighbourhoods(missing, false, threads, extra_nb_);
+      const Neighbourhoods& extra = extra_nb_;
       parallelFor(missing.size(), threads, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t s = begin; s < end; ++s) {
           float sv;
@@ -244,7 +255,6 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
   });
   output.is_dense = dense.load();
   search_.reset();
-  surface_points_.resize(3, 0);
 }
 
 } // namespace facyl
