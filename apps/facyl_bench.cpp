@@ -301,7 +301,7 @@ printHelp(const char* self)
     "Usage: %s [options]\n"
     "Robustness study of the paper's Fig. 10 against PCL SACMODEL_CYLINDER.\n"
     "  --scenes N     cylinders per setting (default 1000, as in the paper)\n"
-    "  --quick        50 scenes (a smoke test; about a minute on 2 cores)\n"
+    "  --quick        50 scenes (a smoke test; about 4 minutes on 2 cores)\n"
     "  --settings S   paper,practical (default both): paper = r 0.3 m, vertical axis;\n"
     "                 practical = random axis, r 0.02-0.3 m, a table-like plane beside it;\n"
     "                 random = random axis, r 0.02-0.3 m, nothing else (other cylinders)\n"
