@@ -32,7 +32,7 @@ namespace facyl {
  * get NaN output and make output.is_dense false. Runs in parallel on std::threads (see
  * setNumberOfThreads and facyl::parallelFor: blocks of 256 points, waiting threads sleep rather
  * than spin); the result does not depend on the number of threads. compute() keeps its working
- * buffers between calls (about 120 bytes per point of the largest input with k = 16: 37 MB
+ * buffers between calls (about 115 bytes per point of the largest input with k = 16: 35 MB
  * after a VGA frame), so that an estimator reused frame after frame allocates nothing; destroy
  * it to free them. One estimator serves one thread at a time.
  *
@@ -132,7 +132,7 @@ private:
   Eigen::Matrix3Xf surface_points_; ///< this compute: the surface as columns (own search)
   // Working buffers of compute(), kept between calls so that a stream of frames does not
   // allocate (and return to the system) memory on every call.
-  std::vector<int> query_indices_, missing_;
+  std::vector<int> missing_;
   Neighbourhoods nb_, extra_nb_;
   std::vector<Eigen::Vector3f> normals_, surface_normals_;
   std::vector<float> variation_;

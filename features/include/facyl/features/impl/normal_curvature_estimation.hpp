@@ -13,6 +13,7 @@
 #include <atomic>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace facyl {
@@ -158,8 +159,10 @@ NormalCurvatureEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& ou
 
   // 1. One neighbourhood query per point, and the query points' normals. The working buffers
   //    are members: a stream of frames allocates nothing once they hold the largest frame.
-  query_indices_.assign(indices.begin(), indices.end());
-  neighbourhoods(query_indices_, true, threads, nb_);
+  static_assert(std::is_same_v<pcl::Indices, std::vector<int>>,
+                "the indices are passed as neighbour queries: pcl::index_t must be int (PCL's "
+                "default)");
+  neighbourhoods(indices, true, threads, nb_);
   const Neighbourhoods& nb = nb_;
   std::vector<Eigen::Vector3f>& normals = normals_;
   std::vector<float>& variation = variation_;
