@@ -2,7 +2,7 @@
  * facyl_crops: the shape classifier's data. Runs the tabletop recognizer (without a
  * classifier) on simulated scenes and writes, for every object it reports, the network's input
  * images (classifierImage, both channel sets) and one CSV row: the ground truth and the fit's
- * evidence (fusionFeatures). Also the single-object crops of the UW RGB-D Object dataset, and
+ * evidence (evidenceFeatures). Also the single-object crops of the UW RGB-D Object dataset, and
  * real crops harvested from mOSD's scenes of boxes only.
  * recognition/training reads what it writes; with --model the rows also get the network's
  * probability from CylinderClassifier (the C++ side of a model, for checks and evaluation).
@@ -101,9 +101,9 @@ public:
     csv_.open(dir + "/objects.csv");
     if (!rgb_ || !depth_ || !csv_)
       throw std::invalid_argument("cannot write to " + dir);
-    csv_ << "row,source,scene,object,kind,label,purity,n_points,fitted,accept_geometry,"
+    csv_ << "row,source,scene,object,kind,label,purity,n_points,fitted,passes_gates,"
             "inlier_ratio,surface_ratio";
-    for (std::size_t i = 0; i < facyl::kFusionFeatures; ++i)
+    for (std::size_t i = 0; i < facyl::kEvidenceFeatures; ++i)
       csv_ << ",f" << i;
     csv_ << ",p_network\n";
   }
@@ -121,11 +121,10 @@ public:
                 static_cast<std::streamsize>(image.size()));
     }
     const facyl::CylinderDecision decision;
-    const auto f =
-      facyl::fusionFeatures(std::numeric_limits<float>::quiet_NaN(), evidence, decision);
+    const auto f = facyl::evidenceFeatures(std::numeric_limits<float>::quiet_NaN(), evidence);
     csv_ << rows_++ << "," << source << "," << scene << "," << object << "," << kind << "," << label
          << "," << purity << "," << view.points.cols() << "," << evidence.fitted << ","
-         << facyl::acceptGeometry(evidence, decision) << "," << evidence.inlier_ratio << ","
+         << facyl::passesGates(evidence, decision) << "," << evidence.inlier_ratio << ","
          << evidence.surface_ratio;
     for (const float x : f)
       csv_ << "," << x;

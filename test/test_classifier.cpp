@@ -264,34 +264,76 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
             std::string::npos);
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 4\n", info), "");
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2\n", info), "");
+  // The evidence model of an older facyl (9 weights) is refused, naming what it expects.
+  EXPECT_NE(
+    facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info)
+      .find("15 finite numbers"),
+    std::string::npos);
   EXPECT_NE(
     facyl::parseClassifierModelInfo("channels rgb\nsize 64\nwidth 3\n", info).find("unknown key"),
     std::string::npos);
   EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb 3\nsize 64\n", info), "");
 }
 
-TEST(CylinderEvidence, FusionFeaturesAndProbability)
+TEST(CylinderEvidence, EvidenceFeaturesAndProbability)
 {
   facyl::CylinderEvidence e;
   e.fitted = true;
   e.surface_ratio = 0.9f;
   e.inlier_ratio = 0.7f;
   e.angular_coverage = 0.4f;
-  const facyl::CylinderDecision d;
-  const auto f = facyl::fusionFeatures(0.5f, e, d);
+  const auto f = facyl::evidenceFeatures(0.5f, e);
   EXPECT_EQ(f[0], 1.f);
-  EXPECT_NEAR(f[1], 0.f, 1e-6f);
-  EXPECT_EQ(f[2], 0.9f);
-  EXPECT_EQ(f[4], 1.f); // unknown curvature ratio
-  EXPECT_EQ(f[8], 1.f); // the geometric rule holds
-  std::array<float, facyl::kFusionFeatures> w{};
-  w[1] = 1.f;
-  EXPECT_NEAR(facyl::fusedProbability(w, 0.8f, e, d), 0.8f, 1e-5f);
+  EXPECT_EQ(f[1], 0.9f);
+  EXPECT_EQ(f[2], 0.7f);
+  EXPECT_EQ(f[3], 1.f);           // unknown curvature ratio
+  EXPECT_EQ(f[7], 8.f);           // unknown normal agreement: the worst
+  EXPECT_EQ(f[8], 1.f);           // unknown normal concentration: the worst
+  EXPECT_EQ(f[9], 0.f);           // unknown profile range: no evidence against
+  EXPECT_NEAR(f[14], 0.f, 1e-6f); // logit(0.5)
+  EXPECT_EQ(facyl::evidenceFeatures(std::nanf(""), e)[14], 0.f); // no network
+  std::array<float, facyl::kEvidenceFeatures> w{};
+  w[14] = 1.f;
+  EXPECT_NEAR(facyl::evidenceProbability(w, 0.8f, e), 0.8f, 1e-5f);
   w = {};
-  w[8] = -2.f;
-  EXPECT_NEAR(facyl::fusedProbability(w, 0.8f, e, d), 1.f / (1.f + std::exp(2.f)), 1e-6f);
-  EXPECT_TRUE(std::isfinite(facyl::fusionFeatures(0.f, e, d)[1]));
-  EXPECT_TRUE(std::isfinite(facyl::fusionFeatures(1.f, e, d)[1]));
+  w[1] = -2.f / 0.9f;
+  EXPECT_NEAR(facyl::evidenceProbability(w, 0.8f, e), 1.f / (1.f + std::exp(2.f)), 1e-6f);
+  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(0.f, e)[14]));
+  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(1.f, e)[14]));
+  // A bowl's inside (shallower than wide) against a cup's.
+  e.shape.inner_share = 0.4f;
+  e.shape.aspect = 0.25f;
+  EXPECT_NEAR(facyl::evidenceFeatures(0.5f, e)[13], 0.3f, 1e-6f);
+  e.shape.aspect = 1.5f;
+  EXPECT_EQ(facyl::evidenceFeatures(0.5f, e)[13], 0.f);
+}
+
+TEST(CylinderEvidence, TheEvidenceModelDecidesAmongTheFitsThatPassTheGates)
+{
+  facyl::CylinderDecision d;
+  facyl::CylinderEvidence e;
+  EXPECT_FALSE(facyl::acceptCylinder(e, d)); // not fitted
+  EXPECT_EQ(facyl::geometricProbability(e, d), 0.f);
+  e.fitted = true;
+  e.surface_ratio = e.inlier_ratio = 0.9f;
+  e.angular_coverage = 0.4f;
+  d.geometry_weights = {};
+  d.geometry_weights[0] = 1.f; // p = 0.73 whatever the evidence
+  EXPECT_TRUE(facyl::acceptGeometry(e, d));
+  EXPECT_TRUE(facyl::acceptCylinder(e, d));
+  e.p_cylinder = 0.2f; // known (a classifier's fusion): it decides
+  EXPECT_FALSE(facyl::acceptCylinder(e, d));
+  EXPECT_TRUE(facyl::acceptGeometry(e, d)); // the geometric decision alone
+  e.p_cylinder = 0.9f;
+  EXPECT_TRUE(facyl::acceptCylinder(e, d));
+  e.surface_ratio = 0.3f; // a gate: the model is not asked
+  EXPECT_FALSE(facyl::acceptCylinder(e, d));
+  EXPECT_FALSE(facyl::passesGates(e, d));
+  e.surface_ratio = 0.9f;
+  d.geometry_weights[0] = -1.f;
+  e.p_cylinder = std::nanf("");
+  EXPECT_FALSE(facyl::acceptGeometry(e, d));
+  EXPECT_FALSE(facyl::acceptCylinder(e, d));
 }
 
 // ------------------------------------------------------------------------ the model

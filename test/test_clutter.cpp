@@ -442,6 +442,82 @@ TEST(CylinderEvidence, ArcGapTaperAndJunctions)
   EXPECT_TRUE(std::isnan(facyl::convexJunctionShare(pts, nrm, left, right, 1e-6f, 0.1f)));
 }
 
+TEST(ShapeEvidence, TellsACylinderFromTheShapesItAlsoFits)
+{
+  // A half cylinder seen from +x: radius 5 cm, 10 cm tall, normals along the radial line
+  // turned by a noise of +-0.02 rad about the axis, k_min of that noise.
+  facyl::CylinderModel m;
+  m.radius = 0.05f;
+  m.axis = Eigen::Vector3f::UnitZ();
+  m.top = Eigen::Vector3f(0.f, 0.f, 0.1f);
+  const int n = 600;
+  Eigen::Matrix3Xf pts(3, n), nrm(3, n);
+  Eigen::VectorXf k_min = Eigen::VectorXf::Constant(n, 0.02f * 0.02f);
+  for (int k = 0; k < n; ++k) {
+    const float a = -0.5f * kPi + kPi * static_cast<float>(k % 60) / 60.f;
+    const float z = 0.1f * (static_cast<float>(k / 60) + 0.5f) / 10.f;
+    const float noise = (k % 3 - 1) * 0.02f;
+    pts.col(k) = Eigen::Vector3f(0.05f * std::cos(a), 0.05f * std::sin(a), z);
+    nrm.col(k) = Eigen::Vector3f(std::cos(a + noise), std::sin(a + noise), 0.f);
+  }
+  const facyl::ShapeEvidence c = facyl::shapeEvidence(m, pts, nrm, k_min, {}, 0.003f);
+  EXPECT_LE(c.normal_agreement, 1.01f);    // within the normals' noise
+  EXPECT_LT(c.normal_concentration, 0.2f); // 20 of 180 degrees, and the noise
+  EXPECT_LT(c.profile_range, 0.01f);
+  EXPECT_LT(c.axis_bend, 0.01f);
+  EXPECT_EQ(c.inner_share, 0.f);
+  EXPECT_EQ(c.outside_share, 0.f);
+  // The same points with the normals of two flat faces (a box's edge along the axis).
+  Eigen::Matrix3Xf faces = nrm;
+  for (int k = 0; k < n; ++k)
+    faces.col(k) = pts(1, k) < 0.f ? Eigen::Vector3f(0.7071f, -0.7071f, 0.f)
+                                   : Eigen::Vector3f(0.7071f, 0.7071f, 0.f);
+  const facyl::ShapeEvidence b = facyl::shapeEvidence(m, pts, faces, k_min, {}, 0.003f);
+  EXPECT_GT(b.normal_agreement, 5.f);
+  EXPECT_GT(b.normal_concentration, 0.45f);
+  // Without k_min the agreement is unknown; a mask keeps what it names.
+  EXPECT_TRUE(
+    std::isnan(facyl::shapeEvidence(m, pts, nrm, Eigen::VectorXf(), {}, 0.003f).normal_agreement));
+  std::vector<std::uint8_t> none(static_cast<std::size_t>(n), 0);
+  EXPECT_TRUE(std::isnan(facyl::shapeEvidence(m, pts, nrm, k_min, none, 0.003f).inner_share));
+  // A cone (the radius shrinks by 3 cm over the height) and a bent tube (each slice's centre
+  // moved along x by 2 z^2): the profile and the bend.
+  Eigen::Matrix3Xf cone = pts, bent = pts;
+  for (int k = 0; k < n; ++k) {
+    cone.col(k).head<2>() *= (0.05f - 0.3f * pts(2, k)) / 0.05f;
+    bent(0, k) += 2.f * pts(2, k) * pts(2, k);
+  }
+  EXPECT_GT(facyl::shapeEvidence(m, cone, nrm, k_min, {}, 0.02f).profile_range, 0.2f);
+  EXPECT_GT(facyl::shapeEvidence(m, bent, nrm, k_min, {}, 0.02f).axis_bend, 0.1f);
+  // The inside of an open container (normals facing the axis at 0.6 r), and points beyond the
+  // surface (a box's corners, a neighbour).
+  Eigen::Matrix3Xf more(3, n + 200), more_n(3, n + 200);
+  more << pts, Eigen::Matrix3Xf::Zero(3, 200);
+  more_n << nrm, Eigen::Matrix3Xf::Zero(3, 200);
+  for (int k = 0; k < 200; ++k) {
+    const float a = 2.f * kPi * static_cast<float>(k) / 200.f;
+    more.col(n + k) = Eigen::Vector3f(0.03f * std::cos(a), 0.03f * std::sin(a), 0.05f);
+    more_n.col(n + k) = -Eigen::Vector3f(std::cos(a), std::sin(a), 0.f);
+  }
+  Eigen::VectorXf more_k = Eigen::VectorXf::Constant(n + 200, 0.0004f);
+  EXPECT_NEAR(facyl::shapeEvidence(m, more, more_n, more_k, {}, 0.003f).inner_share,
+              200.f / (n + 200), 1e-4f);
+  for (int k = 0; k < 200; ++k)
+    more.col(n + k) *= 0.08f / 0.03f;
+  const facyl::ShapeEvidence o = facyl::shapeEvidence(m, more, more_n, more_k, {}, 0.003f);
+  EXPECT_NEAR(o.outside_share, 200.f / (n + 200), 1e-4f);
+  EXPECT_EQ(o.inner_share, 0.f);
+}
+
+TEST(ShapeEvidence, LargestCircularWindowShare)
+{
+  EXPECT_EQ(facyl::largestCircularWindowShare({}, 0.3f), 0.f);
+  // Angles around 0 from both sides of the wrap: one window holds them.
+  EXPECT_FLOAT_EQ(facyl::largestCircularWindowShare({6.2f, 0.05f, -0.05f, 3.f}, 0.2f), 0.75f);
+  EXPECT_FLOAT_EQ(facyl::largestCircularWindowShare({0.f, 1.f, 2.f, 3.f}, 0.5f), 0.25f);
+  EXPECT_FLOAT_EQ(facyl::largestCircularWindowShare({1.f, 1.f, 1.f}, 0.f), 1.f);
+}
+
 TEST(CylinderEvidence, TheDecisionUsesEveryCheck)
 {
   facyl::CylinderEvidence e;

@@ -64,7 +64,8 @@ parseClassifierModelInfo(const std::string& text, ClassifierModelInfo& info)
     else if (key == "fusion") {
       for (auto& w : out.fusion)
         if (!(in >> w) || !std::isfinite(w))
-          return where + "expected " + std::to_string(kFusionFeatures) + " finite numbers";
+          return where + "expected " + std::to_string(kEvidenceFeatures) +
+                 " finite numbers (the evidence model of recognition/training/fit_evidence.py)";
       out.has_fusion = true;
     }
     else
@@ -283,9 +284,11 @@ float
 CylinderClassifier::fuse(float p_network, const CylinderEvidence& evidence,
                          const CylinderDecision& decision) const
 {
-  if (!info_.has_fusion || !std::isfinite(p_network))
+  if (!std::isfinite(p_network))
+    return geometricProbability(evidence, decision);
+  if (!info_.has_fusion)
     return p_network;
-  return fusedProbability(info_.fusion, p_network, evidence, decision);
+  return evidenceProbability(info_.fusion, p_network, evidence);
 }
 
 std::string

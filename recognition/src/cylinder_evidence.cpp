@@ -30,44 +30,72 @@ validate(const CylinderDecision& d)
 }
 
 bool
-acceptGeometry(const CylinderEvidence& e, const CylinderDecision& d)
+passesGates(const CylinderEvidence& e, const CylinderDecision& d)
 {
   return e.fitted && e.score(d) >= d.min_score && !(e.curvature_ratio > d.max_curvature_ratio) &&
          e.angular_coverage >= d.min_angular_coverage && !(e.arc_gap > d.max_arc_gap) &&
          !(e.taper > d.max_taper);
 }
 
-bool
-acceptCylinder(const CylinderEvidence& e, const CylinderDecision& d)
+std::array<float, kEvidenceFeatures>
+evidenceFeatures(float p_network, const CylinderEvidence& e)
 {
-  return !(e.p_cylinder < d.min_probability) && acceptGeometry(e, d);
-}
-
-std::array<float, kFusionFeatures>
-fusionFeatures(float p_network, const CylinderEvidence& e, const CylinderDecision& d)
-{
-  const float p = std::isfinite(p_network) ? std::clamp(p_network, 1e-4f, 1.f - 1e-4f) : 0.5f;
   const auto known = [](float v, float fallback) { return std::isfinite(v) ? v : fallback; };
+  float logit = 0.f;
+  if (std::isfinite(p_network)) {
+    const float p = std::clamp(p_network, 1e-4f, 1.f - 1e-4f);
+    logit = std::log(p / (1.f - p));
+  }
+  const ShapeEvidence& s = e.shape;
   return {1.f,
-          std::log(p / (1.f - p)),
           known(e.surface_ratio, 0.f),
           known(e.inlier_ratio, 0.f),
           known(e.curvature_ratio, 1.f),
           known(e.angular_coverage, 0.f),
           std::clamp(known(e.taper, 0.f), 0.f, 1.f),
           known(e.arc_gap, 0.f),
-          acceptGeometry(e, d) ? 1.f : 0.f};
+          std::clamp(known(s.normal_agreement, 8.f), 0.f, 8.f),
+          known(s.normal_concentration, 1.f),
+          std::clamp(known(s.profile_range, 0.f), 0.f, 1.f),
+          std::clamp(known(s.axis_bend, 0.f), 0.f, 1.f),
+          known(s.inner_share, 0.f),
+          known(s.outside_share, 0.f),
+          known(s.inner_share, 0.f) * std::clamp(1.f - known(s.aspect, 1.f), 0.f, 1.f),
+          logit};
 }
 
 float
-fusedProbability(const std::array<float, kFusionFeatures>& w, float p_network,
-                 const CylinderEvidence& e, const CylinderDecision& d)
+evidenceProbability(const std::array<float, kEvidenceFeatures>& w, float p_network,
+                    const CylinderEvidence& e)
 {
-  const auto f = fusionFeatures(p_network, e, d);
+  const auto f = evidenceFeatures(p_network, e);
   double z = 0.0;
-  for (std::size_t i = 0; i < kFusionFeatures; ++i)
+  for (std::size_t i = 0; i < kEvidenceFeatures; ++i)
     z += static_cast<double>(w[i]) * f[i];
   return static_cast<float>(1.0 / (1.0 + std::exp(-z)));
+}
+
+float
+geometricProbability(const CylinderEvidence& e, const CylinderDecision& d)
+{
+  return e.fitted
+           ? evidenceProbability(d.geometry_weights, std::numeric_limits<float>::quiet_NaN(), e)
+           : 0.f;
+}
+
+bool
+acceptGeometry(const CylinderEvidence& e, const CylinderDecision& d)
+{
+  return passesGates(e, d) && geometricProbability(e, d) >= d.min_probability;
+}
+
+bool
+acceptCylinder(const CylinderEvidence& e, const CylinderDecision& d)
+{
+  if (!passesGates(e, d))
+    return false;
+  const float p = std::isfinite(e.p_cylinder) ? e.p_cylinder : geometricProbability(e, d);
+  return p >= d.min_probability;
 }
 
 float
@@ -341,7 +369,7 @@ CylinderEvidence
 localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
               const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive,
               const ExplainSettings& settings, float radial_margin, float axial_margin,
-              float margin, std::vector<Explained>* explained)
+              float margin, std::vector<Explained>* explained, const Eigen::VectorXf& k_min)
 {
   const std::vector<Explained> why = explainedPoints(model, points, normals, settings);
   const float reach =
@@ -349,6 +377,7 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   const float beyond = std::max(axial_margin * model.radius, margin), h = length(model);
   std::size_t region = 0, lateral = 0, any = 0;
   std::vector<Eigen::Index> on_surface;
+  std::vector<std::uint8_t> in_region(static_cast<std::size_t>(points.cols()), 0);
   const bool with_normals = normals.cols() == points.cols();
   const Eigen::Vector3f a = model.axis.normalized();
   const float cos_max = std::cos(settings.max_angle);
@@ -365,6 +394,7 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     if (why[k] == Explained::No && with_normals && std::abs(normals.col(i).dot(a)) >= cos_max)
       continue;
     ++region;
+    in_region[k] = 1;
     if (why[k] == Explained::Lateral) {
       ++lateral;
       on_surface.push_back(i);
@@ -379,8 +409,10 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     e.surface_ratio = static_cast<float>(any) / static_cast<float>(region);
   }
   e.arc_gap = arcGap(model, points(Eigen::all, on_surface));
-  if (normals.cols() == points.cols())
+  if (normals.cols() == points.cols()) {
     e.taper = taperAlongAxis(model, points, normals, alive);
+    e.shape = shapeEvidence(model, points, normals, k_min, in_region, settings.distance);
+  }
   if (explained)
     *explained = why;
   return e;

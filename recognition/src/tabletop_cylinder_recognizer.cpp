@@ -82,6 +82,30 @@ pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride)
   return out;
 }
 
+pcl::Indices
+angularGrid(const pcl::Indices& indices, const Eigen::Matrix3Xf& points, float angle)
+{
+  pcl::Indices out;
+  if (!(angle > 0.f))
+    return indices;
+  std::unordered_set<std::uint64_t> taken;
+  taken.reserve(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    const Eigen::Vector3f p = points.col(static_cast<Eigen::Index>(k));
+    if (!p.allFinite())
+      continue;
+    const float azimuth = std::atan2(p.x(), p.z());
+    const float elevation = std::atan2(p.y(), std::hypot(p.x(), p.z()));
+    const auto cell = [&](float a) {
+      return static_cast<std::uint64_t>(
+        static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(a / angle))));
+    };
+    if (taken.insert(cell(azimuth) << 32 | cell(elevation)).second)
+      out.push_back(indices[k]);
+  }
+  return out;
+}
+
 } // namespace facyl
 
 FACYL_INSTANTIATE_TabletopCylinderRecognizer(pcl::PointXYZ)

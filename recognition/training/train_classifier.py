@@ -5,7 +5,7 @@ One command: reads one or more facyl_crops folders, splits the simulated objects
 train / calibration / test (70 / 15 / 15 %), trains a SqueezeNet-1.1-style network from scratch
 with mirrored augmentation (paper IV-B), draws learning curves, exports ONNX (opset 11, batch
 dynamic) with its description (.cfg), checks that OpenCV's DNN gives PyTorch's output on the
-same input, fits the fusion model (a logistic regression of fusionFeatures, with the network's
+same input, fits the fusion model (a logistic regression of evidenceFeatures, with the network's
 logit, on the calibration split) and reports the held-out test split.
 
     /usr/bin/python3 recognition/training/train_classifier.py --data DIR... --out OUT \
@@ -34,7 +34,7 @@ CHANNELS = {"rgb": 3, "depth": 2, "depthrgb": 5}
 # The files of facyl_crops that make each channel set: depthrgb is depth's planes followed by
 # rgb's, as facyl::classifierImage makes it (ClassifierChannels::DepthRgb).
 FILES = {"rgb": ("rgb",), "depth": ("depth",), "depthrgb": ("depth", "rgb")}
-FUSION_FEATURES = 9  # facyl::kFusionFeatures
+FUSION_FEATURES = 15  # facyl::kEvidenceFeatures; the last is the network's logit
 
 
 # ----------------------------------------------------------------------------- data
@@ -268,10 +268,10 @@ def calibration_error(p, labels, bins=10):
 # ----------------------------------------------------------------------------- fusion
 
 def fusion_matrix(rows, p_network):
-    """fusionFeatures of facyl (C++ wrote f0, f2..f8), f1 = logit(p) clamped as C++ does."""
+    """evidenceFeatures of facyl (C++ wrote f0..f13), f14 = logit(p) clamped as C++ does."""
     x = np.array([[float(r[f"f{i}"]) for i in range(FUSION_FEATURES)] for r in rows], float)
     p = np.clip(np.asarray(p_network, float), 1e-4, 1 - 1e-4)
-    x[:, 1] = np.log(p / (1 - p))
+    x[:, FUSION_FEATURES - 1] = np.log(p / (1 - p))
     return x
 
 

@@ -26,7 +26,8 @@ namespace facyl {
  * mean 127.5              # input value = (byte - mean) * scale
  * scale 0.0078431373
  * output softmax          # softmax: 2 outputs, the second is "cylinder"; sigmoid: 1 logit
- * fusion w0 w1 ... w8     # weights of fusedProbability (kFusionFeatures numbers)
+ * fusion w0 w1 ... w14    # the evidence model's weights with this network: see
+ *                         # evidenceProbability (kEvidenceFeatures numbers)
  * \endcode */
 struct ClassifierModelInfo {
   ClassifierInputSpec input;
@@ -34,7 +35,7 @@ struct ClassifierModelInfo {
   float scale{1.f / 127.5f};
   bool softmax{true};
   bool has_fusion{false};
-  std::array<float, kFusionFeatures> fusion{};
+  std::array<float, kEvidenceFeatures> fusion{};
 };
 
 /** \brief Parses \a text (the file's contents) into \a info. \return an empty string, or what
@@ -88,8 +89,9 @@ public:
   float cylinderProbability(const ObjectView& view) override;
   /** \brief One batch for all views; NaN for those without an input image. */
   std::vector<float> cylinderProbabilities(const std::vector<ObjectView>& views) override;
-  /** \brief fusedProbability with the model's fusion weights; \a p_network when the model has
-   * none or \a p_network is NaN. */
+  /** \brief evidenceProbability with the model's fusion weights; \a p_network when the model
+   * has none; the evidence model without a network (geometricProbability) when \a p_network
+   * is NaN. */
   float fuse(float p_network, const CylinderEvidence& evidence,
              const CylinderDecision& decision) const override;
   /** \brief Network outputs for ready-made input images (channels x size x size bytes each,

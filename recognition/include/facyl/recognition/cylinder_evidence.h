@@ -6,6 +6,7 @@
 #pragma once
 
 #include <facyl/features/point_types.h>
+#include <facyl/recognition/shape_evidence.h>
 #include <facyl/sample_consensus_alt/cylinder_model.h>
 
 #include <pcl/point_cloud.h>
@@ -21,16 +22,26 @@
 
 namespace facyl {
 
+/** \brief Number of features of the evidence model (see evidenceFeatures). */
+constexpr std::size_t kEvidenceFeatures = 15;
+
+/** \brief Weights of the evidence model without a network: a logistic regression of
+ * evidenceFeatures fitted by recognition/training/fit_evidence.py on simulated and real labelled
+ * objects (docs/classifier.md, "The evidence model"); the network's weight is 0. */
+constexpr std::array<float, kEvidenceFeatures> kGeometryWeights = {
+  2.43258f,  1.80012f,  -2.43618f, -4.45941f, 1.72003f, -15.0715f, 0.f, -0.0823083f,
+  -4.37786f, -8.71453f, -8.42685f, 0.f,       0.f,      -7.27018f, 0.f};
+
 /** \brief The decision rule's settings. */
 struct CylinderDecision {
   /** The fit score: the paper's inlier ratio (eq. 4), or the surface ratio, which also counts
    * the points on the fitted cylinder's end caps and inner wall as explained. */
   enum class Score { InlierRatio, SurfaceRatio } score{Score::SurfaceRatio};
   float min_score{0.5f}; ///< score at least this, in [0, 1]
-  /** With a classifier: p_cylinder at least this, in [0, 1]. 0.5: p_cylinder is a calibrated
-   * probability (the fusion is a logistic regression), so 0.5 calls an object a cylinder when
-   * that is the likelier answer; on simulated clutter the F1 is flat from 0.3 to 0.6 and 0.5
-   * halves the boxes, bowls, cones and spheres called cylinders (docs/classifier.md). */
+  /** p_cylinder at least this, in [0, 1]. p_cylinder is the calibrated probability of the
+   * evidence model (a logistic regression of the fit's evidence, and of the network's output
+   * when there is a classifier), so 0.5 calls an object a cylinder when that is the likelier
+   * answer. */
   float min_probability{0.5f};
   /** The inliers' curvature ratio at most this, in (0, 1]; 1 turns the check off. Rejects
    * most spheres and bowls. */
@@ -46,6 +57,8 @@ struct CylinderDecision {
    * (tan of the half-angle: 0.15 is 8.5 degrees): a cylinder fits a band of a cone, but the
    * cone's radius keeps changing beyond it. Slightly tapered cups pass; 1 turns it off. */
   float max_taper{0.15f};
+  /** The evidence model without a network (see kGeometryWeights). */
+  std::array<float, kEvidenceFeatures> geometry_weights{kGeometryWeights};
 };
 
 /** \brief Checks \a decision. \return an empty string, or what is wrong. */
@@ -74,6 +87,14 @@ struct CylinderEvidence {
   /** |d radius / d axial position| of the side surface around the fit (0 on a cylinder,
    * tan(half-angle) on a cone); NaN when unknown. */
   float taper{std::numeric_limits<float>::quiet_NaN()};
+  /** What the points say about the shape they come from (see ShapeEvidence): normal
+   * agreement and concentration, the profile's range, the axis's bend, the shares inside and
+   * outside; NaN when unknown. */
+  ShapeEvidence shape{
+    std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+    std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+    std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+    std::numeric_limits<float>::quiet_NaN()};
 
   /** \brief The score \a decision uses. */
   float score(const CylinderDecision& decision) const
@@ -82,29 +103,37 @@ struct CylinderEvidence {
   }
 };
 
-/** \brief The decision: fitted, p_cylinder >= min_probability when known, score >= min_score,
- * curvature ratio <= max_curvature_ratio (when known), angular coverage >=
- * min_angular_coverage, arc gap <= max_arc_gap and taper <= max_taper (both when known). */
-bool acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
+/** \brief The gates of the decision: fitted, score >= min_score, curvature ratio <=
+ * max_curvature_ratio (when known), angular coverage >= min_angular_coverage, arc gap <=
+ * max_arc_gap and taper <= max_taper (both when known). The evidence model decides among the
+ * fits that pass them. */
+bool passesGates(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
-/** \brief The decision without its probability test: what acceptCylinder says when
- * p_cylinder is unknown. */
+/** \brief What the evidence model sees of a fitted object: 1, surface ratio, inlier ratio,
+ * curvature ratio (1 when unknown), angular coverage, taper clamped to [0, 1] (0 when unknown),
+ * arc gap (0 when unknown), normal agreement clamped to [0, 8] (8 when unknown),
+ * normal concentration (1 when unknown), profile range and axis bend clamped to [0, 1] (0 when
+ * unknown), inner share and outside share (0 when unknown), the inner share of a shallow
+ * container (inner share x clamp(1 - aspect, 0, 1): a bowl's inside; a cup is deeper than its
+ * radius), and logit(p_network) (p clamped to [1e-4, 1 - 1e-4]; 0 without a network). */
+std::array<float, kEvidenceFeatures> evidenceFeatures(float p_network,
+                                                      const CylinderEvidence& evidence);
+
+/** \brief 1 / (1 + exp(-w . evidenceFeatures(p_network, evidence))). */
+float evidenceProbability(const std::array<float, kEvidenceFeatures>& weights, float p_network,
+                          const CylinderEvidence& evidence);
+
+/** \brief The probability of the evidence model without a network (decision.geometry_weights);
+ * 0 for an object that was not fitted. */
+float geometricProbability(const CylinderEvidence& evidence, const CylinderDecision& decision);
+
+/** \brief The decision without a network: passesGates and geometricProbability >=
+ * min_probability. What the recognizer judges its fits by before the classifier has spoken. */
 bool acceptGeometry(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
-/** \brief Number of features of the fusion model (see fusionFeatures). */
-constexpr std::size_t kFusionFeatures = 9;
-
-/** \brief What the fusion model (a logistic regression fitted on simulated objects by
- * recognition/training) sees of a fitted object: 1, logit(p_network) (p clamped to [1e-4,
- * 1 - 1e-4]), surface ratio, inlier ratio, curvature ratio (1 when unknown), angular coverage,
- * taper clamped to [0, 1] (0 when unknown), arc gap (0 when unknown), and 1 when
- * acceptGeometry(evidence, decision) holds, else 0. */
-std::array<float, kFusionFeatures> fusionFeatures(float p_network, const CylinderEvidence& evidence,
-                                                  const CylinderDecision& decision);
-
-/** \brief 1 / (1 + exp(-w . fusionFeatures(...))). */
-float fusedProbability(const std::array<float, kFusionFeatures>& weights, float p_network,
-                       const CylinderEvidence& evidence, const CylinderDecision& decision);
+/** \brief The decision: passesGates, and p_cylinder >= min_probability (p_cylinder when known,
+ * else geometricProbability). */
+bool acceptCylinder(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
 /** \brief Median |k_min| / median |k_max| of \a cues over \a inliers (indices into cues):
  * 0 on an ideal cylinder, 1 on a sphere. NaN when no inlier has finite curvatures; 1 when the
@@ -203,7 +232,8 @@ CylinderEvidence localEvidence(const CylinderModel& model, const Eigen::Matrix3X
                                const std::vector<std::uint8_t>& alive,
                                const ExplainSettings& settings, float radial_margin,
                                float axial_margin, float margin,
-                               std::vector<Explained>* explained = nullptr);
+                               std::vector<Explained>* explained = nullptr,
+                               const Eigen::VectorXf& k_min = Eigen::VectorXf());
 
 /** \brief Share of \a points (3 x n) inside the volume of \a model: within \a radial_factor x
  * radius of its axis and between base and top grown by \a axial_margin (m). The inside of an

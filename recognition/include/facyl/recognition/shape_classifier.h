@@ -59,8 +59,8 @@ public:
   }
   /** \brief The final probability that a fitted object is a cylinder, from the classifier's
    * \a p_network for its view and the fit's \a evidence under \a decision (see
-   * fusionFeatures). The default returns \a p_network; a classifier with a calibrated fusion
-   * model overrides it. */
+   * evidenceFeatures). The default returns \a p_network; a classifier with a calibrated
+   * evidence model overrides it. */
   virtual float fuse(float p_network, const CylinderEvidence& evidence,
                      const CylinderDecision& decision) const
   {

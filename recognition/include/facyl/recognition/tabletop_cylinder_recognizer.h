@@ -69,15 +69,18 @@ struct TabletopRecognizerParameters {
   /** A cylinder found in a larger cluster is judged on the points within this distance (m,
    * at least; 15% of its radius beyond its surface, half its radius beyond its ends). */
   float recovery_margin{0.025f};
-  /** Organized clouds: the points fitted lie on a pixel grid this many radians apart (3
-   * pixels at a 525 px focal length), so normals and curvatures are estimated at the same
-   * angular scale near and far; 0: every pixel. In [0, 0.1]. */
+  /** The points fitted lie on a grid of directions from the sensor this many radians apart
+   * (organized clouds: of pixels, 3 at a 525 px focal length; other clouds: angularGrid), so
+   * normals and curvatures are estimated at the same angular scale near and far; 0: every
+   * point. In [0, 0.1]. */
   float fit_point_angle{0.006f};
   std::size_t max_fit_points{
     1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
   /** With a classifier: clusters whose network probability is below this are not fitted
-   * (rejected before fitting, paper III-B), in [0, 1]; 0 fits every cluster. */
-  float reject_below{0.1f};
+   * (rejected before fitting, paper III-B), in [0, 1]. 0 (default): every cluster is fitted,
+   * and the network is one piece of evidence beside the fit's (a network trained on one
+   * sensor's views misjudges another's: docs/classifier.md). */
+  float reject_below{0.f};
   int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
   /** Clusters fitted at once, each thread with a cue estimation and estimators of its own;
    * threads that no cluster takes help with a cluster's cues and retries. 0 (default) the
@@ -292,6 +295,13 @@ pcl::Indices evenSubsample(const pcl::Indices& indices, std::size_t max_count);
 /** \brief The \a indices of an organized cloud \a width pixels wide whose column and row are
  * both multiples of \a stride (>= 1). */
 pcl::Indices pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride);
+
+/** \brief Of \a indices (with their coordinates \a points, one column each, in the sensor's
+ * frame), the first in each cell of a grid of directions from the sensor \a angle (rad) apart
+ * (azimuth about the image's y axis, elevation from the x-z plane): what pixelGrid keeps of an
+ * organized cloud, for a cloud without pixels. All of them for \a angle <= 0; points that are
+ * not finite are left out. */
+pcl::Indices angularGrid(const pcl::Indices& indices, const Eigen::Matrix3Xf& points, float angle);
 
 } // namespace facyl
 

@@ -40,6 +40,13 @@ objectJson(std::size_t id, const facyl::RecognizedObject& o, int digits = 6)
   j["angular_coverage"] = num(e.angular_coverage);
   j["taper"] = num(e.taper);
   j["arc_gap"] = num(e.arc_gap);
+  j["normal_agreement"] = num(e.shape.normal_agreement);
+  j["normal_concentration"] = num(e.shape.normal_concentration);
+  j["profile_range"] = num(e.shape.profile_range);
+  j["axis_bend"] = num(e.shape.axis_bend);
+  j["inner_share"] = num(e.shape.inner_share);
+  j["outside_share"] = num(e.shape.outside_share);
+  j["aspect"] = num(e.shape.aspect);
   j["is_cylinder"] = o.is_cylinder;
   j["cylinder"] = e.fitted ? cylinderObject(o.cylinder, false, digits) : Json(nullptr);
   return j;

@@ -71,7 +71,7 @@ recognizerOptionsHelp()
       "  --model M              default (the model shipped with facyl) | none | PATH.onnx\n"
       "                         (with PATH.cfg beside it, see CylinderClassifier)\n"
       "  --reject-below P       clusters whose network probability is below P are not\n"
-      "                         fitted (default 0.1; 0 fits all)\n"
+      "                         fitted (default 0: every cluster is fitted)\n"
       "  --min-probability P    with a model: a cylinder also needs p_cylinder >= P, the\n"
       "                         network fused with the fit's evidence (default 0.5)\n"
       "Decision (a fitted object is a cylinder if score >= R, curvature ratio <= C,\n"

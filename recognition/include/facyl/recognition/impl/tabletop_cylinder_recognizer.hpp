@@ -27,6 +27,7 @@ template <typename PointT> struct TabletopCylinderRecognizer<PointT>::FitInput {
   pcl::PointCloud<NormalCurvature>::Ptr cues; ///< their normals and curvatures
   Eigen::Matrix3Xf columns;                   ///< points with a normal, as columns
   Eigen::Matrix3Xf normals;                   ///< their normals
+  Eigen::VectorXf k_min;                      ///< their smaller principal curvatures
   pcl::Indices column_of;                     ///< subset position -> column, -1 without
 };
 
@@ -182,6 +183,10 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
       applyClassifier(objects, first, p_network[k]);
   }
   joinContainerInsides(objects);
+  if (!classifier_) // the evidence model without a network
+    for (auto& o : objects)
+      if (o.evidence.fitted)
+        o.evidence.p_cylinder = geometricProbability(o.evidence, params_.decision);
   for (auto& o : objects) // base nearest the support, axis away from it
     if (o.evidence.fitted) {
       const int s = o.cluster.support;
@@ -346,8 +351,10 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     if (!outer.evidence.fitted || !acceptGeometry(outer.evidence, params_.decision))
       continue;
     for (std::size_t b = 0; b < objects.size(); ++b) {
+      // An object that is a cylinder on its own is no part of another (a can beside a tin
+      // that a wide cylinder was fitted to).
       if (b == a || host[b] >= 0 || host[a] >= 0 ||
-          objects[b].cluster.support != outer.cluster.support)
+          objects[b].cluster.support != outer.cluster.support || objects[b].is_cylinder)
         continue;
       if (isInside(outer.cylinder, objects[b]) || isAttachment(outer, objects[b])) {
         host[b] = static_cast<int>(a);
@@ -369,11 +376,21 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
     }
     RecognizedObject o = std::move(objects[a]);
     TabletopCluster& c = o.cluster;
+    std::size_t inside = 0; // points of the open container's inside joined to it
     for (std::size_t b = 0; b < objects.size(); ++b)
-      if (host[b] == static_cast<int>(a))
+      if (host[b] == static_cast<int>(a)) {
         c.indices.indices.insert(c.indices.indices.end(),
                                  objects[b].cluster.indices.indices.begin(),
                                  objects[b].cluster.indices.indices.end());
+        if (isInside(o.cylinder, objects[b]))
+          inside += objects[b].cluster.indices.indices.size();
+      }
+    // The evidence of the whole: its inside is what an open container shows (a bowl's is most
+    // of it, a cup's less, a can has none).
+    auto& shape = o.evidence.shape;
+    const float inner = static_cast<float>(inside) / static_cast<float>(c.indices.indices.size());
+    shape.inner_share =
+      std::isfinite(shape.inner_share) ? std::max(shape.inner_share, inner) : inner;
     std::sort(c.indices.indices.begin(), c.indices.indices.end());
     Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(c.indices.indices.size()));
     for (std::size_t k = 0; k < c.indices.indices.size(); ++k)
@@ -395,9 +412,10 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
       auto& e = joined[k].evidence;
       e.p_network = p[k];
       e.p_cylinder = classifier_->fuse(e.p_network, e, params_.decision);
-      joined[k].is_cylinder = acceptCylinder(e, params_.decision);
     }
   }
+  for (auto& o : joined)
+    o.is_cylinder = acceptCylinder(o.evidence, params_.decision);
   objects = std::move(kept);
   for (auto& o : joined)
     objects.push_back(std::move(o));
@@ -458,7 +476,7 @@ TabletopCylinderRecognizer<PointT>::applyClassifier(std::vector<RecognizedObject
     auto& o = objects[k];
     auto& e = o.evidence;
     e.p_cylinder = e.fitted ? classifier_->fuse(e.p_network, e, params_.decision) : e.p_network;
-    o.is_cylinder = o.is_cylinder && acceptCylinder(e, params_.decision); // p now known
+    o.is_cylinder = acceptCylinder(e, params_.decision); // p now known
   }
   timing_.classification +=
     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -525,15 +543,19 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
       if (alive[k])
         alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
     std::vector<Explained> why;
-    CylinderEvidence e =
-      localEvidence(fit.model, input.columns, input.normals, alive_columns,
-                    explainSettings(fit.model), radial_margin, axial_margin, margin, &why);
+    CylinderEvidence e = localEvidence(fit.model, input.columns, input.normals, alive_columns,
+                                       explainSettings(fit.model), radial_margin, axial_margin,
+                                       margin, &why, input.k_min);
     e.curvature_ratio = fit.evidence.curvature_ratio;
     std::vector<Eigen::Index> part, rest;
     for (std::size_t k = 0; k < alive.size(); ++k)
       if (alive[k])
         (why[static_cast<std::size_t>(input.column_of[k])] != Explained::No ? part : rest)
           .push_back(input.column_of[k]);
+    PCL_DEBUG("[facyl::TabletopCylinderRecognizer] recovery round %zu: radius %.3f, %zu of %zu "
+              "points, surface %.2f, p %.2f\n",
+              round, fit.model.radius, part.size(), part.size() + rest.size(), e.surface_ratio,
+              geometricProbability(e, params_.decision));
     if (!acceptCylinder(e, params_.decision) || part.size() < min_part)
       break;
     // Objects that touch meet at a concave crease; a part of one object (a box's edge)
@@ -697,9 +719,18 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
   // of a curvature with noise / size^2, so the cues stay as reliable far away as near.
   const int stride =
     static_cast<int>(std::lround(params_.fit_point_angle * segmentation_.getFocalLength()));
+  // Clouds without pixels: the same grid of directions from the sensor.
   if (input_->isOrganized() && stride > 1)
     in.subset = evenSubsample(pixelGrid(cluster.indices.indices, input_->width, stride),
                               params_.max_fit_points);
+  else if (!input_->isOrganized() && params_.fit_point_angle > 0.f) {
+    const auto& idx = cluster.indices.indices;
+    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
+    in.subset =
+      evenSubsample(angularGrid(idx, pts, params_.fit_point_angle), params_.max_fit_points);
+  }
   else
     in.subset = evenSubsample(cluster.indices.indices, params_.max_fit_points);
   in.points.reset(new pcl::PointCloud<pcl::PointXYZ>);
@@ -715,6 +746,7 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
   const auto n = static_cast<Eigen::Index>(in.points->size());
   in.columns.resize(3, n);
   in.normals.resize(3, n);
+  in.k_min.resize(n);
   in.column_of.assign(in.points->size(), -1);
   Eigen::Index m = 0;
   for (std::size_t k = 0; k < in.points->size(); ++k) {
@@ -723,10 +755,12 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
       continue;
     in.columns.col(m) = (*in.points)[k].getVector3fMap();
     in.normals.col(m) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
+    in.k_min[m] = c.pc2;
     in.column_of[k] = static_cast<pcl::index_t>(m++);
   }
   in.columns.conservativeResize(3, m);
   in.normals.conservativeResize(3, m);
+  in.k_min.conservativeResize(m);
   return in;
 }
 
@@ -767,6 +801,8 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
         alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
   }
   e.taper = taperAlongAxis(f.model, input.columns, input.normals, alive_columns);
+  e.shape = shapeEvidence(f.model, input.columns, input.normals, input.k_min, alive_columns,
+                          f.model.distance_threshold);
   // The surface ratio: lateral inliers, plus the points on the caps and on the inner wall.
   std::vector<std::uint8_t> counted(static_cast<std::size_t>(input.columns.cols()), 0);
   for (const auto i : f.model.inliers)
@@ -787,6 +823,10 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
                                                      static_cast<float>(fitted_points));
   f.explained_share = e.surface_ratio;
   f.accepted = acceptCylinder(e, params_.decision);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] fit %zu of %zu points: radius %.3f, surface %.2f, "
+            "p %.2f%s\n",
+            estimator, fitted_points, f.model.radius, e.surface_ratio,
+            geometricProbability(e, params_.decision), f.accepted ? ", accepted" : "");
   return f;
 }
 
@@ -823,9 +863,11 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInpu
   Fit best = std::move(fits[0]);
   for (std::size_t i = 0; i < retries.size() && !best.accepted; ++i) {
     Fit f = at_once ? std::move(fits[i + 1]) : fitOnce(fitter, input, alive, retries[i]);
-    if (f.evidence.fitted &&
-        (f.accepted || f.evidence.score(params_.decision) > best.evidence.score(params_.decision) ||
-         !best.evidence.fitted))
+    // Of fits that are not accepted, the likelier cylinder (a fit that explains more of the
+    // points by bending around them is not).
+    if (f.evidence.fitted && (f.accepted || !best.evidence.fitted ||
+                              geometricProbability(f.evidence, params_.decision) >
+                                geometricProbability(best.evidence, params_.decision)))
       best = std::move(f);
   }
   return best;

@@ -1,0 +1,487 @@
+#!/usr/bin/python3
+"""The evidence model of facyl's cylinder decision, fitted and validated leave-one-source-out.
+
+p_cylinder is a logistic regression of evidenceFeatures (C++: the fit's evidence and, with a
+classifier, the network's logit). This script collects the recognizer's objects with their
+labels from every labelled source there is, fits the model with each source left out in turn and
+scores that source with it (the estimate of what a sensor or room never seen will get), then fits
+the model on all of them and prints the weights for facyl (kGeometryWeights in
+cylinder_evidence.h; the "fusion" line of a classifier's .cfg).
+
+Sources (each one of the sensors, rooms or renderers the recognizer must transfer to):
+  sim-kinect, sim-stereo, sim-random   facyl_crops --sim (layouts spread, cluttered, realistic)
+  mosd                                  the 45 mOSD learn frames (Kinect; per-pixel labels)
+  rgbd-<folder>                         the hand-labelled rgbd frames (labels.csv), one source per
+                                        folder (RealSense-class and Kinect v1 rooms)
+  uw                                    UW RGB-D Object crops (Kinect, single objects)
+
+Positives are cylinders (cans, tins, tubes); boxes, bowls, cones, spheres and unlabelled objects
+(clutter, furniture) are negatives; cups and mugs with handles, open cups and "other" (bottles,
+tools, fruit) are neither, as in score_frames.py. Only fits that pass the decision's gates
+(passesGates: score, curvature ratio, coverage, arc gap, taper) are the model's to decide.
+
+    /usr/bin/python3 recognition/training/fit_evidence.py --build build \\
+        --real ../shared/data/real --out /tmp/evidence [--model none|default|PATH.onnx]
+
+Prints, per source, precision, recall and F1 of the decision left out (rgbd sources: scored as
+score_frames.py scores frames, with segmentation recall; mosd: the labelled objects and every
+object on a box-only frame; sim: the ground truth; uw: each crop's largest object) and the worst
+source; then the weights fitted on every source. The recognizer's own flow (retries and the
+cylinder-first recovery ask the decision too) ran with the model built into BUILD, so each left-out
+score re-decides the objects that flow produced: an estimate, exact for the built-in weights.
+"""
+import argparse
+import csv
+import glob
+import json
+import math
+import os
+import pickle
+import subprocess
+import sys
+from collections import Counter, defaultdict
+
+import numpy as np
+
+FEATURES = 15  # facyl::kEvidenceFeatures; the last is the network's logit
+NETWORK = FEATURES - 1
+POSITIVE = {"cylinder", "can", "tin", "tube"}
+IGNORED = {"cylinder_handle", "cup_handle", "cup", "cylinder_open", "other", "unknown", "merged",
+           "coffee_mug", "mustard"}
+CUPS = {"cylinder_handle", "cup_handle", "cup", "cylinder_open", "coffee_mug"}
+UW_CYLINDERS = {"soda_can", "food_can", "food_jar", "glue_stick", "marker", "dry_battery",
+                "flashlight"}
+
+
+def label_kind(kind):
+    """1 positive, 0 negative, None ignored (as score_frames.py scores)."""
+    if kind in POSITIVE:
+        return 1
+    if kind in IGNORED:
+        return None
+    return 0
+
+
+def training_label(kind):
+    """What the model learns: cylinders and cups (open, with or without a handle: a cylinder
+    wall all the same, which scores ignore) are positives; bottles, tools, fruit and what is
+    unknown are left out."""
+    if kind in CUPS:
+        return 1
+    return label_kind(kind)
+
+
+# --------------------------------------------------------------------------- features
+
+def features_of(obj):
+    """evidenceFeatures (without the network's logit) from a detect() object, as C++ makes
+    them (cylinder_evidence.cpp); None when the object was not fitted."""
+    if obj.get("cylinder") is None:
+        return None
+
+    def known(k, fallback):
+        v = obj.get(k)
+        return fallback if v is None or not math.isfinite(v) else float(v)
+
+    clamp = lambda v, lo, hi: min(max(v, lo), hi)
+    return [1.0, known("surface_ratio", 0.0), known("inlier_ratio", 0.0),
+            known("curvature_ratio", 1.0), known("angular_coverage", 0.0),
+            clamp(known("taper", 0.0), 0.0, 1.0), known("arc_gap", 0.0),
+            clamp(known("normal_agreement", 8.0), 0.0, 8.0), known("normal_concentration", 1.0),
+            clamp(known("profile_range", 0.0), 0.0, 1.0), clamp(known("axis_bend", 0.0), 0.0, 1.0),
+            known("inner_share", 0.0), known("outside_share", 0.0),
+            known("inner_share", 0.0) * clamp(1.0 - known("aspect", 1.0), 0.0, 1.0), 0.0]
+
+
+def logit(p):
+    if p is None or not math.isfinite(p):
+        return 0.0
+    p = min(max(p, 1e-4), 1 - 1e-4)
+    return math.log(p / (1 - p))
+
+
+def passes_gates(obj, gates):
+    """passesGates of facyl's default CylinderDecision (surface ratio as the score)."""
+    if obj.get("cylinder") is None:
+        return False
+    v = lambda k: obj.get(k)
+    bad = lambda x, limit: x is not None and math.isfinite(x) and x > limit
+    return (v("surface_ratio") >= gates["min_score"] and not bad(v("curvature_ratio"), gates["max_curvature_ratio"])
+            and v("angular_coverage") >= gates["min_angular_coverage"]
+            and not bad(v("arc_gap"), gates["max_arc_gap"]) and not bad(v("taper"), gates["max_taper"]))
+
+
+GATES = {"min_score": 0.5, "max_curvature_ratio": 0.35, "min_angular_coverage": 0.2,
+         "max_arc_gap": 0.1, "max_taper": 0.15}
+
+
+# --------------------------------------------------------------------------- sources
+
+def read_frame(path):
+    import open3d as o3d
+    pc = o3d.t.io.read_point_cloud(path)
+    pts = pc.point.positions.numpy()
+    col = pc.point.colors.numpy() if "colors" in pc.point else None
+    lab = pc.point.label.numpy().reshape(-1) if "label" in pc.point else None
+    return pts, col, lab
+
+
+def detect(facyl, pts, col, model, shape=(480, 640), camera=None):
+    if camera is None:
+        pts = pts.reshape(shape[0], shape[1], 3)
+        col = None if col is None else col.reshape(shape[0], shape[1], 3)
+    kw = {"model": model}
+    if camera is not None:
+        kw["camera"] = camera
+    return facyl.detect(pts, col, **kw)
+
+
+def obj_row(source, frame, obj, label, extra=None):
+    r = {"source": source, "frame": frame, "label": label, "obj": obj}
+    r.update(extra or {})
+    return r
+
+
+def collect_mosd(facyl, real, model):
+    classes = {}
+    with open(os.path.join(real, "mosd", "labels.csv"), newline="") as f:
+        for r in csv.DictReader(f):
+            classes[(r["scene"], int(r["object_id"]))] = r["class"]
+    rows, truth = [], []
+    for k in range(45):
+        frame = "learn%d" % k
+        pts, col, lab = read_frame(os.path.join(real, "mosd", frame + ".pcd"))
+        out = detect(facyl, pts, col, model)
+        obj_of = np.where(lab >= 20, lab // 10, 0)
+        ids, counts = np.unique(obj_of[obj_of > 0], return_counts=True)
+        found = {int(i): False for i in ids}
+        for o in out["objects"]:
+            idx = np.asarray(o["indices"])
+            v, c = np.unique(obj_of[idx], return_counts=True)
+            top = int(v[np.argmax(c)])
+            if top > 0:
+                inter = int((obj_of[idx] == top).sum())
+                union = len(idx) + int(counts[list(ids).index(top)]) - inter
+                found[top] = found[top] or inter / union >= 0.5
+            if top == 0:
+                kind = "none"
+            elif k <= 24:
+                kind = "box"
+            elif k <= 32:
+                kind = "unknown"
+            else:
+                kind = classes.get((frame, top), "unknown")
+            rows.append(obj_row("mosd", frame, o, kind))
+        truth += [("mosd", frame, i, ok) for i, ok in found.items()]
+    return rows, truth
+
+
+def collect_rgbd(facyl, real, model):
+    labels = defaultdict(list)
+    with open(os.path.join(real, "rgbd", "labels.csv"), newline="") as f:
+        for r in csv.DictReader(f):
+            labels[r["frame"]]
+            if r["class"] != "none":
+                labels[r["frame"]].append((r["class"], float(r["u"]), float(r["v"]),
+                                           [float(r[k]) for k in ("u0", "v0", "u1", "v1")]))
+    frames = []
+    for frame, labs in sorted(labels.items()):
+        pts, col, _ = read_frame(os.path.join(real, "rgbd", frame + ".pcd"))
+        out = detect(facyl, pts, col, model)
+        frames.append(("rgbd-" + frame.split("/")[0], frame, labs, out["objects"]))
+    return frames
+
+
+def collect_uw(facyl, real, model):
+    rows = []
+    for path in sorted(glob.glob(os.path.join(real, "uw_objects", "*.pcd"))):
+        stem = os.path.splitext(os.path.basename(path))[0]
+        category = stem
+        for i in range(len(stem) - 1):
+            if stem[i] == "_" and stem[i + 1].isdigit():
+                category = stem[:i]
+                break
+        pts, col, _ = read_frame(path)
+        cam = np.stack([pts[:, 0], -pts[:, 2], pts[:, 1]], 1)  # z up, y depth -> camera frame
+        ok = np.isfinite(cam).all(1)
+        out = detect(facyl, cam[ok].astype(np.float64), None if col is None else col[ok], model,
+                     camera=(525.0, 525.0, 319.5, 239.5))
+        if not out["objects"]:
+            continue
+        o = max(out["objects"], key=lambda o: o["n_points"])
+        kind = ("cylinder" if category in UW_CYLINDERS else
+                "coffee_mug" if category == "coffee_mug" else "none")
+        rows.append(obj_row("uw", stem, o, kind))
+    return rows
+
+
+def collect_sim(build, out, scenes, model):
+    rows = []
+    crops = os.path.join(build, "apps", "facyl_crops")
+    for k, sensor in enumerate(("kinect", "stereo", "random")):
+        d = os.path.join(out, "sim-" + sensor)
+        os.makedirs(d, exist_ok=True)
+        cmd = [crops, "--sim", str(scenes), "--seed", str(90000 + 10000 * k), "--layout",
+               "spread,cluttered,realistic", "--sensor", sensor, "--model", model, d]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        with open(os.path.join(d, "objects.csv"), newline="") as f:
+            for r in csv.DictReader(f):
+                if r["fitted"] != "1" or r["kind"] == "table":
+                    continue
+                x = [float(r["f%d" % i]) for i in range(FEATURES)]
+                p = float(r["p_network"]) if r["p_network"] not in ("", "nan") else float("nan")
+                rows.append({"source": "sim-" + sensor, "frame": r["scene"], "label": r["kind"],
+                             "x": x, "p_network": p, "gates": r["passes_gates"] == "1"})
+    return rows
+
+
+def prepare(row):
+    """Adds x (features), p_network and gates to a row from detect()."""
+    if "x" in row:
+        return row
+    o = row["obj"]
+    row["x"] = features_of(o)
+    row["p_network"] = o.get("p_network") if o.get("p_network") is not None else float("nan")
+    row["gates"] = passes_gates(o, GATES)
+    return row
+
+
+# --------------------------------------------------------------------------- model
+
+def design(rows, network):
+    x = np.array([r["x"] for r in rows], float)
+    if network:
+        x[:, NETWORK] = [logit(r["p_network"]) for r in rows]
+    else:
+        x = x[:, :NETWORK]
+    return x
+
+
+def fit_logistic(x, y, weight, l2=0.1):
+    """Weighted, L2-regularised logistic regression by Newton's method on standardised
+    features; returns the weights of the raw features (bias first, unpenalised)."""
+    mu = x[:, 1:].mean(0)
+    sd = x[:, 1:].std(0) + 1e-6
+    z = np.hstack([np.ones((len(x), 1)), (x[:, 1:] - mu) / sd])
+    w = np.zeros(z.shape[1])
+    weight = weight / weight.sum()
+    reg = np.full(z.shape[1], l2)
+    reg[0] = 0.0
+    for _ in range(100):
+        p = 1 / (1 + np.exp(-(z @ w)))
+        g = z.T @ ((p - y) * weight) + reg * w
+        h = (z * (weight * p * (1 - p))[:, None]).T @ z + np.diag(reg + 1e-12)
+        step = np.linalg.solve(h, g)
+        w -= step
+        if np.abs(step).max() < 1e-10:
+            break
+    raw = np.zeros(x.shape[1])
+    raw[1:] = w[1:] / sd
+    raw[0] = w[0] - (w[1:] * mu / sd).sum()
+    return raw
+
+
+# The direction in which each feature can speak for a cylinder (evidenceFeatures' order; 0:
+# either): more of the surface explained, more coverage and a surer network speak for one; a
+# curved profile, a taper, normals that disagree with the radial line or point one way, a bent
+# axis and points beyond the surface against. A weight that comes out the other way (the
+# features overlap) is set to 0 and the rest refitted. The arc gap is a gate only: it is known
+# for the parts of the cylinder-first recovery alone.
+SIGNS = [0, 1, 0, -1, 1, -1, None, -1, -1, -1, -1, None, -1, -1, 1]
+
+
+def fit_signed(x, y, weight):
+    use = [i for i, s in enumerate(SIGNS[:x.shape[1]]) if s is not None]
+    while True:
+        w = np.zeros(x.shape[1])
+        w[use] = fit_logistic(x[:, use], y, weight)
+        wrong = [i for i in use if SIGNS[i] and np.sign(w[i]) == -SIGNS[i]]
+        if not wrong:
+            return w
+        use = [i for i in use if i not in wrong]
+
+
+def train(rows, network):
+    """Each source weighs the same, and within it positives and negatives weigh the same."""
+    data = [r for r in rows if r["gates"] and training_label(r["label"]) is not None]
+    y = np.array([training_label(r["label"]) for r in data], float)
+    count = Counter((r["source"], training_label(r["label"])) for r in data)
+    weight = np.array([1.0 / count[(r["source"], training_label(r["label"]))] for r in data])
+    return fit_signed(design(data, network), y, weight)
+
+
+def decide(rows, w, network):
+    """is_cylinder of each row under weights w (gates, then p >= 0.5)."""
+    out = []
+    for r in rows:
+        if not r["gates"]:
+            out.append(False)
+            continue
+        x = design([r], network)[0]
+        out.append(float(x @ w) >= 0.0)
+    return out
+
+
+# --------------------------------------------------------------------------- scores
+
+def prf(tp, fp, fn):
+    p = tp / (tp + fp) if tp + fp else 1.0
+    r = tp / (tp + fn) if tp + fn else 1.0
+    f = 2 * p * r / (p + r) if p + r else 0.0
+    return p, r, f
+
+
+def score_objects(rows, calls):
+    tp = fp = fn = 0
+    for r, c in zip(rows, calls):
+        k = label_kind(r["label"])
+        if k is None:
+            continue
+        tp += c and k == 1
+        fp += c and k == 0
+        fn += (not c) and k == 1
+    return tp, fp, fn
+
+
+def inside(b, u, v):
+    return b[0] <= u <= b[2] and b[1] <= v <= b[3]
+
+
+def score_frames(frames, calls_of):
+    """score_frames.py's rules: tp, fp, fn and segmentation recall over labelled frames."""
+    tp = fp = npos = clean = nlab = 0
+    for source, frame, labs, objs in frames:
+        calls = calls_of(frame, objs)
+        boxes = [o["bbox"] for o in objs]
+        npts = [sum(inside(b, u, v) for _, u, v, _ in labs) for b in boxes]
+        matched = defaultdict(set)
+        for cls, u, v, _ in labs:
+            hits = [i for i, b in enumerate(boxes) if b and inside(b, u, v)]
+            best = min(hits, key=lambda i: (boxes[i][2] - boxes[i][0]) * (boxes[i][3] - boxes[i][1])) if hits else None
+            ok = best is not None and npts[best] == 1
+            nlab += 1
+            clean += ok
+            if best is not None:
+                matched[best].add(cls)
+            if cls == "cylinder":
+                npos += 1
+                tp += best is not None and calls[best] and ok
+        for i, o in enumerate(objs):
+            cl = matched.get(i, set())
+            if not cl and boxes[i]:
+                cu, cv = (boxes[i][0] + boxes[i][2]) / 2, (boxes[i][1] + boxes[i][3]) / 2
+                cl = {c for c, _, _, b in labs if inside(b, cu, cv)}
+            if calls[i] and "cylinder" not in cl and (not cl or cl - {"cylinder_handle", "other"}):
+                fp += 1
+    return tp, fp, npos - tp, clean / nlab if nlab else float("nan")
+
+
+def frame_rows(frames):
+    """One row per rgbd object, labelled as score_frames.py matches it (for training)."""
+    rows = []
+    for source, frame, labs, objs in frames:
+        for o in objs:
+            b = o["bbox"]
+            hit = [cls for cls, u, v, _ in labs if b and inside(b, u, v)]
+            kind = hit[0] if len(hit) == 1 else ("merged" if hit else "none")
+            if kind == "none" and b:
+                cu, cv = (b[0] + b[2]) / 2, (b[1] + b[3]) / 2
+                part = {c for c, _, _, bb in labs if inside(bb, cu, cv)}
+                if part:
+                    kind = "cylinder_handle" if part <= {"cylinder", "cylinder_handle", "other"} else "box"
+            rows.append(prepare(obj_row(source, frame, o, kind)))
+    return rows
+
+
+# --------------------------------------------------------------------------- main
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--real", default="../shared/data/real")
+    ap.add_argument("--out", required=True, help="working folder (simulated crops)")
+    ap.add_argument("--model", default="none", help="none | default | PATH.onnx (the network)")
+    ap.add_argument("--sim-scenes", type=int, default=300, help="scenes per simulated sensor")
+    ap.add_argument("--json", help="write the per-source table and the weights here")
+    ap.add_argument("--rows", help="pickle of the collected objects: read when it exists, else "
+                    "written (to refit without running the recognizer again)")
+    ap.add_argument("--list", action="store_true", help="list the real objects each left-out "
+                    "model decides wrongly")
+    args = ap.parse_args()
+    sys.path.insert(0, os.path.join(os.path.abspath(args.build), "python"))
+    import facyl
+    network = args.model != "none"
+
+    if args.rows and os.path.exists(args.rows):
+        with open(args.rows, "rb") as f:
+            sim, mosd_rows, mosd_truth, frames, uw = pickle.load(f)
+    else:
+        sim = collect_sim(args.build, args.out, args.sim_scenes, args.model)
+        mosd_rows, mosd_truth = collect_mosd(facyl, args.real, args.model)
+        frames = collect_rgbd(facyl, args.real, args.model)
+        uw = collect_uw(facyl, args.real, args.model)
+        if args.rows:
+            for r in mosd_rows + uw:
+                r["obj"].pop("indices", None)
+            for fr in frames:
+                for o in fr[3]:
+                    o.pop("indices", None)
+            with open(args.rows, "wb") as f:
+                pickle.dump((sim, mosd_rows, mosd_truth, frames, uw), f)
+    rows = sim + [prepare(r) for r in mosd_rows + uw] + frame_rows(frames)
+    rows = [r for r in rows if r["x"] is not None or not r["gates"]]
+    for r in rows:
+        if r["x"] is None:
+            r["x"] = [0.0] * FEATURES
+    sources = sorted({r["source"] for r in rows} | {f[0] for f in frames})
+
+    table = {}
+    for s in sources:
+        w = train([r for r in rows if r["source"] != s], network)
+        if s.startswith("rgbd-"):
+            mine = [f for f in frames if f[0] == s]
+            calls_of = lambda frame, objs: decide([prepare(obj_row(s, frame, o, "")) for o in objs], w, network)
+            tp, fp, fn, seg = score_frames(mine, calls_of)
+        else:
+            mine = [r for r in rows if r["source"] == s]
+            tp, fp, fn = score_objects(mine, decide(mine, w, network))
+            seg = float("nan")
+            if s == "mosd":
+                seg = sum(ok for *_, ok in mosd_truth) / len(mosd_truth)
+        if args.list and not s.startswith("sim"):
+            mine_rows = [r for r in rows if r["source"] == s]
+            for r, c in zip(mine_rows, decide(mine_rows, w, network)):
+                k = label_kind(r["label"])
+                if k is not None and c != bool(k) or (args.list and c and k is None):
+                    x = design([r], network)[0]
+                    print("  %s %-10s %-22s p=%.2f  %s" % (s, r["label"], r["frame"][:22],
+                          1 / (1 + math.exp(-float(x @ w))), " ".join("%.2f" % v for v in r["x"][1:13])))
+        p, r, f = prf(tp, fp, fn)
+        table[s] = {"tp": tp, "fp": fp, "fn": fn, "precision": p, "recall": r, "f1": f,
+                    "segmentation_recall": seg}
+    w_all = train(rows, network)
+
+    print("Leave-one-source-out (model %s; each source scored by the evidence model fitted "
+          "without it):" % args.model)
+    print("| source | tp | fp | fn | precision | recall | F1 | segmentation recall |")
+    print("|---|---|---|---|---|---|---|---|")
+    for s, t in table.items():
+        print("| %s | %d | %d | %d | %.3f | %.3f | %.3f | %s |" % (
+            s, t["tp"], t["fp"], t["fn"], t["precision"], t["recall"], t["f1"],
+            "-" if not math.isfinite(t["segmentation_recall"]) else "%.3f" % t["segmentation_recall"]))
+    with_pos = {s: t for s, t in table.items() if t["tp"] + t["fn"] > 0}
+    worst = min(with_pos, key=lambda s: with_pos[s]["f1"])
+    print("worst source: %s (F1 %.3f); false positives where nothing is a cylinder: %s" % (
+        worst, with_pos[worst]["f1"],
+        ", ".join("%s %d" % (s, t["fp"]) for s, t in table.items() if s not in with_pos) or "-"))
+    full = list(w_all) + ([] if network else [0.0])
+    print("weights fitted on every source (kEvidenceFeatures = %d):" % FEATURES)
+    print("  " + " ".join("%.6g" % v for v in full))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"model": args.model, "table": table, "worst": worst, "weights": full}, f,
+                      indent=1)
+
+
+if __name__ == "__main__":
+    main()
