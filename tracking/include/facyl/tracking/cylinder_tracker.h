@@ -20,6 +20,8 @@
 
 namespace facyl {
 
+struct TrackObservation; // tracker_steps.h
+
 /** \brief Settings of CylinderTracker. Lengths in metres, angles in radians, counts in frames
  * given to update(). */
 struct CylinderTrackerParameters {
@@ -368,14 +370,40 @@ public:
   }
 
 private:
-  /** An object of the frame in the world. */
-  struct Observation;
-  /** The in-view state of an unmatched track. */
-  TrackStatus viewStatus(const CylinderTrack& t, const TrackerView& view,
-                         const std::vector<RecognizedObject>& objects, int& inside) const;
+  // The steps of update(), in order (the rules are free functions, tracker_steps.h).
+  /** The frame's anchor and its pose in the world (frame_to_world_; \a info's anchor, scene
+   * and registration): the tracks move into the support's plane when the world becomes one,
+   * and end when the frame starts a new scene. */
+  void locateFrame(const std::vector<SupportPlane>& supports, int table,
+                   const std::vector<RecognizedObject>& objects, const TrackerView& view,
+                   TrackerFrameInfo& info);
+  /** The frame, anchored on the support at \a plane_to_cloud that continues the tracks' plane,
+   * registered against the tracks (\a pose: cloud to world). \return true when it starts a
+   * new scene (the tracks ended, \a pose the support's plane). */
+  bool registerFrame(const std::vector<RecognizedObject>& objects, const TrackerView& view,
+                     const Eigen::Affine3f& plane_to_cloud, const Eigen::Affine3f& cloud_to_plane,
+                     const Eigen::Affine3f& predicted, const Eigen::Affine3f& last_pose,
+                     bool plane_jump, Eigen::Affine3f& pose, TrackerFrameInfo& info);
+  /** The tracks matched (\a match) corrected by their objects, counting with \a weight.
+   * \return a flag per track: matched. */
+  std::vector<char> correctMatched(const std::vector<RecognizedObject>& objects,
+                                   const std::vector<TrackObservation>& obs,
+                                   const std::vector<int>& match, float weight);
+  /** Each object left: a fragment of the matched track it looks most like a piece of
+   * (fragmentGain), else a new track. */
+  void startOrAttach(const std::vector<TrackObservation>& obs, const std::vector<int>& match,
+                     const std::vector<char>& matched_track);
+  /** The tracks not matched: their status (viewStatus) and counters; without an anchor only
+   * the tentative ones' misses count. */
+  void updateUnseen(const TrackerView& view, const std::vector<RecognizedObject>& objects,
+                    const std::vector<TrackObservation>& obs,
+                    const std::vector<char>& matched_track, bool anchored);
+  /** Confirmed track \a t, merged into \a object that started a new track, takes it back. */
+  void takeBack(CylinderTrack& t, int object, const TrackObservation& o);
+  /** Two tracks of one object become the older one (areOneObject, absorbTrack); the tracks
+   * that end go (trackEnded); the rest sorted by id. */
+  void joinAndEndTracks();
   void predict();
-  void startTrack(const Observation& o, int object);
-  void correct(CylinderTrack& t, const Observation& o, float weight);
   void endTracks();
 
   CylinderTrackerParameters params_;
