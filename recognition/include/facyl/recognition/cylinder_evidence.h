@@ -29,8 +29,8 @@ struct CylinderDecision {
   float min_score{0.5f}; ///< score at least this, in [0, 1]
   /** With a classifier: p_cylinder at least this, in [0, 1]. 0.5: p_cylinder is a calibrated
    * probability (the fusion is a logistic regression), so 0.5 calls an object a cylinder when
-   * that is the likelier answer; on simulated clutter the F1 is flat from 0.3 to 0.6 and 0.5
-   * halves the boxes, bowls, cones and spheres called cylinders (docs/classifier.md). */
+   * that is the likelier answer (against 0.3 on simulated clutter and real frames:
+   * docs/classifier.md). */
   float min_probability{0.5f};
   /** The inliers' curvature ratio at most this, in (0, 1]; 1 turns the check off. Rejects
    * most spheres and bowls. */

@@ -244,9 +244,9 @@ struct HoughCylinderParameters {
   /** The coarse scale, in [0, 2]: neighbours within this share of the winner's radius (at
    * most 64). The coarse cues also judge the candidates: their normals' noise sets the
    * gate that keeps a plane beside the cylinder out of its refinement, so wide patches pay
-   * where a plane lies within a few sigma (facyl_bench, practical setting, noise 20% and 30%
-   * of r, six seeds: 28 and 73 of 360 failures at 0.5, 17 and 52 at 1; random setting and
-   * lids unchanged within a cloud or two). 0: cues are never estimated again. */
+   * where a plane lies within a few sigma (the failures at 0.5 to 1.5, beside a plane and
+   * elsewhere: docs/benchmark.md, "The coarse scale and more seeds"). 0: cues are never
+   * estimated again. */
   float coarse_scale{1.f};
   std::size_t max_cylinders{1}; ///< >= 1
   /** A cylinder needs this many points: its inliers and the points of its end caps

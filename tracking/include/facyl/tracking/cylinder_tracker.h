@@ -82,11 +82,11 @@ struct CylinderTrackerParameters {
   int history{30};
   float axis_agreement{0.14f}; ///< rad (8 degrees), in (0, pi/2]
   /** How much an observation counts grows with what the frame saw of the object: its points
-   * times the angular coverage of its fit (a cylinder seen in 500 points errs ten times more
-   * in radius than one seen in 2500). The measurement variances above are those of an object
-   * of this quality (points x coverage, > 0), divided by an observation's quality over it
-   * (within [1/4, 4]); the history weighs each observation by its quality squared (the inverse
-   * of its variance). */
+   * times the angular coverage of its fit (a fit on few points, or on a narrow arc, errs more
+   * in radius: docs/tracking.md, "Design in brief"). The measurement variances above are those
+   * of an object of this quality (points x coverage, > 0), divided by an observation's quality
+   * over it (within [1/4, 4]); the history weighs each observation by its quality squared (the
+   * inverse of its variance). */
   float reference_quality{600.f};
 
   // ---- confidence
@@ -266,8 +266,8 @@ struct TrackerFrameInfo {
  * }
  * \endcode
  * Thread safety: update() and skipFrame() are not reentrant on one tracker; the const members
- * may be called concurrently while neither runs. Distinct trackers are independent. Cost: well
- * under a millisecond per frame for tens of objects (facyl_benchmarks BM_TrackerUpdate).
+ * may be called concurrently while neither runs. Distinct trackers are independent. Cost per
+ * frame: docs/tracking.md, "Cost" (facyl_benchmarks BM_TrackerUpdate).
  */
 class CylinderTracker {
 public:
