@@ -454,6 +454,25 @@ def test_tracker_keeps_ids_on_a_simulated_stream():
     assert cylinders and all(t["cylinder"]["radius"] > 0 for t in cylinders)
 
 
+def test_degenerate_points_fail_with_one_line(capfd):
+    # Identical or collinear points hold no plane: one line says so (before: PCL's "Sample
+    # points too similar or collinear!" 1,000 times, on every call, and no error).
+    same = np.tile(np.array([[0.1, 0.2, 1.0]], np.float32), (10, 1))
+    line = np.array([[0.1 + 0.01 * i, 0.2 + 0.02 * i, 1.0 + 0.005 * i] for i in range(50)],
+                    np.float32)
+    for points in (same, line):
+        capfd.readouterr()
+        with pytest.raises(ValueError, match="recognition failed"):
+            facyl.detect(points)
+        err = capfd.readouterr().err
+        assert len(err.splitlines()) == 1 and "lie on one line" in err, err[:500]
+        tracker = facyl.Tracker()
+        with pytest.raises(ValueError, match="recognition failed"):
+            tracker.update(points)
+        err = capfd.readouterr().err
+        assert len(err.splitlines()) == 1 and "lie on one line" in err, err[:500]
+
+
 def test_tracker_bad_frames_keep_the_tracks():
     tracker = facyl.Tracker()
     for k in range(3):

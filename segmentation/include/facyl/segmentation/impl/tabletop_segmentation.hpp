@@ -87,6 +87,12 @@ TabletopSegmentation<PointT>::run(std::vector<TabletopCluster>& clusters, bool c
     this->deinitCompute();
     return false;
   }
+  if (!spansPlane(*input_, *indices_)) {
+    PCL_ERROR("[facyl::TabletopSegmentation::segment] The finite points lie on one line (or at "
+              "one point): they hold no plane.\n");
+    this->deinitCompute();
+    return false;
+  }
   const Eigen::Affine3f pose =
     check_pose ? plausibleSensorPose(*input_) : Eigen::Affine3f(Eigen::Affine3f::Identity());
   const std::size_t far = check_pose ? countFarPoints(*input_) : 0;
