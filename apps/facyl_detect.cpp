@@ -46,7 +46,8 @@ printHelp(const char* self)
     "                         <stem>-<k>.png when scenes share a name, k from 1). A path not\n"
     "                         ending in .png, or one that is an input, is refused\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png);\n"
-    "                         refused when a name it would write is an input\n"
+    "                         refused when DIR holds an input (a later *.pcd there would\n"
+    "                         read the clusters as scenes) or a name it would write is one\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
     "  --verbose              what each step found (PCL's debug messages, on standard\n"
     "                         output between the JSON lines)\n"
@@ -421,6 +422,15 @@ checkOutputs(const Settings& s, const std::vector<std::string>& files, const std
     facyl_cli::checkOutputFolder(
       "--save-clusters", s.clusters_dir, [&](const std::string& f) { return isName(f, "_obj"); },
       inputs);
+    // Not into a folder of scenes: its next *.pcd would read the clusters as scenes.
+    for (const auto& f : files) {
+      const std::filesystem::path p(f);
+      if (facyl_cli::samePath(p.has_parent_path() ? p.parent_path() : ".", s.clusters_dir))
+        throw std::invalid_argument("--save-clusters " + s.clusters_dir + ": holds the input " + f +
+                                    "; a later *.pcd of that folder would read the clusters "
+                                    "(<stem>_obj<k>.pcd) as scenes. Give another folder. "
+                                    "Nothing was written.");
+    }
   }
 }
 
