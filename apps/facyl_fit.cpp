@@ -115,7 +115,8 @@ processFile(const std::string& file, const Settings& s, bool& ok)
     return errorObject(file, units);
   const float to_metres = facyl_cli::metresPerUnit(s.units);
   facyl_cli::scaleCloud(*cloud, facyl_cli::metresPerUnitExact(s.units));
-  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, s.threads, given);
+  const Cues::Ptr cues =
+    facyl_cli::estimateFitCues(cloud, s.neighbours, static_cast<unsigned>(s.threads), given);
   if (cues->size() != cloud->size())
     return errorObject(file, "normal estimation failed (too few points for k = " +
                                std::to_string(s.neighbours) + "?)");

@@ -338,6 +338,42 @@ def test_bad_parameters(kwargs, message):
         facyl.fit_cylinders(pts, **kwargs)
 
 
+def test_settings_errors_name_the_keyword():
+    """Keywords are the tools' options (one table with the tools): an unknown keyword, or a
+    value out of its range (the settings struct's validate() says which), raises ValueError
+    naming the keyword, with the value as given."""
+    pts = cylinder(seed=1)["points"]
+    frame = np.zeros((4, 4, 3))
+
+    def detect(**kw):
+        return facyl.detect(frame, model="none", **kw)
+
+    def tracker(**kw):
+        return facyl.Tracker(model="none", **kw)
+
+    for call, keyword, value, message in [
+            (detect, "neighbours", 3, r"^neighbours: 3 is not in \[5, 200\]$"),
+            (detect, "k", 300, r"^k: 300 is not in \[5, 200\]$"),
+            (detect, "max_taper", 0, r"^max_taper: 0 is not in \(0, 1\]$"),
+            (detect, "voting", "majority",
+             r"^voting: 'majority' is not soft-curvature, soft-normal or rabbani$"),
+            (tracker, "min_score", 2, r"^min_score: 2 is not in \[0, 1\]$"),
+            (tracker, "track_max_misses", 0, r"^track_max_misses: max_misses 0 is not in"),
+            (facyl.fit_cylinders, "orientations", 5, r"^orientations: 5 is not in \[10, 100000\]$"),
+            (facyl.fit_cylinders, "max_cylinders", 101, r"^max_cylinders: 101 is not in"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            if call is facyl.fit_cylinders:
+                call(pts, **{keyword: value})
+            else:
+                call(**{keyword: value})
+    for call in (detect, tracker):
+        with pytest.raises(ValueError, match="^unknown option bogus$"):
+            call(bogus=1)
+    with pytest.raises(TypeError, match="^any_normal_sign: expected True or False"):
+        detect(any_normal_sign="yes")
+
+
 def test_bad_normals_and_frames():
     pts = cylinder(seed=1)["points"]
     with pytest.raises(ValueError, match="normals"):

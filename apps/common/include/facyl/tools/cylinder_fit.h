@@ -4,6 +4,8 @@
  */
 #pragma once
 
+#include <facyl/tools/settings_table.h>
+
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/hough_cylinder_estimation.h>
 
@@ -11,6 +13,7 @@
 #include <pcl/point_types.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace facyl_cli {
@@ -21,6 +24,22 @@ struct HoughSettings {
   facyl::HoughCylinderParameters params;
   Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
 };
+
+/** The voting modes, in the help's order. */
+inline std::vector<std::pair<std::string, facyl::VotingMode>>
+votingChoices()
+{
+  using V = facyl::VotingMode;
+  return namedChoices<V>({V::SoftCurvature, V::SoftNormal, V::Rabbani});
+}
+
+/** The orientation priors, in the help's order. */
+inline std::vector<std::pair<std::string, facyl::OrientationPrior>>
+priorChoices()
+{
+  using P = facyl::OrientationPrior;
+  return namedChoices<P>({P::Uniform, P::Vertical, P::VerticalStrong, P::Horizontal});
+}
 
 /** Normals and curvatures of \a cloud from its \a k nearest neighbours (\a normals, when
  * given, instead of the estimated normals); \a threads 0: all cores. The result has the
