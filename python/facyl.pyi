@@ -60,6 +60,10 @@ def fit_cylinders(
     distance_threshold: Optional[float] = None,
     max_cylinders: int = 1,
     outward_normals: bool = False,
+    any_normal_sign: bool = False,
+    point_candidates: int = 3,
+    coarse_scale: float = 1.0,
+    method: str = "facyl",  # "facyl" | "pcl-ransac"
     seed: int = 0,
     units: str = "auto",  # "auto" | "m" | "mm"
     k: Optional[int] = None,  # old spelling of neighbours

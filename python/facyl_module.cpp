@@ -399,7 +399,7 @@ estimateNormalsCurvatures(const py::object& points, const py::object& neighbours
 // ------------------------------------------------------------------------------- fitting
 
 /** The fit of facyl_fit (apps/common/include/facyl/tools/cylinder_fit.h) on \a cloud (already in
- * metres): cues estimated unless \a normals. */
+ * metres): cues estimated unless \a normals, then the method of \a s. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
          const FitSettings& s, std::string* why = nullptr)
@@ -407,6 +407,8 @@ fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::Const
   const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, 0, normals);
   if (cues->size() != cloud->size())
     return {};
+  if (s.method == "pcl-ransac")
+    return facyl_cli::pclRansacFit(cloud, *cues, s.params);
   return facyl_cli::houghFit(cloud, cues, s, why);
 }
 
@@ -939,16 +941,22 @@ the table: vertical in its frame). neighbours: k of the normal and curvature est
 accumulators: independent accumulators ()" +
          value("accumulators") + R"(). distance_threshold: inlier distance (default
 None: estimated from the residuals). outward_normals: inliers' normals must point away from
-the axis (default False). seed: seed of the randomized accumulator (same seed, same result).
+the axis (default False; any_normal_sign=True says the default). point_candidates:
+candidates refined and compared on the points (0: the best alone, as facyl 0.1). coarse_scale:
+at high noise, cues again from neighbours within this many radii (0: never). method: "facyl",
+or "pcl-ransac" (PCL's SACSegmentationFromNormals on the same normals, for comparison). seed:
+seed of the randomized accumulator (same seed, same result).
 units: facyl works in metres. "auto" (default): metres, and a cloud evidently in millimetres
 (spanning more than )" +
          facyl_cli::compactNumber(facyl_cli::kMaxMetreExtent) +
          R"( units) or radius limits beyond 1 raise ValueError; "m": metres, no
 check; "mm": points, lengths given and results in millimetres (converted to metres for the
 fit and back).
+Every keyword and its default: )" +
+         keywordDefaults(table, d) + R"(.
 Returns a list of Cylinder, best first; empty when no cylinder is found (with a UserWarning that
 says why: the radius limits exclude the cylinder there, too few points, ...). Raises
-ValueError/TypeError for bad input.)";
+ValueError for an unknown keyword or a bad value, TypeError for a value of the wrong type.)";
 }
 
 std::string
@@ -1051,36 +1059,10 @@ PYBIND11_MODULE(facyl, m)
   const FitSettings fit; // the defaults' one home
   m.def(
     "fit_cylinders",
-    [](const py::object& points, const py::object& normals, const py::object& radius_limits,
-       const py::object& prior, const py::object& up, const std::string& voting,
-       const py::object& neighbours, int orientations, int accumulators,
-       const py::object& distance_threshold, int max_cylinders, bool outward_normals,
-       long long seed, const std::string& units, const py::object& k) {
-      if (!k.is_none() && neighbours.cast<int>() != FitSettings{}.neighbours)
-        throw py::value_error("give neighbours once (k is its old spelling)");
-      return fitCylinders(points, normals,
-                          {{"radius_limits", radius_limits},
-                           {"prior", prior},
-                           {"up", up},
-                           {"voting", py::str(voting)},
-                           {k.is_none() ? "neighbours" : "k", k.is_none() ? neighbours : k},
-                           {"orientations", py::int_(orientations)},
-                           {"accumulators", py::int_(accumulators)},
-                           {"distance_threshold", distance_threshold},
-                           {"max_cylinders", py::int_(max_cylinders)},
-                           {"outward_normals", py::bool_(outward_normals)},
-                           {"seed", py::int_(seed)},
-                           {"units", py::str(units)}});
+    [](const py::object& points, const py::object& normals, const py::kwargs& options) {
+      return fitCylinders(points, normals, keywordList(options));
     },
-    py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
-    py::arg("radius_limits") = py::none(), py::arg("prior") = py::none(),
-    py::arg("up") = py::none(), py::arg("voting") = facyl::toString(fit.params.voting_mode),
-    py::arg("neighbours") = fit.neighbours, py::arg("orientations") = fit.params.orientations,
-    py::arg("accumulators") = fit.params.accumulators, py::arg("distance_threshold") = py::none(),
-    py::arg("max_cylinders") = fit.params.max_cylinders,
-    py::arg("outward_normals") = fit.params.outward_normals, py::arg("seed") = fit.params.seed,
-    py::arg("units") = facyl_cli::fitOptions().find("units")->show(fit), py::arg("k") = py::none(),
-    fitDoc(fit).c_str());
+    py::arg("points"), py::arg("normals") = py::none(), fitDoc(fit).c_str());
 
   m.def(
     "estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),

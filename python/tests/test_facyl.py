@@ -117,6 +117,31 @@ def test_defaults_are_facyl_fits():
             assert c.radius == pytest.approx(ref["radius"], rel=1e-5), name
 
 
+def test_fit_cylinders_takes_every_option_of_facyl_fit():
+    """Issue 41: fit_cylinders takes facyl_fit's options under the same names (point_candidates,
+    coarse_scale, method and any_normal_sign were missing), and an unknown keyword raises
+    ValueError naming it alone (pybind's TypeError printed the whole array)."""
+    sim = cylinder(seed=9, noise=0.02)
+    pts, radius = sim["points"], sim["truth"]["radius"]
+    c = facyl.fit_cylinders(pts, point_candidates=0, coarse_scale=0.5, any_normal_sign=True)
+    assert c[0].radius == pytest.approx(radius, rel=0.05)
+    ransac = facyl.fit_cylinders(pts, method="pcl-ransac")
+    assert ransac and ransac[0].radius == pytest.approx(radius, rel=0.1)
+    with pytest.raises(ValueError, match="^unknown option bogus$"):
+        facyl.fit_cylinders(pts, bogus=1)
+    with pytest.raises(ValueError, match="^give neighbours once"):
+        facyl.fit_cylinders(pts, k=12, neighbours=14)
+    if FACYL_FIT:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "c.pcd")
+            write_pcd(path, pts.astype(np.float32))
+            out = subprocess.run([FACYL_FIT, "--method", "pcl-ransac", path], check=True,
+                                 capture_output=True, text=True).stdout
+        ref = json.loads(out)["cylinders"][0]
+        mine = facyl.fit_cylinders(pts.astype(np.float32), method="pcl-ransac")[0]
+        assert mine.radius == pytest.approx(ref["radius"], rel=1e-5)
+
+
 def test_open3d_vectors_are_taken_as_they_are():
     o3d = pytest.importorskip("open3d")
     sim = cylinder(seed=4)
@@ -549,3 +574,20 @@ def test_stub_defaults_are_the_module_defaults():
             assert module_value == stub_value, (node.name, arg.arg, module_value, stub_value)
             checked += 1
     assert checked >= 10
+    # fit_cylinders takes **options: its keywords and their defaults are listed in its
+    # docstring, from the same table as facyl_fit's options.
+    listed = dict(pair.split("=", 1) for pair in
+                  facyl.fit_cylinders.__doc__.split("Every keyword and its default: ")[1]
+                  .split(".\n")[0].replace("\n", " ").split(", ") if "=" in pair
+                  and "(" not in pair and ")" not in pair)
+    stub_fit = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and
+                    n.name == "fit_cylinders")
+    compared = 0
+    for arg, default in zip(stub_fit.args.kwonlyargs, stub_fit.args.kw_defaults):
+        stub_value = ast.literal_eval(default)
+        if stub_value is None:
+            continue
+        assert arg.arg in listed, arg.arg
+        assert ast.literal_eval(listed[arg.arg]) == stub_value, (arg.arg, listed[arg.arg])
+        compared += 1
+    assert compared >= 10
