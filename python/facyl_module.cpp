@@ -115,24 +115,12 @@ vector3(const Eigen::Vector3f& v)
 using facyl_cli::OptionValue;
 using facyl_cli::ValueKind;
 
-/** How a keyword's value is echoed in messages. */
+/** A keyword's value as the user wrote it, for messages: its repr (0.1, not the double's
+ * 0.10000000000000001). */
 std::string
 written(const py::handle& v)
 {
-  const auto one = [](const py::handle& x) -> std::string {
-    if (py::isinstance<py::float_>(x)) {
-      char buf[40];
-      std::snprintf(buf, sizeof buf, "%.17g", x.cast<double>());
-      return buf;
-    }
-    return std::string(py::str(x));
-  };
-  if (py::isinstance<py::str>(v) || !py::isinstance<py::sequence>(v))
-    return one(v);
-  std::string out;
-  for (const auto& x : py::reinterpret_borrow<py::sequence>(v))
-    out += (out.empty() ? "" : ",") + one(x);
-  return out;
+  return std::string(py::repr(v));
 }
 
 /** \a v as a number; nullopt when it is none (a bool is none either). */
@@ -183,7 +171,8 @@ keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py
   };
   switch (o.kind) {
   case ValueKind::Switch:
-    if (!py::isinstance<py::bool_>(v))
+    if (!py::isinstance<py::bool_>(v) &&
+        !py::isinstance(v, py::module_::import("numpy").attr("bool_")))
       throw wrong("True or False");
     break;
   case ValueKind::Integer: {
@@ -202,7 +191,7 @@ keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py
     else if (std::isfinite(*d) && std::floor(*d) == *d && std::abs(*d) < 9e18)
       out.integer = static_cast<long long>(*d);
     else
-      throw py::value_error(keyword + ": '" + out.written + "' is not an integer");
+      throw py::value_error(keyword + ": " + out.written + " is not an integer");
     break;
   }
   case ValueKind::Number: {
@@ -210,21 +199,21 @@ keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py
     if (!d)
       throw wrong("a number");
     if (!std::isfinite(*d))
-      throw py::value_error(keyword + ": '" + out.written + "' is not a number");
+      throw py::value_error(keyword + ": " + out.written + " is not a number");
     out.number = *d;
     break;
   }
   case ValueKind::Pair: {
     const auto values = numbers(2);
     if (values.empty())
-      throw py::value_error(keyword + ": expected A,B, got '" + out.written + "'");
+      throw py::value_error(keyword + ": expected two numbers (A, B), got " + out.written);
     out.pair = {values[0], values[1]};
     break;
   }
   case ValueKind::Vector3: {
     const auto values = numbers(3);
     if (values.empty())
-      throw py::value_error(keyword + ": expected x,y,z, got '" + out.written + "'");
+      throw py::value_error(keyword + ": expected three numbers (x, y, z), got " + out.written);
     out.vector = Eigen::Vector3d(values[0], values[1], values[2]).cast<float>();
     break;
   }

@@ -397,6 +397,22 @@ def test_settings_errors_name_the_keyword():
             call(bogus=1)
     with pytest.raises(TypeError, match="^any_normal_sign: expected True or False"):
         detect(any_normal_sign="yes")
+    with pytest.raises(ValueError, match="exclude each other"):  # numpy's bools are bools
+        detect(any_normal_sign=np.True_, outward_normals=True)
+
+
+def test_values_are_echoed_as_written():
+    """Issue 41: radius_limits=0.1 said "got '0.10000000000000001'"; a message echoes the value
+    as the user wrote it (its repr)."""
+    pts = cylinder(seed=1)["points"]
+    with pytest.raises(ValueError, match=r"^radius_limits: expected two numbers \(A, B\), got 0\.1$"):
+        facyl.fit_cylinders(pts, radius_limits=0.1)
+    with pytest.raises(ValueError, match=r"^min_score: 1\.1 is not in \[0, 1\]$"):
+        facyl.detect(np.zeros((4, 4, 3)), model="none", min_score=1.1)
+    with pytest.raises(ValueError, match=r"^up: expected three numbers \(x, y, z\), got \(0, 1\)$"):
+        facyl.fit_cylinders(pts, up=(0, 1))
+    with pytest.raises(ValueError, match=r"^orientations: 450\.5 is not an integer$"):
+        facyl.fit_cylinders(pts, orientations=450.5)
 
 
 def test_bad_normals_and_frames():
