@@ -47,7 +47,7 @@ using Cues = pcl::PointCloud<facyl::NormalCurvature>;
 // ------------------------------------------------------------------------------ inputs
 
 /** The float32 or float64 array \a obj as float64 values, checked to have \a cols columns
- * (ndim 2) or, with \a frame, shape (H, W, cols). */
+ * (ndim 2) or, with \a frame, shape (H, W, cols); float16 raises TypeError. */
 py::array_t<double, py::array::c_style | py::array::forcecast>
 floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame = false)
 {
@@ -60,10 +60,12 @@ floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame
   const auto a = py::isinstance<py::array>(obj)
                    ? py::reinterpret_borrow<py::array>(obj)
                    : py::array(py::reinterpret_borrow<py::buffer>(obj));
-  const auto kind = a.dtype().kind();
-  if (kind != 'f')
+  // float16 is refused, not converted: its 3 significant digits cannot hold a point of a
+  // scene (a millimetre at 2 m needs 4).
+  if (a.dtype().kind() != 'f' || a.itemsize() < 4)
     throw py::type_error(std::string(name) + ": expected float32 or float64 values, got dtype " +
-                         std::string(py::str(a.dtype())));
+                         std::string(py::str(a.dtype())) +
+                         (a.itemsize() == 2 ? " (convert it: .astype(numpy.float32))" : ""));
   const bool ok =
     frame ? (a.ndim() == 3 && a.shape(2) == cols) : (a.ndim() == 2 && a.shape(1) == cols);
   if (!ok) {
@@ -974,8 +976,9 @@ support -1. Raises ValueError for bad input.)";
 PYBIND11_MODULE(facyl, m)
 {
   m.doc() = "facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.\n\n"
-            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), or Open3D "
-            "Vector3dVector; metres (fit_cylinders: units=\"mm\" converts); NaN rows are missing "
+            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3); float16 raises "
+            "TypeError: convert it), or Open3D Vector3dVector; metres (fit_cylinders: units=\"mm\" "
+            "converts); NaN rows are missing "
             "points. Keywords are the tools' option names with '_' for '-', with their defaults. "
             "Functions release the GIL while they compute.";
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);

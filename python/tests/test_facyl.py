@@ -333,6 +333,8 @@ def test_bundled_scene_matches_facyl_detect():
     (np.zeros((0, 3)), ValueError, "empty"),
     (np.full((50, 3), np.nan), ValueError, "no row is finite"),
     (np.zeros((50, 3), np.int32), TypeError, "float32 or float64"),
+    # Issue 41: float16 was taken silently (3 significant digits: 2.0 m and 2.001 m are one).
+    (np.zeros((50, 3), np.float16), TypeError, "float32 or float64 values, got dtype float16"),
     ([[0.0, 0.0, 0.0]] * 50, TypeError, "numpy array"),
     (np.zeros((4, 3)), ValueError, "fewer than k"),
     (np.zeros(9), ValueError, "expected shape"),
@@ -423,6 +425,10 @@ def test_bad_normals_and_frames():
         facyl.detect(np.full((4, 4, 3), np.nan))
     with pytest.raises(TypeError, match="colors"):
         facyl.detect(np.zeros((4, 4, 3)), np.zeros((4, 4, 3)))
+    with pytest.raises(TypeError, match="^points: .*got dtype float16"):
+        facyl.detect(np.zeros((4, 4, 3), np.float16))
+    with pytest.raises(TypeError, match="^normals: .*got dtype float16"):
+        facyl.fit_cylinders(pts, pts.astype(np.float16))
     with pytest.raises(ValueError, match="model"):
         facyl.detect(np.random.default_rng(0).random((20, 20, 3)), model="/nonexistent.onnx")
     # No support in view is not an error: the frame's objects, with "found" False.
