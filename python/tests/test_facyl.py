@@ -429,7 +429,8 @@ def test_bad_normals_and_frames():
         facyl.detect(np.zeros((4, 4, 3), np.float16))
     with pytest.raises(TypeError, match="^normals: .*got dtype float16"):
         facyl.fit_cylinders(pts, pts.astype(np.float16))
-    with pytest.raises(ValueError, match="model"):
+    # Issue 41: the message named "/nonexistent.cfg".
+    with pytest.raises(ValueError, match="^model: .*/nonexistent.onnx: no such file"):
         facyl.detect(np.random.default_rng(0).random((20, 20, 3)), model="/nonexistent.onnx")
     # No support in view is not an error: the frame's objects, with "found" False.
     nothing = facyl.detect(cylinder(seed=1)["points"], model="none")
