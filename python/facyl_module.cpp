@@ -125,7 +125,7 @@ written(const py::handle& v)
   return std::string(py::repr(v));
 }
 
-/** \a v as a number; nullopt when it is none (a bool is none either). */
+/** \a v as a number; nullopt when it is not one (a bool is not). */
 std::optional<double>
 numberOf(const py::handle& v)
 {
@@ -178,10 +178,9 @@ keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py
       throw wrong("True or False");
     break;
   case ValueKind::Integer: {
-    const auto d = numberOf(v);
-    if (!d)
+    if (py::isinstance<py::bool_>(v))
       throw wrong("an integer");
-    if (PyIndex_Check(v.ptr())) {
+    if (PyIndex_Check(v.ptr())) { // int, numpy's integers: beyond 64 bits, saturated
       int overflow = 0;
       const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(v.ptr()));
       out.integer = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
@@ -189,11 +188,14 @@ keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py
       if (overflow)
         out.integer = overflow > 0 ? std::numeric_limits<long long>::max()
                                    : std::numeric_limits<long long>::min();
+      break;
     }
-    else if (std::isfinite(*d) && std::floor(*d) == *d && std::abs(*d) < 9e18)
-      out.integer = static_cast<long long>(*d);
-    else
+    const auto d = numberOf(v); // a float with an integral value is taken
+    if (!d)
+      throw wrong("an integer");
+    if (!(std::isfinite(*d) && std::floor(*d) == *d && std::abs(*d) < 9e18))
       throw py::value_error(keyword + ": " + out.written + " is not an integer");
+    out.integer = static_cast<long long>(*d);
     break;
   }
   case ValueKind::Number: {
