@@ -34,6 +34,7 @@
 #include <cstring>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -880,24 +881,28 @@ pythonValue(facyl_cli::ValueKind kind, const std::string& text)
   }
 }
 
-/** "name=default, ..." of the keywords \a table gives Python, the defaults those of
- * \a defaults where the help prints them (a word: always), else None; False: a switch. */
+/** "name=default, ...; switches (True gives one): name, ..." of the keywords \a table gives
+ * Python but \a skipped, the defaults those of \a defaults where the help prints them (a word:
+ * always), else None. */
 template <typename S>
 std::string
-keywordDefaults(const facyl_cli::SettingsTable<S>& table, const S& defaults)
+keywordDefaults(const facyl_cli::SettingsTable<S>& table, const S& defaults,
+                const std::set<std::string>& skipped = {})
 {
   const facyl_cli::Vocabulary say{true};
-  std::string out;
+  std::string values, switches;
   for (const auto& o : table.options) {
-    if (o.tool_only)
+    if (o.tool_only || skipped.count(o.name))
       continue;
+    if (o.kind == ValueKind::Switch) {
+      switches += (switches.empty() ? "" : ", ") + say.option(o.name);
+      continue;
+    }
     const bool printed = o.kind == ValueKind::Word || o.help.find("{}") != std::string::npos;
-    const std::string value = o.kind == ValueKind::Switch ? "False"
-                              : printed                   ? pythonValue(o.kind, o.show(defaults))
-                                                          : "None";
-    out += (out.empty() ? "" : ", ") + say.option(o.name) + "=" + value;
+    values += (values.empty() ? "" : ", ") + say.option(o.name) + "=" +
+              (printed ? pythonValue(o.kind, o.show(defaults)) : "None");
   }
-  return out;
+  return values + "; switches (True gives one): " + switches;
 }
 
 std::string
@@ -963,7 +968,9 @@ objects' pixel boxes. colors: uint8 RGB of the same shape, optional. up: gravity
 optional. model: "default" (the shipped shape classifier), "none", or a path to an .onnx with
 its .cfg. Any other keyword is one of facyl_detect's recognizer options with '_' for '-'
 (the same checks; facyl_detect -h says what each does); their defaults: )" +
-         keywordDefaults(facyl_cli::recognizerOptions(), facyl_cli::RecognizerSettings{}) + R"(.
+         keywordDefaults(facyl_cli::recognizerOptions(), facyl_cli::RecognizerSettings{},
+                         {"model", "up"}) +
+         R"(.
 Returns facyl_detect's JSON object as a dict, the same fields with the same meanings:
 "organized", "table" {"coefficients": [a, b, c, d] of the table plane in the cloud's frame
 with a unit normal towards the sensor, or None; "found"}, "supports", "objects" (each with

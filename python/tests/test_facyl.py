@@ -599,10 +599,12 @@ def test_stub_defaults_are_the_module_defaults():
     assert checked >= 10
     # fit_cylinders takes **options: its keywords and their defaults are listed in its
     # docstring, from the same table as facyl_fit's options.
-    listed = dict(pair.split("=", 1) for pair in
-                  facyl.fit_cylinders.__doc__.split("Every keyword and its default: ")[1]
-                  .split(".\n")[0].replace("\n", " ").split(", ") if "=" in pair
-                  and "(" not in pair and ")" not in pair)
+    listed_text = facyl.fit_cylinders.__doc__.split("Every keyword and its default: ")[1]
+    values, switches = listed_text.split(".\n")[0].replace("\n", " ").split(
+        "; switches (True gives one): ")
+    listed = dict(pair.split("=", 1) for pair in values.split(", ")
+                  if "=" in pair and "(" not in pair and ")" not in pair)
+    listed.update((name, "False") for name in switches.split(", "))
     stub_fit = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and
                     n.name == "fit_cylinders")
     compared = 0
