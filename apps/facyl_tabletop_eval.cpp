@@ -717,8 +717,10 @@ parseOptions(int argc, char** argv)
   if (roll % 90 != 0)
     throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
   opt.roll = static_cast<int>(roll / 90);
-  facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
-  opt.classifier = facyl_cli::classifierFromOptions(args);
+  facyl_cli::RecognizerSettings recognizer;
+  opt.classifier = facyl_cli::applyRecognizerOptions(args, recognizer);
+  opt.params = recognizer.params;
+  opt.up = recognizer.up;
   if (opt.sim == 0 && opt.mosd.empty())
     throw std::invalid_argument("give --sim N and/or --mosd DIR");
   return opt;

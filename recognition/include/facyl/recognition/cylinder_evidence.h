@@ -48,8 +48,9 @@ struct CylinderDecision {
   float max_taper{0.15f};
 };
 
-/** \brief Checks \a decision. \return an empty string, or what is wrong. */
-std::string validate(const CylinderDecision& decision);
+/** \brief Checks \a decision. \return an empty string, or what is wrong; \a rule, when given,
+ * receives the rule broken alone (see settingProblem). */
+std::string validate(const CylinderDecision& decision, std::string* rule = nullptr);
 
 /** \brief What the decision looks at for one object. */
 struct CylinderEvidence {

@@ -207,6 +207,10 @@ constexpr std::size_t kMinOrientations = 10;
 constexpr std::size_t kMaxOrientations = 100000;
 /** \brief Most accumulators per fit (HoughCylinderParameters::accumulators). */
 constexpr std::size_t kMaxAccumulators = 64;
+/** \brief The radius limits (m) of the tabletop recognizer (tabletopHoughDefaults) and of the
+ * tools' bare fit (facyl_fit, Python's fit_cylinders): cans to buckets. */
+constexpr double kDefaultRadiusMin = 0.01;
+constexpr double kDefaultRadiusMax = 0.25;
 
 /** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). Each
  * setting has its home here: the tools, the recognizer and the Python module read their
@@ -261,8 +265,9 @@ struct HoughCylinderParameters {
   bool outward_normals{false};
 };
 
-/** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string validate(const HoughCylinderParameters& params);
+/** \brief Checks \a params. \return an empty string, or what is wrong ("NAME VALUE RULE",
+ * settingProblem); \a rule, when given, receives the RULE alone (see settingProblem). */
+std::string validate(const HoughCylinderParameters& params, std::string* rule = nullptr);
 
 /** \brief The points a cylinder needs among \a n (HoughCylinderParameters::min_inliers, or
  * its automatic value when 0). */
