@@ -233,7 +233,7 @@ runTask(const Task& task, const Level& level, const std::vector<Method>& ms, std
   Cues::Ptr cues(new Cues);
   facyl::NormalCurvatureEstimation<pcl::PointXYZ> ne;
   ne.setInputCloud(s.cloud);
-  ne.setKSearch(16);
+  ne.setKSearch(facyl::kDefaultNeighbours);
   ne.setNumberOfThreads(1);
   ne.compute(*cues);
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);

@@ -51,7 +51,8 @@ struct Scene {
 /** |P| lateral points plus \a lid_ratio times as many lid points (outliers, eq. 5), noise
  * \a noise of the radius, r = 0.3 m. */
 Scene
-makeScene(std::size_t lateral, int k = 16, float noise = 0.01f, float lid_ratio = 1.f)
+makeScene(std::size_t lateral, int k = facyl::kDefaultNeighbours, float noise = 0.01f,
+          float lid_ratio = 1.f)
 {
   facyl::CylinderSimulationParameters p;
   p.radius = 0.3f;
@@ -123,7 +124,10 @@ void
 BM_FitAtNoise(benchmark::State& state)
 {
   Hough hough;
-  timeFits(state, makeScene(900, 16, 0.01f * static_cast<float>(state.range(0)), 0.f), hough);
+  timeFits(
+    state,
+    makeScene(900, facyl::kDefaultNeighbours, 0.01f * static_cast<float>(state.range(0)), 0.f),
+    hough);
 }
 BENCHMARK(BM_FitAtNoise)->Arg(1)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMillisecond);
 
@@ -231,12 +235,12 @@ BM_PclNormalsThenCurvatures(benchmark::State& state)
   for (auto _ : state) {
     pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
     ne.setInputCloud(s.cloud);
-    ne.setKSearch(16);
+    ne.setKSearch(facyl::kDefaultNeighbours);
     ne.compute(*normals);
     pcl::PrincipalCurvaturesEstimation<pcl::PointXYZ, pcl::Normal> pce;
     pce.setInputCloud(s.cloud);
     pce.setInputNormals(normals);
-    pce.setKSearch(16);
+    pce.setKSearch(facyl::kDefaultNeighbours);
     pce.compute(curvatures);
     benchmark::DoNotOptimize(curvatures);
   }

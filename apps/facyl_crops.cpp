@@ -13,6 +13,7 @@
  */
 #include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/json_writer.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/scene_options.h>
 
@@ -490,7 +491,8 @@ main(int argc, char** argv)
       failed += uwCrops(s, out);
     if (!s.mosd.empty())
       failed += mosdCrops(s, rec, out);
-    std::printf("{\"objects\":%zu,\"failed\":%zu,\"size\":%d}\n", out.rows(), failed, s.size);
+    const facyl_cli::Json summary{{"objects", out.rows()}, {"failed", failed}, {"size", s.size}};
+    std::printf("%s\n", facyl_cli::dumpJson(summary).c_str());
   }
   catch (const std::exception& e) {
     std::fprintf(stderr, "facyl_crops: %s\n", e.what());

@@ -7,6 +7,7 @@
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/track_json.h>
+#include <facyl/tools/tracker_options.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/simulation/frame_roll.h>
@@ -46,7 +47,8 @@ printHelp(const char* self)
     "                         <stem>-<k>.png when scenes share a name, k from 1). A path not\n"
     "                         ending in .png, or one that is an input, is refused\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png);\n"
-    "                         refused when a name it would write is an input\n"
+    "                         refused when DIR holds an input (a later *.pcd there would\n"
+    "                         read the clusters as scenes) or a name it would write is one\n"
     "  --repeat N             run N times, report the median timing (default 1)\n"
     "  --verbose              what each step found (PCL's debug messages, on standard\n"
     "                         output between the JSON lines)\n"
@@ -63,13 +65,13 @@ printHelp(const char* self)
     "                         own; each line adds \"stream\" and \"tracks\" (every live track).\n"
     "                         A frame that fails (its line has \"error\") does not end the\n"
     "                         stream; frames of a new scene start new tracks. docs/tracking.md\n"
-    "  --track-confirm-hits N frames a new track must be seen in to be confirmed (default 2)\n"
-    "  --track-max-misses N   missed frames a confirmed track survives (default 5)\n"
-    "%s"
+    "%s%s"
     "Exit status: 0 all scenes processed (warnings, e.g. no overlay for an unorganized cloud\n"
     "without --camera, go to standard error and do not change it), 1 a scene failed or an\n"
     "output could not be written (its JSON has \"error\"), 2 bad usage (nothing written).\n",
-    self, facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
+    self, facyl_cli::recognizerOptionsHelp(),
+    facyl_cli::helpText(facyl_cli::trackerOptions(), facyl::CylinderTrackerParameters{}).c_str(),
+    facyl_cli::commonHelp());
 }
 
 // ---- drawing on an RGB buffer ----
@@ -421,6 +423,15 @@ checkOutputs(const Settings& s, const std::vector<std::string>& files, const std
     facyl_cli::checkOutputFolder(
       "--save-clusters", s.clusters_dir, [&](const std::string& f) { return isName(f, "_obj"); },
       inputs);
+    // Not into a folder of scenes: its next *.pcd would read the clusters as scenes.
+    for (const auto& f : files) {
+      const std::filesystem::path p(f);
+      if (facyl_cli::samePath(p.has_parent_path() ? p.parent_path() : ".", s.clusters_dir))
+        throw std::invalid_argument("--save-clusters " + s.clusters_dir + ": holds the input " + f +
+                                    "; a later *.pcd of that folder would read the clusters "
+                                    "(<stem>_obj<k>.pcd) as scenes. Give another folder. "
+                                    "Nothing was written.");
+    }
   }
 }
 
@@ -431,16 +442,18 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   Settings s;
   const facyl_cli::Arguments args(
     argc, argv,
-    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
-                      {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll",
-                       "--track-confirm-hits", "--track-max-misses"}),
+    facyl_cli::joined(facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                                        facyl_cli::valueOptions(facyl_cli::trackerOptions())),
+                      {"--camera", "--overlay", "--save-clusters", "--repeat", "--roll"}),
     facyl_cli::joined(facyl_cli::recognizerSwitches(), {"--verbose", "--track"}),
     facyl_cli::recognizerAliases());
   files = args.positional();
   if (files.empty())
     throw std::invalid_argument("give at least one scene (see -h)");
-  facyl_cli::applyRecognizerOptions(args, s.params, s.up);
-  s.classifier = facyl_cli::classifierFromOptions(args);
+  facyl_cli::RecognizerSettings recognizer;
+  s.classifier = facyl_cli::applyRecognizerOptions(args, recognizer);
+  s.params = recognizer.params;
+  s.up = recognizer.up;
   if (args.has("--camera")) {
     std::istringstream in(args.text("--camera", ""));
     char c1 = 0, c2 = 0, c3 = 0;
@@ -465,10 +478,7 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.track = args.has("--track");
   if (!s.track && (args.has("--track-confirm-hits") || args.has("--track-max-misses")))
     throw std::invalid_argument("--track-confirm-hits and --track-max-misses need --track");
-  s.tracking.confirm_hits =
-    static_cast<int>(args.integer("--track-confirm-hits", s.tracking.confirm_hits, 1, 100));
-  s.tracking.max_misses =
-    static_cast<int>(args.integer("--track-max-misses", s.tracking.max_misses, 1, 1000));
+  facyl_cli::applyOptions(facyl_cli::trackerOptions(), args, s.tracking);
   s.many = files.size() > 1;
   checkOutputs(s, files, args.text("--model", ""));
   return s;

@@ -7,7 +7,6 @@
 #include <facyl/tools/fit_options.h>
 #include <facyl/tools/json_writer.h>
 #include <facyl/tools/pcd_input.h>
-#include <facyl/tools/pcl_baseline.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
@@ -50,24 +49,6 @@ struct Settings : facyl_cli::FitSettings {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using Cues = pcl::PointCloud<facyl::NormalCurvature>;
-
-/** PCL RANSAC on the same cloud and normals, with the same radius limits. */
-std::vector<facyl::CylinderModel>
-fitPclRansac(const Cloud::ConstPtr& cloud, const Cues& cues, const Settings& s)
-{
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  pcl::copyPointCloud(cues, *normals);
-  Eigen::Vector4f lo, hi;
-  pcl::getMinMax3D(*cloud, lo, hi);
-  const float diagonal = (hi - lo).head<3>().norm();
-  facyl_cli::PclCylinderOptions o;
-  o.distance_threshold =
-    s.params.distance_threshold > 0.f ? s.params.distance_threshold : 0.01f * diagonal;
-  o.radius_min = s.params.radius_min;
-  o.radius_max = std::isfinite(s.params.radius_max) ? s.params.radius_max : diagonal;
-  o.max_cylinders = s.params.max_cylinders;
-  return facyl_cli::fitPclCylinders<pcl::PointXYZ>(cloud, normals, o);
-}
 
 std::string
 errorObject(const std::string& file, const std::string& message)
@@ -115,7 +96,8 @@ processFile(const std::string& file, const Settings& s, bool& ok)
     return errorObject(file, units);
   const float to_metres = facyl_cli::metresPerUnit(s.units);
   facyl_cli::scaleCloud(*cloud, facyl_cli::metresPerUnitExact(s.units));
-  const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, s.threads, given);
+  const Cues::Ptr cues =
+    facyl_cli::estimateFitCues(cloud, s.neighbours, static_cast<unsigned>(s.threads), given);
   if (cues->size() != cloud->size())
     return errorObject(file, "normal estimation failed (too few points for k = " +
                                std::to_string(s.neighbours) + "?)");
@@ -129,7 +111,7 @@ processFile(const std::string& file, const Settings& s, bool& ok)
   pcl::StopWatch fit_watch;
   std::vector<facyl::CylinderModel> models;
   if (s.method == "pcl-ransac") {
-    models = fitPclRansac(cloud, *cues, s);
+    models = facyl_cli::pclRansacFit(cloud, *cues, s.params);
   }
   std::string why;
   if (s.method != "pcl-ransac")

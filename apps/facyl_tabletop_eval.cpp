@@ -6,6 +6,7 @@
  * Prints figures (markdown) and, with --csv FILE, one row per object.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/csv_reader.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/scene_options.h>
 
@@ -485,24 +486,9 @@ std::map<std::string, std::map<int, std::array<std::string, 3>>>
 readMosdLabels(std::istream& in)
 {
   std::map<std::string, std::map<int, std::array<std::string, 3>>> truth;
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::string cur;
-    bool quoted = false;
-    for (char ch : line) {
-      if (ch == '"')
-        quoted = !quoted;
-      else if (ch == ',' && !quoted)
-        f.push_back(cur), cur.clear();
-      else
-        cur += ch;
-    }
-    f.push_back(cur);
+  for (const auto& f : facyl_cli::readCsvRows(in))
     if (f.size() >= 9)
       truth[f[1]][std::stoi(f[2])] = {f[3], f[4], f[8]};
-  }
   return truth;
 }
 
@@ -731,8 +717,10 @@ parseOptions(int argc, char** argv)
   if (roll % 90 != 0)
     throw std::invalid_argument("--roll must be 0, 90, 180 or 270 (degrees)");
   opt.roll = static_cast<int>(roll / 90);
-  facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
-  opt.classifier = facyl_cli::classifierFromOptions(args);
+  facyl_cli::RecognizerSettings recognizer;
+  opt.classifier = facyl_cli::applyRecognizerOptions(args, recognizer);
+  opt.params = recognizer.params;
+  opt.up = recognizer.up;
   if (opt.sim == 0 && opt.mosd.empty())
     throw std::invalid_argument("give --sim N and/or --mosd DIR");
   return opt;

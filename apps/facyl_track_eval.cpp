@@ -6,6 +6,7 @@
 #include <facyl/tools/cli.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/scene_options.h>
+#include <facyl/tools/tracker_options.h>
 
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/simulation/tabletop_sequence.h>
@@ -494,11 +495,11 @@ parseOptions(int argc, char** argv)
   Options opt;
   const facyl_cli::Arguments args(
     argc, argv,
-    facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+    facyl_cli::joined(facyl_cli::joined(facyl_cli::recognizerValueOptions(),
+                                        facyl_cli::valueOptions(facyl_cli::trackerOptions())),
                       facyl_cli::joined(facyl_cli::sceneImageOptions(),
                                         {"--sequences", "--frames", "--first-seed", "--sensor",
-                                         "--layout", "--change", "--orbit", "--track-confirm-hits",
-                                         "--track-max-misses", "--csv"})),
+                                         "--layout", "--change", "--orbit", "--csv"})),
     facyl_cli::recognizerSwitches(), facyl_cli::recognizerAliases());
   if (!args.positional().empty())
     throw std::invalid_argument("unexpected argument " + args.positional()[0]);
@@ -517,15 +518,14 @@ parseOptions(int argc, char** argv)
   if (opt.change != "mixed" && !facyl::parseSequenceChange(opt.change, c))
     throw std::invalid_argument("--change must be mixed, none, remove or add");
   opt.sequence.orbit = static_cast<float>(args.number("--orbit", opt.sequence.orbit, 0.0, 6.3));
-  opt.tracking.confirm_hits =
-    static_cast<int>(args.integer("--track-confirm-hits", opt.tracking.confirm_hits, 1, 100));
-  opt.tracking.max_misses =
-    static_cast<int>(args.integer("--track-max-misses", opt.tracking.max_misses, 1, 1000));
+  facyl_cli::applyOptions(facyl_cli::trackerOptions(), args, opt.tracking);
   opt.csv = args.text("--csv", "");
   if (!opt.csv.empty())
     facyl_cli::checkOutputFile("--csv", opt.csv, {".csv"}, "CSV table", {});
-  facyl_cli::applyRecognizerOptions(args, opt.params, opt.up);
-  opt.classifier = facyl_cli::classifierFromOptions(args);
+  facyl_cli::RecognizerSettings recognizer;
+  opt.classifier = facyl_cli::applyRecognizerOptions(args, recognizer);
+  opt.params = recognizer.params;
+  opt.up = recognizer.up;
   return opt;
 }
 

@@ -507,13 +507,13 @@ pclObjects(const Scene& scene, Scene& pcl_scene)
     pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
     pcl::copyPointCloud(*scene.cloud, o.indices, *points);
     if (points->size() >= 20) {
-      const auto cues = facyl_cli::estimateFitCues(points, 16, 0, nullptr);
+      const auto cues = facyl_cli::estimateFitCues(points, facyl::kDefaultNeighbours, 0, nullptr);
       pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
       pcl::copyPointCloud(*cues, *normals);
       facyl_cli::PclCylinderOptions options;
       options.distance_threshold = 0.005f;
-      options.radius_min = 0.01f;
-      options.radius_max = 0.25f;
+      options.radius_min = static_cast<float>(facyl::kDefaultRadiusMin);
+      options.radius_max = static_cast<float>(facyl::kDefaultRadiusMax);
       const auto fits = facyl_cli::fitPclCylinders<pcl::PointXYZ>(points, normals, options);
       if (!fits.empty() && fits.front().inlier_ratio >= kPclMinInlierRatio) {
         q.is_cylinder = true;
@@ -1011,7 +1011,10 @@ parseSettings(int argc, char** argv)
     if (s.files.empty())
       throw std::invalid_argument("give at least one scene (see -h)");
   }
-  facyl_cli::applyRecognizerOptions(args, s.params, s.up);
+  facyl_cli::RecognizerSettings recognizer;
+  facyl_cli::applyOptions(facyl_cli::recognizerOptions(), args, recognizer);
+  s.params = recognizer.params;
+  s.up = recognizer.up;
   s.detections = args.text("--detections", "");
   if (!s.detections.empty() && args.has("--detect"))
     throw std::invalid_argument("--detect and --detections exclude each other");
@@ -1040,7 +1043,7 @@ parseSettings(int argc, char** argv)
   s.width = static_cast<int>(size.first);
   s.height = static_cast<int>(size.second);
   if (s.detect)
-    s.classifier = facyl_cli::classifierFromOptions(args);
+    s.classifier = facyl_cli::classifierFor(recognizer.model);
   return s;
 }
 

@@ -1,6 +1,7 @@
 """facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.
 
-Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), or Open3D Vector3dVector;
+Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3); float16 raises TypeError:
+convert it), or Open3D Vector3dVector;
 metres (fit_cylinders: units="mm" converts); NaN rows are missing points. Keywords are the
 tools' option names with '_' for '-', with their defaults. Functions release the GIL while
 they compute.
@@ -60,6 +61,10 @@ def fit_cylinders(
     distance_threshold: Optional[float] = None,
     max_cylinders: int = 1,
     outward_normals: bool = False,
+    any_normal_sign: bool = False,
+    point_candidates: int = 3,
+    coarse_scale: float = 1.0,
+    method: str = "facyl",  # "facyl" | "pcl-ransac"
     seed: int = 0,
     units: str = "auto",  # "auto" | "m" | "mm"
     k: Optional[int] = None,  # old spelling of neighbours

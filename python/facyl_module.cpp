@@ -7,7 +7,9 @@
 #include <facyl/tools/detect_json.h>
 #include <facyl/tools/fit_options.h>
 #include <facyl/tools/recognizer_options.h>
+#include <facyl/tools/settings_table.h>
 #include <facyl/tools/track_json.h>
+#include <facyl/tools/tracker_options.h>
 
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/recognition/cylinder_classifier.h>
@@ -32,7 +34,7 @@
 #include <cstring>
 #include <mutex>
 #include <optional>
-#include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -46,7 +48,7 @@ using Cues = pcl::PointCloud<facyl::NormalCurvature>;
 // ------------------------------------------------------------------------------ inputs
 
 /** The float32 or float64 array \a obj as float64 values, checked to have \a cols columns
- * (ndim 2) or, with \a frame, shape (H, W, cols). */
+ * (ndim 2) or, with \a frame, shape (H, W, cols); float16 raises TypeError. */
 py::array_t<double, py::array::c_style | py::array::forcecast>
 floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame = false)
 {
@@ -59,10 +61,12 @@ floatArray(const py::handle& obj, const char* name, py::ssize_t cols, bool frame
   const auto a = py::isinstance<py::array>(obj)
                    ? py::reinterpret_borrow<py::array>(obj)
                    : py::array(py::reinterpret_borrow<py::buffer>(obj));
-  const auto kind = a.dtype().kind();
-  if (kind != 'f')
+  // float16 is refused, not converted: its 3 significant digits cannot hold a point of a
+  // scene (a millimetre at 2 m needs 4).
+  if (a.dtype().kind() != 'f' || a.itemsize() < 4)
     throw py::type_error(std::string(name) + ": expected float32 or float64 values, got dtype " +
-                         std::string(py::str(a.dtype())));
+                         std::string(py::str(a.dtype())) +
+                         (a.itemsize() == 2 ? " (convert it: .astype(numpy.float32))" : ""));
   const bool ok =
     frame ? (a.ndim() == 3 && a.shape(2) == cols) : (a.ndim() == 2 && a.shape(1) == cols);
   if (!ok) {
@@ -111,72 +115,207 @@ vector3(const Eigen::Vector3f& v)
 
 // ------------------------------------------------------------------- one vocabulary
 
-/** A Python keyword value as a command-line value: numbers exactly, sequences as "a,b,c". */
+using facyl_cli::OptionValue;
+using facyl_cli::ValueKind;
+
+/** A keyword's value as the user wrote it, for messages: its repr (0.1, not the double's
+ * 0.10000000000000001). */
 std::string
-optionText(const py::handle& v)
+written(const py::handle& v)
 {
-  const auto one = [](const py::handle& x) -> std::string {
-    if (py::isinstance<py::bool_>(x))
-      return x.cast<bool>() ? "true" : "false";
-    if (py::isinstance<py::int_>(x))
-      return std::string(py::str(x));
-    if (py::isinstance<py::float_>(x)) {
-      char buf[40];
-      std::snprintf(buf, sizeof buf, "%.17g", x.cast<double>());
-      return buf;
-    }
-    if (py::isinstance<py::str>(x))
-      return x.cast<std::string>();
-    // numpy scalars and the like
-    return std::string(py::str(x));
+  return std::string(py::repr(v));
+}
+
+/** \a v as a number; nullopt when it is not one (a bool is not). */
+std::optional<double>
+numberOf(const py::handle& v)
+{
+  if (py::isinstance<py::bool_>(v) || py::isinstance<py::str>(v) || !PyNumber_Check(v.ptr()))
+    return std::nullopt;
+  const double d = PyFloat_AsDouble(v.ptr());
+  if (d == -1.0 && PyErr_Occurred()) {
+    PyErr_Clear();
+    return std::nullopt;
+  }
+  return d;
+}
+
+/** Keyword \a keyword's value \a v for option \a o, as that option's kind of value. A str is
+ * read as the tools read the option's text ("0.01,0.25", "auto").
+ * \throws py::type_error or py::value_error naming the keyword. */
+template <typename S>
+OptionValue
+keywordValue(const facyl_cli::Option<S>& o, const std::string& keyword, const py::handle& v)
+{
+  const auto wrong = [&](const std::string& expected) {
+    return py::type_error(keyword + ": expected " + expected + ", got " + written(v));
   };
-  if (py::isinstance<py::str>(v) || !py::isinstance<py::sequence>(v))
-    return one(v);
-  std::string out;
-  for (const auto& x : py::reinterpret_borrow<py::sequence>(v))
-    out += (out.empty() ? "" : ",") + one(x);
+  OptionValue out;
+  if (py::isinstance<py::str>(v) && o.kind != ValueKind::Switch) {
+    try {
+      return facyl_cli::readOptionValue(o, v.cast<std::string>());
+    }
+    catch (const std::invalid_argument& e) {
+      throw py::value_error(keyword + ": " + e.what());
+    }
+  }
+  out.written = written(v);
+  const auto numbers = [&](std::size_t n) {
+    std::vector<double> values;
+    if (!py::isinstance<py::sequence>(v) || py::len(v) != n)
+      return values;
+    for (const auto& x : py::reinterpret_borrow<py::sequence>(v)) {
+      const auto d = numberOf(x);
+      if (!d || !std::isfinite(*d))
+        return std::vector<double>();
+      values.push_back(*d);
+    }
+    return values;
+  };
+  switch (o.kind) {
+  case ValueKind::Switch:
+    if (!py::isinstance<py::bool_>(v) &&
+        !py::isinstance(v, py::module_::import("numpy").attr("bool_")))
+      throw wrong("True or False");
+    break;
+  case ValueKind::Integer: {
+    if (py::isinstance<py::bool_>(v))
+      throw wrong("an integer");
+    if (PyIndex_Check(v.ptr())) { // int, numpy's integers: beyond 64 bits, saturated
+      int overflow = 0;
+      const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(v.ptr()));
+      out.integer = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+      out.overflow = overflow != 0;
+      if (overflow)
+        out.integer = overflow > 0 ? std::numeric_limits<long long>::max()
+                                   : std::numeric_limits<long long>::min();
+      break;
+    }
+    const auto d = numberOf(v); // a float with an integral value is taken
+    if (!d)
+      throw wrong("an integer");
+    if (!(std::isfinite(*d) && std::floor(*d) == *d && std::abs(*d) < 9e18))
+      throw py::value_error(keyword + ": " + out.written + " is not an integer");
+    out.integer = static_cast<long long>(*d);
+    break;
+  }
+  case ValueKind::Number: {
+    const auto d = numberOf(v);
+    if (!d)
+      throw wrong("a number");
+    if (!std::isfinite(*d))
+      throw py::value_error(keyword + ": " + out.written + " is not a number");
+    out.number = *d;
+    break;
+  }
+  case ValueKind::Pair: {
+    const auto values = numbers(2);
+    if (values.empty())
+      throw py::value_error(keyword + ": expected two numbers (A, B), got " + out.written);
+    out.pair = {values[0], values[1]};
+    break;
+  }
+  case ValueKind::Vector3: {
+    const auto values = numbers(3);
+    if (values.empty())
+      throw py::value_error(keyword + ": expected three numbers (x, y, z), got " + out.written);
+    out.vector = Eigen::Vector3d(values[0], values[1], values[2]).cast<float>();
+    break;
+  }
+  case ValueKind::Word:
+    throw wrong("a str");
+  }
   return out;
 }
 
-/** Keyword arguments as the tools' words: name_with_underscores=value becomes
- * --name-with-underscores=value; True a switch, False and None nothing. */
+/** Keyword arguments (name, value) applied to \a s by \a table's rows: the tools' option
+ * names with '_' for '-', their checks and their messages. None is "not given", as False is
+ * for a switch. \throws py::value_error / py::type_error naming the keyword. */
+template <typename S>
 void
-appendOptions(std::vector<std::string>& words, const py::dict& options)
+applyKeywords(const facyl_cli::SettingsTable<S>& table,
+              const std::vector<std::pair<std::string, py::object>>& keywords, S& s)
 {
-  for (const auto& [key, value] : options) {
-    const std::string name =
-      "--" + std::regex_replace(key.cast<std::string>(), std::regex("_"), "-");
+  std::vector<facyl_cli::GivenOption<S>> given;
+  for (const auto& [keyword, value] : keywords) {
     if (value.is_none())
       continue;
-    if (py::isinstance<py::bool_>(value)) {
-      if (value.cast<bool>())
-        words.push_back(name);
+    std::string name = keyword;
+    std::replace(name.begin(), name.end(), '_', '-');
+    const facyl_cli::Option<S>* o = table.find(name);
+    if (!o || o->tool_only)
+      throw py::value_error("unknown option " + keyword);
+    const OptionValue v = keywordValue(*o, keyword, value);
+    if (o->kind == ValueKind::Switch && !py::cast<bool>(value))
       continue;
-    }
-    words.push_back(name + "=" + optionText(value));
+    for (const auto& g : given)
+      if (g.option == o)
+        throw py::value_error("give " + facyl_cli::Vocabulary{true}.option(o->name) + " once (" +
+                              facyl_cli::Vocabulary{true}.option(o->alias) +
+                              " is its old spelling)");
+    given.push_back({o, keyword, v});
+  }
+  try {
+    facyl_cli::applyOptions(table, given, facyl_cli::Vocabulary{true}, s);
+  }
+  catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
   }
 }
 
-/** A tool's message in Python's words: --radius-limits is radius_limits. */
-std::string
-pythonWords(std::string message)
+/** The keyword arguments of \a options, in their order. */
+std::vector<std::pair<std::string, py::object>>
+keywordList(const py::dict& options)
 {
-  message = std::regex_replace(message, std::regex("--units mm"), "units=\"mm\"");
-  message = std::regex_replace(message, std::regex("--units m\\b"), "units=\"m\"");
-  message = std::regex_replace(message, std::regex(" \\(see -h\\)"), "");
-  std::string out;
-  const std::regex option("--([a-z][a-z0-9-]*)");
-  auto begin = std::sregex_iterator(message.begin(), message.end(), option);
-  std::size_t last = 0;
-  for (auto it = begin; it != std::sregex_iterator(); ++it) {
-    out += message.substr(last, static_cast<std::size_t>(it->position()) - last);
-    out += std::regex_replace(it->str(1), std::regex("-"), "_");
-    last = static_cast<std::size_t>(it->position() + it->length());
-  }
-  return out + message.substr(last);
+  std::vector<std::pair<std::string, py::object>> list;
+  for (const auto& [key, value] : options)
+    list.emplace_back(key.cast<std::string>(), py::reinterpret_borrow<py::object>(value));
+  return list;
 }
 
 // ---------------------------------------------------------------------------- results
+
+/** \a j, a result as the tools write it (json_writer.h: numbers already carry their digits),
+ * as Python objects: dicts keep the fields' order, null is None. */
+py::object
+toPython(const facyl_cli::Json& j)
+{
+  using T = facyl_cli::Json::value_t;
+  switch (j.type()) {
+  case T::null:
+    return py::none();
+  case T::boolean:
+    return py::bool_(j.get<bool>());
+  case T::number_integer:
+    return py::int_(j.get<std::int64_t>());
+  case T::number_unsigned:
+    return py::int_(j.get<std::uint64_t>());
+  case T::number_float:
+    return py::float_(j.get<double>());
+  case T::string: {
+    const auto& text = j.get_ref<const std::string&>();
+    return py::reinterpret_steal<py::object>(
+      PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace"));
+  }
+  case T::array: {
+    py::list list;
+    for (const auto& x : j)
+      list.append(toPython(x));
+    return std::move(list);
+  }
+  case T::object: {
+    py::dict dict;
+    for (const auto& [key, value] : j.items())
+      dict[py::str(key)] = toPython(value);
+    return std::move(dict);
+  }
+  default:
+    return py::none();
+  }
+}
+
+/** The digits of the numbers of Python's results: a float32 exactly. */
+constexpr int kPythonDigits = 9;
 
 /** A fitted cylinder as Python sees it. */
 struct PyCylinder {
@@ -185,26 +324,44 @@ struct PyCylinder {
 
 // ------------------------------------------------------------------- normals, curvatures
 
-void
-checkK(int k, std::size_t points)
+using FitSettings = facyl_cli::FitSettings;
+
+/** facyl_fit's settings from keywords (fitOptions). \throws py::value_error. */
+FitSettings
+fitSettings(const std::vector<std::pair<std::string, py::object>>& keywords)
 {
-  if (k < 3 || k > 1000)
-    throw py::value_error("neighbours: " + std::to_string(k) + " is not in [3, 1000]");
+  FitSettings s;
+  applyKeywords(facyl_cli::fitOptions(), keywords, s);
+  return s;
+}
+
+/** \a neighbours, or its old spelling \a k, as the fit reads them. */
+int
+neighboursOf(const py::object& neighbours, const py::object& k)
+{
+  const bool both = !k.is_none() && neighbours.cast<int>() != FitSettings{}.neighbours;
+  std::vector<std::pair<std::string, py::object>> keywords{{"k", k}};
+  if (k.is_none() || both)
+    keywords.insert(keywords.begin(), {"neighbours", neighbours});
+  return fitSettings(keywords).neighbours;
+}
+
+void
+checkRows(std::size_t points, int k)
+{
   if (points < static_cast<std::size_t>(k))
     throw py::value_error("points: " + std::to_string(points) +
                           " rows are fewer than k = " + std::to_string(k) + " neighbours");
 }
 
 py::tuple
-estimateNormalsCurvatures(const py::object& points, int neighbours,
-                          const std::optional<int>& k_alias)
+estimateNormalsCurvatures(const py::object& points, const py::object& neighbours,
+                          const py::object& k_alias)
 {
-  if (k_alias && neighbours != 16 && *k_alias != neighbours)
-    throw py::value_error("give neighbours once (k is its old spelling)");
-  const int k = k_alias ? *k_alias : neighbours;
+  const int k = neighboursOf(neighbours, k_alias);
   const auto a = floatArray(points, "points", 3);
   const Cloud::Ptr cloud = toCloud(a, "points");
-  checkK(k, cloud->size());
+  checkRows(cloud->size(), k);
   Cues::Ptr cues;
   {
     py::gil_scoped_release release;
@@ -235,39 +392,8 @@ estimateNormalsCurvatures(const py::object& points, int neighbours,
 
 // ------------------------------------------------------------------------------- fitting
 
-using FitSettings = facyl_cli::FitSettings;
-
-/** facyl_fit's settings from the keywords (facyl_fit's options, same names with '_', same
- * defaults, same checks). \throws py::value_error. */
-FitSettings
-fitSettings(const py::dict& options)
-{
-  std::vector<std::string> words;
-  appendOptions(words, options);
-  FitSettings s;
-  try {
-    const facyl_cli::Arguments args(words, facyl_cli::fitValueOptions(), facyl_cli::fitSwitches(),
-                                    facyl_cli::fitAliases());
-    if (!args.positional().empty())
-      throw std::invalid_argument("unexpected value " + args.positional()[0]);
-    if (args.has("--method") || args.has("--threads") || args.has("--radius-min") ||
-        args.has("--radius-max"))
-      throw std::invalid_argument("unknown option --" +
-                                  std::string(args.has("--method")       ? "method"
-                                              : args.has("--threads")    ? "threads"
-                                              : args.has("--radius-min") ? "radius-min"
-                                                                         : "radius-max") +
-                                  " (facyl_fit only; here: radius_limits=(min, max))");
-    facyl_cli::applyFitOptions(args, s);
-  }
-  catch (const std::invalid_argument& e) {
-    throw py::value_error(pythonWords(e.what()));
-  }
-  return s;
-}
-
 /** The fit of facyl_fit (apps/common/include/facyl/tools/cylinder_fit.h) on \a cloud (already in
- * metres): cues estimated unless \a normals. */
+ * metres): cues estimated unless \a normals, then the method of \a s. */
 std::vector<facyl::CylinderModel>
 fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::ConstPtr& normals,
          const FitSettings& s, std::string* why = nullptr)
@@ -275,6 +401,8 @@ fitCloud(const Cloud::ConstPtr& cloud, const pcl::PointCloud<pcl::Normal>::Const
   const Cues::Ptr cues = facyl_cli::estimateFitCues(cloud, s.neighbours, 0, normals);
   if (cues->size() != cloud->size())
     return {};
+  if (s.method == "pcl-ransac")
+    return facyl_cli::pclRansacFit(cloud, *cues, s.params);
   return facyl_cli::houghFit(cloud, cues, s, why);
 }
 
@@ -300,17 +428,19 @@ toNormals(const py::object& normals, std::size_t rows)
 }
 
 std::vector<PyCylinder>
-fitCylinders(const py::object& points, const py::object& normals, const py::dict& options)
+fitCylinders(const py::object& points, const py::object& normals,
+             const std::vector<std::pair<std::string, py::object>>& keywords)
 {
   const auto a = floatArray(points, "points", 3);
-  const FitSettings s = fitSettings(options);
+  const FitSettings s = fitSettings(keywords);
   // Millimetres are converted in double precision, before the points become floats.
   const float to_metres = facyl_cli::metresPerUnit(s.units);
-  const Cloud::Ptr cloud =
-    toCloud(a, "points", s.units == facyl_cli::Units::Millimetres ? 1e-3 : 1.0);
+  const Cloud::Ptr cloud = toCloud(a, "points", facyl_cli::metresPerUnitExact(s.units));
   const auto given = toNormals(normals, cloud->size());
-  checkK(s.neighbours, cloud->size());
-  const std::string units = facyl_cli::unitsProblem(*cloud, s.units, "units=\"mm\"", "units=\"m\"");
+  checkRows(cloud->size(), s.neighbours);
+  const facyl_cli::Vocabulary say{true};
+  const std::string units =
+    facyl_cli::unitsProblem(*cloud, s.units, say.option("units", "mm"), say.option("units", "m"));
   if (!units.empty())
     throw py::value_error("points: " + units);
   std::vector<facyl::CylinderModel> models;
@@ -333,20 +463,17 @@ fitCylinders(const py::object& points, const py::object& normals, const py::dict
 }
 
 /** Median milliseconds of \a repeats calls of the same fit inside C++ (no Python between
- * them): the reference for the binding's overhead (radius limits 0.01-0.25 m, as
- * python/bench_binding.py calls fit_cylinders). */
+ * them): the reference for the binding's overhead (fit_cylinders' defaults, as
+ * python/bench_binding.py calls it). */
 double
-timeFitInCpp(const py::object& points, int repeats, int k)
+timeFitInCpp(const py::object& points, int repeats, const py::object& k)
 {
+  const FitSettings s = fitSettings({{"neighbours", k}});
   const auto a = floatArray(points, "points", 3);
   const Cloud::Ptr cloud = toCloud(a, "points");
-  checkK(k, cloud->size());
+  checkRows(cloud->size(), s.neighbours);
   if (repeats < 1 || repeats > 100000)
     throw py::value_error("repeats: must be in [1, 100000]");
-  py::dict options;
-  options["radius_limits"] = py::make_tuple(0.01, 0.25);
-  options["neighbours"] = k;
-  const FitSettings s = fitSettings(options);
   std::vector<double> ms;
   py::gil_scoped_release release;
   for (int r = 0; r < repeats; ++r) {
@@ -362,6 +489,7 @@ timeFitInCpp(const py::object& points, int repeats, int k)
 // -------------------------------------------------------------------------------- detect
 
 using RgbCloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+using Recognizer = facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>;
 
 RgbCloud::Ptr
 frameCloud(const py::object& points, const py::object& colors, bool& organized)
@@ -410,54 +538,74 @@ frameCloud(const py::object& points, const py::object& colors, bool& organized)
   return cloud;
 }
 
-py::dict
+/** camera=(fx, fy, cx, cy) as a pinhole camera (the image twice the principal point's size).
+ * \throws py::value_error. */
+facyl::PinholeCamera
+cameraOf(const std::optional<std::vector<double>>& camera)
+{
+  if (!camera)
+    return {};
+  const auto& c = *camera;
+  if (c.size() != 4 || !(c[0] > 0 && c[0] <= 1e5 && c[1] > 0 && c[1] <= 1e5 && c[2] >= 0 &&
+                         c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
+    throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
+                          "0 <= cx, cy <= 4000 (pixels)");
+  return {static_cast<float>(c[0]),
+          static_cast<float>(c[1]),
+          static_cast<float>(c[2]),
+          static_cast<float>(c[3]),
+          static_cast<int>(std::ceil(2 * c[2] + 1)),
+          static_cast<int>(std::ceil(2 * c[3] + 1))};
+}
+
+/** A recognizer set up from detect()'s (and Tracker's) arguments: camera, up, model and the
+ * recognizer's options (recognizerOptions) as keywords. \throws py::value_error. */
+void
+configureRecognizer(Recognizer& rec, const std::optional<std::vector<double>>& camera,
+                    const py::object& up, const std::string& model, const py::kwargs& options)
+{
+  const facyl::PinholeCamera cam = cameraOf(camera);
+  auto keywords = keywordList(options);
+  keywords.emplace_back("up", up);
+  keywords.emplace_back("model", py::str(model));
+  facyl_cli::RecognizerSettings s;
+  applyKeywords(facyl_cli::recognizerOptions(), keywords, s);
+  facyl::ShapeClassifier::Ptr classifier;
+  try {
+    classifier = facyl_cli::classifierFor(s.model, facyl_cli::Vocabulary{true});
+  }
+  catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  rec.setParameters(s.params);
+  rec.setCamera(cam);
+  rec.setClassifier(classifier);
+  rec.setUpDirection(s.up);
+}
+
+/** The objects' point indices (rows of the flattened frame), added to \a out["objects"]. */
+void
+addIndices(py::object& out, const std::vector<facyl::RecognizedObject>& objects)
+{
+  py::list list = out["objects"];
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const auto& idx = objects[i].cluster.indices.indices;
+    list[i]["indices"] =
+      py::array_t<std::int64_t>(static_cast<py::ssize_t>(idx.size()),
+                                std::vector<std::int64_t>(idx.begin(), idx.end()).data());
+  }
+}
+
+py::object
 detect(const py::object& points, const py::object& colors,
        const std::optional<std::vector<double>>& camera, const py::object& up,
        const std::string& model, const py::kwargs& options)
 {
   bool organized = false;
   const RgbCloud::Ptr cloud = frameCloud(points, colors, organized);
-  facyl::PinholeCamera cam;
-  if (camera) {
-    const auto& c = *camera;
-    if (c.size() != 4 || !(c[0] > 0 && c[0] <= 1e5 && c[1] > 0 && c[1] <= 1e5 && c[2] >= 0 &&
-                           c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
-      throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
-                            "0 <= cx, cy <= 4000 (pixels)");
-    cam = {static_cast<float>(c[0]),
-           static_cast<float>(c[1]),
-           static_cast<float>(c[2]),
-           static_cast<float>(c[3]),
-           static_cast<int>(std::ceil(2 * c[2] + 1)),
-           static_cast<int>(std::ceil(2 * c[3] + 1))};
-  }
-  // The recognizer's options: facyl_detect's, by the same parser.
-  py::dict all(options);
-  all["up"] = up;
-  all["model"] = model;
-  std::vector<std::string> words;
-  appendOptions(words, all);
-  facyl::TabletopRecognizerParameters params;
-  Eigen::Vector3f up_direction = Eigen::Vector3f::Zero();
-  facyl::ShapeClassifier::Ptr classifier;
-  try {
-    const facyl_cli::Arguments args(words, facyl_cli::recognizerValueOptions(),
-                                    facyl_cli::recognizerSwitches(),
-                                    facyl_cli::recognizerAliases());
-    if (!args.positional().empty())
-      throw std::invalid_argument("unexpected value " + args.positional()[0]);
-    facyl_cli::applyRecognizerOptions(args, params, up_direction);
-    classifier = facyl_cli::classifierFromOptions(args);
-  }
-  catch (const std::invalid_argument& e) {
-    throw py::value_error(pythonWords(e.what()));
-  }
-  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
-  rec.setParameters(params);
+  Recognizer rec;
+  configureRecognizer(rec, camera, up, model, options);
   rec.setInputCloud(cloud);
-  rec.setCamera(cam);
-  rec.setClassifier(classifier);
-  rec.setUpDirection(up_direction);
   std::vector<facyl::RecognizedObject> objects;
   bool ok = false;
   {
@@ -466,17 +614,10 @@ detect(const py::object& points, const py::object& colors,
   }
   if (!ok)
     throw py::value_error("detect: recognition failed (see the message printed above)");
-  // facyl_detect's JSON, parsed: the same fields with the same meanings (9 digits: floats
-  // exactly).
-  py::dict out = py::module_::import("json").attr("loads")(
-    facyl_cli::dumpJson(facyl_cli::sceneJson("", *cloud, rec, objects, rec.getTiming(), 9)));
-  py::list list = out["objects"];
-  for (std::size_t i = 0; i < objects.size(); ++i) {
-    const auto& idx = objects[i].cluster.indices.indices;
-    list[i]["indices"] =
-      py::array_t<std::int64_t>(static_cast<py::ssize_t>(idx.size()),
-                                std::vector<std::int64_t>(idx.begin(), idx.end()).data());
-  }
+  // facyl_detect's fields, with the same meanings (floats exactly).
+  py::object out =
+    toPython(facyl_cli::sceneJson("", *cloud, rec, objects, rec.getTiming(), kPythonDigits));
+  addIndices(out, objects);
   return out;
 }
 
@@ -486,58 +627,18 @@ detect(const py::object& points, const py::object& colors,
 class PyTracker {
 public:
   PyTracker(const std::optional<std::vector<double>>& camera, const py::object& up,
-            const std::string& model, int confirm_hits, int max_misses, const py::kwargs& options)
+            const std::string& model, const py::object& confirm_hits, const py::object& max_misses,
+            const py::kwargs& options)
   {
-    if (camera) {
-      const auto& c = *camera;
-      if (c.size() != 4 || !(c[0] > 0 && c[0] <= 1e5 && c[1] > 0 && c[1] <= 1e5 && c[2] >= 0 &&
-                             c[2] <= 4000 && c[3] >= 0 && c[3] <= 4000))
-        throw py::value_error("camera: expected (fx, fy, cx, cy) with 0 < fx, fy <= 1e5 and "
-                              "0 <= cx, cy <= 4000 (pixels)");
-      camera_ = {static_cast<float>(c[0]),
-                 static_cast<float>(c[1]),
-                 static_cast<float>(c[2]),
-                 static_cast<float>(c[3]),
-                 static_cast<int>(std::ceil(2 * c[2] + 1)),
-                 static_cast<int>(std::ceil(2 * c[3] + 1))};
-    }
-    py::dict all(options);
-    all["up"] = up;
-    all["model"] = model;
-    std::vector<std::string> words;
-    appendOptions(words, all);
-    facyl::TabletopRecognizerParameters params;
-    Eigen::Vector3f up_direction = Eigen::Vector3f::Zero();
-    facyl::ShapeClassifier::Ptr classifier;
-    try {
-      const facyl_cli::Arguments args(words, facyl_cli::recognizerValueOptions(),
-                                      facyl_cli::recognizerSwitches(),
-                                      facyl_cli::recognizerAliases());
-      if (!args.positional().empty())
-        throw std::invalid_argument("unexpected value " + args.positional()[0]);
-      facyl_cli::applyRecognizerOptions(args, params, up_direction);
-      classifier = facyl_cli::classifierFromOptions(args);
-    }
-    catch (const std::invalid_argument& e) {
-      throw py::value_error(pythonWords(e.what()));
-    }
+    configureRecognizer(rec_, camera, up, model, options);
     facyl::CylinderTrackerParameters tp;
-    tp.confirm_hits = confirm_hits;
-    tp.max_misses = max_misses;
-    const std::string why = facyl::validate(tp);
-    if (!why.empty())
-      throw py::value_error(std::regex_replace(
-        std::regex_replace(why, std::regex("confirm_hits"), "track_confirm_hits"),
-        std::regex("max_misses"), "track_max_misses"));
+    applyKeywords(facyl_cli::trackerOptions(),
+                  {{"track_confirm_hits", confirm_hits}, {"track_max_misses", max_misses}}, tp);
     tracker_.setParameters(tp);
-    tracker_.setCamera(camera_);
-    rec_.setParameters(params);
-    rec_.setCamera(camera_);
-    rec_.setClassifier(classifier);
-    rec_.setUpDirection(up_direction);
+    tracker_.setCamera(cameraOf(camera));
   }
 
-  py::dict update(const py::object& points, const py::object& colors)
+  py::object update(const py::object& points, const py::object& colors)
   {
     bool organized = false;
     RgbCloud::Ptr cloud;
@@ -548,25 +649,18 @@ public:
       skip();
       throw;
     }
-    std::string json;
+    facyl_cli::Json json;
     bool ok = false;
-    std::vector<std::int64_t> flat;
-    std::vector<std::size_t> sizes;
+    std::vector<facyl::RecognizedObject> objects;
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
       rec_.setInputCloud(cloud);
-      std::vector<facyl::RecognizedObject> objects;
       ok = rec_.recognize(objects);
       if (ok) {
         tracker_.update(rec_, objects);
-        json = facyl_cli::dumpJson(
-          facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_, 9));
-        for (const auto& o : objects) {
-          sizes.push_back(o.cluster.indices.indices.size());
-          flat.insert(flat.end(), o.cluster.indices.indices.begin(),
-                      o.cluster.indices.indices.end());
-        }
+        json = facyl_cli::trackedSceneJson("", *cloud, rec_, objects, rec_.getTiming(), tracker_,
+                                           kPythonDigits);
       }
       else
         tracker_.skipFrame();
@@ -574,14 +668,8 @@ public:
     if (!ok)
       throw py::value_error("Tracker.update: recognition failed (see the message printed above); "
                             "the frame is skipped, the tracks are kept");
-    py::dict out = py::module_::import("json").attr("loads")(json);
-    py::list list = out["objects"];
-    std::size_t at = 0;
-    for (std::size_t i = 0; i < sizes.size(); ++i) {
-      list[i]["indices"] =
-        py::array_t<std::int64_t>(static_cast<py::ssize_t>(sizes[i]), flat.data() + at);
-      at += sizes[i];
-    }
+    py::object out = toPython(json);
+    addIndices(out, objects);
     return out;
   }
 
@@ -599,17 +687,15 @@ public:
     tracker_.reset();
   }
 
-  py::list tracks()
+  py::object tracks()
   {
-    std::string json;
+    facyl_cli::Json frame = facyl_cli::Json::object();
     {
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
-      facyl_cli::Json frame = facyl_cli::Json::object();
-      facyl_cli::addStreamFields(frame, tracker_, nullptr, 9);
-      json = facyl_cli::dumpJson(frame);
+      facyl_cli::addStreamFields(frame, tracker_, nullptr, kPythonDigits);
     }
-    return py::module_::import("json").attr("loads")(json)["tracks"];
+    return toPython(frame["tracks"]);
   }
 
   std::size_t frame()
@@ -619,8 +705,7 @@ public:
   }
 
 private:
-  facyl::PinholeCamera camera_;
-  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec_;
+  Recognizer rec_;
   facyl::CylinderTracker tracker_;
   std::mutex mutex_; ///< one update at a time (the GIL is released while it runs)
 };
@@ -777,13 +862,132 @@ renderSequenceFrame(long long seed, long long frame, long long frames, const std
   return out;
 }
 
+/** \a text (an option's help value, as the tools write it) as Python writes it. */
+std::string
+pythonValue(facyl_cli::ValueKind kind, const std::string& text)
+{
+  switch (kind) {
+  case ValueKind::Word:
+    return "\"" + text + "\"";
+  case ValueKind::Pair:
+  case ValueKind::Vector3: {
+    std::string out = "(" + text + ")";
+    for (std::size_t at = out.find(','); at != std::string::npos; at = out.find(',', at + 2))
+      out.insert(at + 1, " ");
+    return out;
+  }
+  default:
+    return text;
+  }
+}
+
+/** "name=default, ...; switches (True gives one): name, ..." of the keywords \a table gives
+ * Python but \a skipped, the defaults those of \a defaults where the help prints them (a word:
+ * always), else None. */
+template <typename S>
+std::string
+keywordDefaults(const facyl_cli::SettingsTable<S>& table, const S& defaults,
+                const std::set<std::string>& skipped = {})
+{
+  const facyl_cli::Vocabulary say{true};
+  std::string values, switches;
+  for (const auto& o : table.options) {
+    if (o.tool_only || skipped.count(o.name))
+      continue;
+    if (o.kind == ValueKind::Switch) {
+      switches += (switches.empty() ? "" : ", ") + say.option(o.name);
+      continue;
+    }
+    const bool printed = o.kind == ValueKind::Word || o.help.find("{}") != std::string::npos;
+    values += (values.empty() ? "" : ", ") + say.option(o.name) + "=" +
+              (printed ? pythonValue(o.kind, o.show(defaults)) : "None");
+  }
+  return values + "; switches (True gives one): " + switches;
+}
+
+std::string
+fitDoc(const FitSettings& d)
+{
+  const auto& table = facyl_cli::fitOptions();
+  const auto value = [&](const char* name) {
+    const auto* o = table.find(name);
+    return pythonValue(o->kind, o->show(d));
+  };
+  return R"(Fits up to max_cylinders cylinders to points (N, 3), one after another: facyl_fit's fit,
+with facyl_fit's options under the same names ('_' for '-') and the same defaults.
+
+The two-step Hough estimator: normals and principal curvatures of the neighbours nearest
+points (unless normals (N, 3) are given), orientation votes weighted by curvature
+(voting="soft-curvature", paper eq. 3; "soft-normal"; "rabbani": hard votes), a circle Hough
+for position and radius, least-squares refinement.
+
+points, normals: numpy arrays (N, 3) or Open3D Vector3dVector (pcd.points, pcd.normals).
+radius_limits: (min, max), default None: )" +
+         value("radius-limits") + R"( m as in every facyl tool (cans to
+buckets); "auto": 0 to twice the extent of the data across each candidate axis (pipes,
+tanks). up: gravity's opposite in the cloud's frame (default None: unknown). prior:
+orientation prior "uniform", "vertical", "vertical-strong" or "horizontal" about up ()" +
+         pythonValue(ValueKind::Vector3, facyl_cli::shownVector(d.up)) +
+         R"(
+when not given); default None: "vertical" when up is given, else )" +
+         value("prior") + R"( (detect() knows
+the table: vertical in its frame). neighbours: k of the normal and curvature estimation
+(default )" +
+         value("neighbours") +
+         R"(; k= is its old spelling). orientations: accumulator cells N_d ()" +
+         value("orientations") + R"().
+accumulators: independent accumulators ()" +
+         value("accumulators") + R"(). distance_threshold: inlier distance (default
+None: estimated from the residuals). outward_normals: inliers' normals must point away from
+the axis (default False; any_normal_sign=True says the default). point_candidates:
+candidates refined and compared on the points (0: the best alone, as facyl 0.1). coarse_scale:
+at high noise, cues again from neighbours within this many radii (0: never). method: "facyl",
+or "pcl-ransac" (PCL's SACSegmentationFromNormals on the same normals, for comparison). seed:
+seed of the randomized accumulator (same seed, same result).
+units: facyl works in metres. "auto" (default): metres, and a cloud evidently in millimetres
+(spanning more than )" +
+         facyl_cli::compactNumber(facyl_cli::kMaxMetreExtent) +
+         R"( units) or radius limits beyond 1 raise ValueError; "m": metres, no
+check; "mm": points, lengths given and results in millimetres (converted to metres for the
+fit and back).
+Every keyword and its default: )" +
+         keywordDefaults(table, d) + R"(.
+Returns a list of Cylinder, best first; empty when no cylinder is found (with a UserWarning that
+says why: the radius limits exclude the cylinder there, too few points, ...). Raises
+ValueError for an unknown keyword or a bad value, TypeError for a value of the wrong type.)";
+}
+
+std::string
+detectDoc()
+{
+  return R"(The tabletop pipeline of facyl_detect on one frame: table, objects on it, cylinders.
+
+points: an organized frame (H, W, 3) in the camera frame (x right, y down, z forward; NaN
+where the sensor has no depth; metres), or (N, 3) with camera=(fx, fy, cx, cy) for the
+objects' pixel boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite,
+optional. model: "default" (the shipped shape classifier), "none", or a path to an .onnx with
+its .cfg. Any other keyword is one of facyl_detect's recognizer options with '_' for '-'
+(the same checks; facyl_detect -h says what each does); their defaults: )" +
+         keywordDefaults(facyl_cli::recognizerOptions(), facyl_cli::RecognizerSettings{},
+                         {"model", "up"}) +
+         R"(.
+Returns facyl_detect's JSON object as a dict, the same fields with the same meanings:
+"organized", "table" {"coefficients": [a, b, c, d] of the table plane in the cloud's frame
+with a unit normal towards the sensor, or None; "found"}, "supports", "objects" (each with
+"cylinder": the fields of Cylinder.as_dict(), or None), "timing_ms"; objects also carry
+"indices" (int64 rows of the flattened frame). A frame without any support is not an error:
+"table" then has "found" False and coefficients None, "supports" is empty and the objects have
+support -1. Raises ValueError for bad input.)";
+}
+
 } // namespace
 
 PYBIND11_MODULE(facyl, m)
 {
   m.doc() = "facyl: fast cylinder detection (Figueiredo et al., RAS 2019) for numpy and Open3D.\n\n"
-            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3)), or Open3D "
-            "Vector3dVector; metres (fit_cylinders: units=\"mm\" converts); NaN rows are missing "
+            "Arrays are float32 or float64 of shape (N, 3) (frames: (H, W, 3); float16 raises "
+            "TypeError: convert it), or Open3D Vector3dVector; metres (fit_cylinders: units=\"mm\" "
+            "converts); NaN rows are missing "
             "points. Keywords are the tools' option names with '_' for '-', with their defaults. "
             "Functions release the GIL while they compute.";
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
@@ -839,8 +1043,7 @@ PYBIND11_MODULE(facyl, m)
     .def(
       "as_dict",
       [](const PyCylinder& c) {
-        return py::module_::import("json").attr("loads")(
-          facyl_cli::cylinderJson(c.model, false, 9));
+        return toPython(facyl_cli::cylinderObject(c.model, false, kPythonDigits));
       },
       "The fields facyl_fit prints for this cylinder (no inlier indices), as a dict.")
     .def("__repr__", [](const PyCylinder& c) {
@@ -854,96 +1057,30 @@ PYBIND11_MODULE(facyl, m)
       return std::string(buf);
     });
 
+  const FitSettings fit; // the defaults' one home
   m.def(
     "fit_cylinders",
-    [](const py::object& points, const py::object& normals, const py::object& radius_limits,
-       const py::object& prior, const py::object& up, const std::string& voting, int neighbours,
-       int orientations, int accumulators, const py::object& distance_threshold, int max_cylinders,
-       bool outward_normals, long long seed, const std::string& units, const py::object& k) {
-      py::dict o;
-      o["radius_limits"] = radius_limits;
-      o["prior"] = prior;
-      o["up"] = up;
-      o["voting"] = voting;
-      if (!k.is_none() && neighbours != 16)
-        throw py::value_error("give neighbours once (k is its old spelling)");
-      if (k.is_none())
-        o["neighbours"] = neighbours;
-      else
-        o["k"] = k; // the old spelling: messages name it as given
-      o["orientations"] = orientations;
-      o["accumulators"] = accumulators;
-      o["distance_threshold"] = distance_threshold;
-      o["max_cylinders"] = max_cylinders;
-      o["outward_normals"] = outward_normals;
-      o["seed"] = seed;
-      o["units"] = units;
-      return fitCylinders(points, normals, o);
+    [](const py::object& points, const py::object& normals, const py::kwargs& options) {
+      return fitCylinders(points, normals, keywordList(options));
     },
-    py::arg("points"), py::arg("normals") = py::none(), py::kw_only(),
-    py::arg("radius_limits") = py::none(), py::arg("prior") = py::none(),
-    py::arg("up") = py::none(), py::arg("voting") = "soft-curvature", py::arg("neighbours") = 16,
-    py::arg("orientations") = facyl::HoughCylinderParameters{}.orientations,
-    py::arg("accumulators") = facyl::HoughCylinderParameters{}.accumulators,
-    py::arg("distance_threshold") = py::none(), py::arg("max_cylinders") = 1,
-    py::arg("outward_normals") = false, py::arg("seed") = 0, py::arg("units") = "auto",
-    py::arg("k") = py::none(),
-    R"(Fits up to max_cylinders cylinders to points (N, 3), one after another: facyl_fit's fit,
-with facyl_fit's options under the same names ('_' for '-') and the same defaults.
+    py::arg("points"), py::arg("normals") = py::none(), fitDoc(fit).c_str());
 
-The two-step Hough estimator: normals and principal curvatures of the neighbours nearest
-points (unless normals (N, 3) are given), orientation votes weighted by curvature
-(voting="soft-curvature", paper eq. 3; "soft-normal"; "rabbani": hard votes), a circle Hough
-for position and radius, least-squares refinement.
-
-points, normals: numpy arrays (N, 3) or Open3D Vector3dVector (pcd.points, pcd.normals).
-radius_limits: (min, max), default None: (0.01, 0.25) m as in every facyl tool (cans to
-buckets); "auto": 0 to twice the extent of the data across each candidate axis (pipes,
-tanks). up: gravity's opposite in the cloud's frame (default None: unknown). prior:
-orientation prior "uniform", "vertical", "vertical-strong" or "horizontal" about up ((0, 0, 1)
-when not given); default None: "vertical" when up is given, else "uniform" (detect() knows
-the table: vertical in its frame). neighbours: k of the normal and curvature estimation
-(default 16; k= is its old spelling). orientations: accumulator cells N_d (450).
-accumulators: independent accumulators (1). distance_threshold: inlier distance (default
-None: estimated from the residuals). outward_normals: inliers' normals must point away from
-the axis (default False). seed: seed of the randomized accumulator (same seed, same result).
-units: facyl works in metres. "auto" (default): metres, and a cloud evidently in millimetres
-(spanning more than 20 units) or radius limits beyond 1 raise ValueError; "m": metres, no
-check; "mm": points, lengths given and results in millimetres (converted to metres for the
-fit and back).
-Returns a list of Cylinder, best first; empty when no cylinder is found (with a UserWarning that
-says why: the radius limits exclude the cylinder there, too few points, ...). Raises
-ValueError/TypeError for bad input.)");
-
-  m.def("estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),
-        py::arg("neighbours") = 16, py::kw_only(), py::arg("k") = py::none(),
-        R"(Normals and principal curvatures of points (N, 3) from their nearest neighbours
-(default 16; k= is the old spelling), in one pass (facyl's NormalCurvatureEstimation). Returns (normals (N, 3),
+  m.def(
+    "estimate_normals_curvatures", &estimateNormalsCurvatures, py::arg("points"),
+    py::arg("neighbours") = fit.neighbours, py::kw_only(), py::arg("k") = py::none(),
+    (R"(Normals and principal curvatures of points (N, 3) from their nearest neighbours
+(default )" +
+     std::to_string(fit.neighbours) +
+     R"(; k= is the old spelling), in one pass (facyl's NormalCurvatureEstimation). Returns (normals (N, 3),
 principal_directions (N, 3), k_max (N,), k_min (N,)) as float32: unit normals, the unit
 direction of largest normal change, and k_max >= k_min >= 0, the eigenvalues of the covariance
 of the neighbours' normals projected on the tangent plane (PCL's pc1, pc2: dimensionless,
-larger for tighter bends). NaN rows for points without a usable neighbourhood.)");
+larger for tighter bends). NaN rows for points without a usable neighbourhood.)")
+      .c_str());
 
   m.def("detect", &detect, py::arg("points"), py::arg("colors") = py::none(), py::kw_only(),
-        py::arg("camera") = py::none(), py::arg("up") = py::none(), py::arg("model") = "default",
-        R"(The tabletop pipeline of facyl_detect on one frame: table, objects on it, cylinders.
-
-points: an organized frame (H, W, 3) in the camera frame (x right, y down, z forward; NaN
-where the sensor has no depth; metres), or (N, 3) with camera=(fx, fy, cx, cy) for the
-objects' pixel boxes. colors: uint8 RGB of the same shape, optional. up: gravity's opposite,
-optional. model: "default" (the shipped shape classifier), "none", or a path to an .onnx with
-its .cfg. Any other keyword is one of facyl_detect's recognizer options with '_' for '-':
-radius_limits=(0.01, 0.25), prior="vertical" (in the table frame), voting=, neighbours=16,
-orientations=450, distance_threshold=, min_score=0.5, min_probability=0.5, reject_below=0.1,
-max_cylinders_per_cluster=3, clustering="edge-aware", support="standing", any_normal_sign=True,
-... (same defaults and checks; facyl_detect -h lists them).
-Returns facyl_detect's JSON object as a dict, the same fields with the same meanings:
-"organized", "table" {"coefficients": [a, b, c, d] of the table plane in the cloud's frame
-with a unit normal towards the sensor, or None; "found"}, "supports", "objects" (each with
-"cylinder": the fields of Cylinder.as_dict(), or None), "timing_ms"; objects also carry
-"indices" (int64 rows of the flattened frame). A frame without any support is not an error:
-"table" then has "found" False and coefficients None, "supports" is empty and the objects have
-support -1. Raises ValueError for bad input.)");
+        py::arg("camera") = py::none(), py::arg("up") = py::none(),
+        py::arg("model") = facyl_cli::RecognizerSettings{}.model, detectDoc().c_str());
 
   const facyl::CylinderSimulationParameters sim; // the defaults' one home
   const auto shown = [](float v) { return std::round(1e6 * static_cast<double>(v)) / 1e6; };
@@ -988,10 +1125,11 @@ confirmed (a cylinder seen in one frame only never becomes a track); track_max_m
 frames a confirmed track survives (occlusion; longer when the frame shows it hidden or out of
 view). update() is serialised: one frame at a time, from any thread (the GIL is released).)")
     .def(py::init<const std::optional<std::vector<double>>&, const py::object&, const std::string&,
-                  int, int, const py::kwargs&>(),
+                  const py::object&, const py::object&, const py::kwargs&>(),
          py::kw_only(), py::arg("camera") = py::none(), py::arg("up") = py::none(),
-         py::arg("model") = "default", py::arg("track_confirm_hits") = 2,
-         py::arg("track_max_misses") = 5)
+         py::arg("model") = facyl_cli::RecognizerSettings{}.model,
+         py::arg("track_confirm_hits") = facyl::CylinderTrackerParameters{}.confirm_hits,
+         py::arg("track_max_misses") = facyl::CylinderTrackerParameters{}.max_misses)
     .def("update", &PyTracker::update, py::arg("points"), py::arg("colors") = py::none(),
          R"(The next frame of the stream (points and colors as for detect()). Returns facyl_detect
 --track's JSON line as a dict: detect()'s fields, with per object "track_id" (int, stable across
@@ -1008,7 +1146,7 @@ that cannot be used raises ValueError and is skipped: the tracks are kept.)")
     .def_property_readonly("frame", &PyTracker::frame, "Frames given (update() and skip()).");
 
   m.def("_time_fit_in_cpp", &timeFitInCpp, py::arg("points"), py::arg("repeats") = 50,
-        py::arg("k") = 16,
+        py::arg("k") = fit.neighbours,
         "Median ms of fit_cylinders' C++ work (default settings) repeated inside C++: the "
         "reference for the binding's overhead.");
   m.attr("__version__") = FACYL_VERSION;

@@ -5,7 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=OFF -DFACYL_BUILD_BENCHMARKS=OFF >/dev/null
+# build/ is test.sh's too: configured as test.sh does (whichever runs first, the cache is the
+# same; CTest scripts_configure_alike), only the demo's tools built.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=ON -DFACYL_BUILD_BENCHMARKS=ON >/dev/null
 cmake --build build -j"$(nproc)" --target facyl_detect facyl_fit facyl_synth
 if [ $# -eq 0 ]; then
   set -- --overlay build/default_scene_overlay.png data/default_scene.pcd

@@ -17,7 +17,9 @@ for a in "$@"; do
 done
 bash scripts/setup.sh
 bash scripts/check_format.sh # unformatted C++ fails CI (scripts/check_format.sh --fix formats it)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=ON >/dev/null
+# The same configure as demo.sh (they share build/): the benchmarks on even in a cache made
+# without them.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFACYL_BUILD_TESTS=ON -DFACYL_BUILD_BENCHMARKS=ON >/dev/null
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 if [ "$sanitize" -eq 1 ]; then

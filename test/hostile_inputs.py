@@ -113,6 +113,17 @@ with tempfile.TemporaryDirectory() as tmp:
                       "do not have the same length")
     expect_file_error("garbage.pcd", os.urandom(2000), "not a PCD file")
 
+    # Points that hold no plane: one line on standard error (before: 1,003 lines of PCL's
+    # "Sample points too similar or collinear!" and exit 0).
+    same = b"0.1 0.2 1\n" * 10
+    line = "".join(f"{0.1 + 0.01 * i:.4f} {0.2 + 0.02 * i:.4f} {1 + 0.005 * i:.4f}\n"
+                   for i in range(50)).encode()
+    for name, body, width in [("identical.pcd", same, 10), ("collinear.pcd", line, 50)]:
+        expect_file_error(name, header(width=width) + body, "recognition failed", tools=(DETECT,))
+        rc, out, err = run(DETECT, [os.path.join(tmp, name)])
+        check(f"facyl_detect {name}: one line on stderr",
+              len(err.splitlines()) == 1 and "lie on one line" in err, f"stderr {err[-300:]!r}")
+
     # 4. Organized clouds too narrow for an image search (an 8-ring scan; before: segfault).
     for w, h in [(12, 480), (640, 12), (640, 5), (8, 64), (1024, 8), (1, 2)]:
         pts = plane_points(w, h)

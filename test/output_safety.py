@@ -85,6 +85,12 @@ with tempfile.TemporaryDirectory() as tmp:
     refused("facyl_detect --save-clusters DIR (a generated name is an input)",
             [detect, "--save-clusters", d, os.path.join(d, "s.pcd"), os.path.join(d, "s_obj1.pcd")],
             tmp, "which is an input")
+    # --save-clusters DIR where DIR holds an input: the next *.pcd of DIR would read the
+    # clusters as scenes (before: written, exit 0).
+    refused("facyl_detect --save-clusters DIR DIR/a.pcd (the folder holds an input)",
+            [detect, "--save-clusters", d, a], tmp, "holds the input")
+    refused("facyl_detect --save-clusters . a.pcd (the same folder, relative)",
+            [detect, "--save-clusters", ".", "a.pcd"], tmp, "holds the input", cwd=d)
     # What is fine is still written.
     out = os.path.join(tmp, "out")
     os.makedirs(out)

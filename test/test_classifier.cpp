@@ -416,8 +416,11 @@ TEST(CylinderClassifier, BadModelsGiveErrorsThatNameTheFile)
     }
     return std::string("no error");
   };
-  // Missing model, missing description.
-  EXPECT_NE(message("/nonexistent/net.onnx").find("/nonexistent/net.cfg: no such file"),
+  // Missing model (named as given, not by its description's name: issue 41), missing
+  // description.
+  EXPECT_NE(message("/nonexistent/net.onnx").find("/nonexistent/net.onnx: no such file"),
+            std::string::npos);
+  EXPECT_NE(message(writeFile("undescribed.onnx", onnx)).find("undescribed.cfg: no such file"),
             std::string::npos);
   writeFile("lonely.cfg", cfg);
   EXPECT_NE(message(std::filesystem::temp_directory_path() / "facyl_test_classifier_lonely.onnx")

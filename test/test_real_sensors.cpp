@@ -7,6 +7,8 @@
  */
 #include "test_helpers.h"
 
+#include <facyl/tools/csv_reader.h>
+
 #include <facyl/recognition/cylinder_classifier.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/plane_search.h>
@@ -630,28 +632,38 @@ readLabels(const std::string& csv)
 {
   std::vector<Label> out;
   std::ifstream in(csv);
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::string cur;
-    bool quoted = false;
-    for (const char ch : line) {
-      if (ch == '"')
-        quoted = !quoted;
-      else if (ch == ',' && !quoted)
-        f.push_back(cur), cur.clear();
-      else
-        cur += ch;
-    }
-    f.push_back(cur);
+  for (const auto& f : facyl_cli::readCsvRows(in))
     if (f.size() >= 5)
       out.push_back({f[0], f[1], f[2], std::stoi(f[3]), std::stoi(f[4])});
-  }
   return out;
 }
 
 } // namespace
+
+TEST(LabelTables, QuotedFieldsMayHoldCommas)
+{
+  // The rgbd labels.csv format: frame,object,class,u,v,u0,v0,u1,v1,note; a note in quotes
+  // may hold commas, one without quotes is taken as it is.
+  std::istringstream table(
+    "frame,object,class,u,v,u0,v0,u1,v1,note\n"
+    "graspnet6dof/blue_mug,blue_mug,cylinder_handle,330,235,267,163,421,302,\"dark blue mug "
+    "with handle, upright\"\n"
+    "posecnn/0001,can,cylinder,10,20,1,2,30,40,plain note; no quotes\n"
+    "sevenscenes/frame150,,box,1,2,,,,,\n");
+  const auto rows = facyl_cli::readCsvRows(table);
+  ASSERT_EQ(rows.size(), 3u); // the header is skipped
+  ASSERT_EQ(rows[0].size(), 10u);
+  EXPECT_EQ(rows[0][0], "graspnet6dof/blue_mug");
+  EXPECT_EQ(rows[0][3], "330");
+  EXPECT_EQ(rows[0][9], "dark blue mug with handle, upright");
+  EXPECT_EQ(rows[1][9], "plain note; no quotes");
+  ASSERT_EQ(rows[2].size(), 10u); // empty fields count
+  EXPECT_EQ(rows[2][1], "");
+  EXPECT_EQ(rows[2][9], "");
+  EXPECT_EQ(facyl_cli::splitCsvLine(""), std::vector<std::string>{""});
+  EXPECT_EQ(facyl_cli::splitCsvLine("a,\"b, \"\"c\"\"\",d"),
+            (std::vector<std::string>{"a", "b, c", "d"}));
+}
 
 TEST(RealFrames, OtherSensorsAndRooms)
 {

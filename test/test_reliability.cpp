@@ -10,13 +10,16 @@
 
 #include <facyl/features/parallel.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
+#include <facyl/simulation/random.h>
 #include <facyl/simulation/tabletop_scene.h>
 
 #include <pcl/common/transforms.h>
+#include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstring>
@@ -193,6 +196,51 @@ TEST(Reliability, PointsWithHugeCoordinatesAreTreatedAsMissing)
     EXPECT_EQ(fingerprint(with_garbage), fingerprint(with_holes));
     EXPECT_GE(with_garbage.size(), 5u);
   }
+}
+
+TEST(Reliability, DegenerateCloudsFailWithOneLine)
+{
+  // Identical or collinear points hold no plane: PCL's plane RANSAC printed "Sample points
+  // too similar or collinear!" for each of its 1,000 tries, and the frame came out as one
+  // without a table. Now the segmentation says what is wrong, once, and fails.
+  const pcl::console::VERBOSITY_LEVEL level = pcl::console::getVerbosityLevel();
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR); // as the tools run
+  for (const bool collinear : {false, true}) {
+    SCOPED_TRACE(collinear ? "collinear" : "identical");
+    Cloud::Ptr cloud(new Cloud);
+    for (int i = 0; i < (collinear ? 50 : 10); ++i) {
+      pcl::PointXYZRGBA p;
+      const float t = collinear ? 0.01f * static_cast<float>(i) : 0.f;
+      p.getVector3fMap() = Eigen::Vector3f(0.1f + t, 0.2f + 2.f * t, 1.f + 0.5f * t);
+      cloud->push_back(p);
+    }
+    testing::internal::CaptureStderr();
+    bool ok = true;
+    recognize(cloud, &ok);
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_FALSE(ok);
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err.substr(0, 500);
+    EXPECT_NE(err.find("lie on one line"), std::string::npos) << err.substr(0, 500);
+  }
+  // A table with a line of points above it: the table is found; the line, left over, is no
+  // second plane and makes no noise.
+  Cloud::Ptr cloud(new Cloud);
+  facyl::Random rng(5);
+  for (int i = 0; i < 4000; ++i) {
+    pcl::PointXYZRGBA p;
+    p.getVector3fMap() = Eigen::Vector3f(rng.uniform(-0.5f, 0.5f), 0.4f, rng.uniform(0.8f, 1.8f));
+    cloud->push_back(p);
+  }
+  for (int i = 0; i < 400; ++i) {
+    pcl::PointXYZRGBA p;
+    p.getVector3fMap() = Eigen::Vector3f(0.001f * static_cast<float>(i), 0.f, 1.2f);
+    cloud->push_back(p);
+  }
+  testing::internal::CaptureStderr();
+  recognize(cloud);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err.find("collinear"), std::string::npos) << err.substr(0, 500);
+  pcl::console::setVerbosityLevel(level);
 }
 
 TEST(Reliability, TheSegmentationTreatsHugeCoordinatesAsMissing)

@@ -559,3 +559,53 @@ TEST(RealSensorArtefacts, InvalidSettingsAreRejected)
   p.sensor.noise_linear = -1.f;
   EXPECT_FALSE(facyl::validate(p).empty());
 }
+
+// -------------------------------------------------------------------- the ground truth's JSON
+
+#include <facyl/simulation/tabletop_sequence.h>
+#include <facyl/tools/json_writer.h>
+
+TEST(GroundTruthJson, NumbersAsAStreamWritesThemStringsEscaped)
+{
+  // %.7g for every float, as the text of a stream with setprecision(7); nlohmann's own
+  // writer of the same rounded number can give 17 digits instead.
+  using facyl_cli::Json;
+  const Json j{{"a", 0.2154446f},
+               {"b", Json::array({3.f, -0.5f, 1.5e-5f, 12345678.f})},
+               {"c", std::nanf("")},
+               {"d", "a \"quoted\"\nkind"},
+               {"e", 7}};
+  EXPECT_EQ(facyl_cli::dumpJsonWithDigits(j, 7),
+            "{\"a\":0.2154446,\"b\":[3,-0.5,1.5e-05,1.234568e+07],\"c\":null,"
+            "\"d\":\"a \\\"quoted\\\"\\nkind\",\"e\":7}");
+  EXPECT_EQ(facyl_cli::dumpJson(facyl_cli::jsonNumber(0.2154446f, 7)), "0.21544460000000001");
+
+  // A scene whose names need escaping, and a number that is not finite: valid JSON.
+  facyl::TabletopSceneParameters p;
+  p.camera.width = 80;
+  p.camera.height = 60;
+  p.camera.fx = p.camera.fy = 65.625f;
+  p.camera.cx = 39.5f;
+  p.camera.cy = 29.5f;
+  p.seed = 3;
+  facyl::RenderedScene r = facyl::simulateTabletopScene(p);
+  ASSERT_FALSE(r.scene.objects.empty());
+  r.scene.objects[0].kind = "can \"a\\b\"";
+  r.scene.objects[0].radius = std::nanf("");
+  const std::string text = facyl::groundTruthJson(r);
+  Json truth;
+  ASSERT_NO_THROW(truth = Json::parse(text)) << text;
+  EXPECT_EQ(truth["objects"][0]["kind"], "can \"a\\b\"");
+  EXPECT_TRUE(truth["objects"][0]["radius"].is_null());
+  EXPECT_EQ(truth["camera"]["fx"].dump(), "65.625");
+  EXPECT_NE(text.find("\"cx\":39.5,"), std::string::npos);
+
+  facyl::TabletopSequenceParameters sp;
+  sp.frames = 3;
+  facyl::TabletopSequence seq = facyl::generateTabletopSequence(p, sp);
+  seq.scene.objects[0].kind = "tube \"x\"";
+  Json sequence;
+  ASSERT_NO_THROW(sequence = Json::parse(facyl::sequenceJson(seq)));
+  EXPECT_EQ(sequence["objects"][0]["kind"], "tube \"x\"");
+  EXPECT_EQ(sequence["cameras"].size(), 3u);
+}

@@ -263,6 +263,31 @@ TEST(PlaneSearch, FamiliesFacingUpComeFirst)
             (std::vector<std::size_t>{0}));
 }
 
+TEST(PlaneSearch, SpansPlaneIsFalseForCoincidentAndCollinearPoints)
+{
+  pcl::PointCloud<pcl::PointXYZ> c;
+  const auto indices = [&c] {
+    pcl::Indices all(c.size());
+    std::iota(all.begin(), all.end(), 0);
+    return all;
+  };
+  c.push_back(pcl::PointXYZ(0.1f, 0.2f, 1.f));
+  c.push_back(pcl::PointXYZ(0.1f, 0.2f, 1.f));
+  EXPECT_FALSE(facyl::spansPlane(c, indices())); // fewer than 3 distinct points
+  for (int i = 0; i < 40; ++i) // on one line (float rounding and all), NaN between
+    c.push_back(i % 7 ? pcl::PointXYZ(0.1f + 0.01f * i, 0.2f + 0.02f * i, 1.f + 0.005f * i)
+                      : pcl::PointXYZ(NAN, NAN, NAN));
+  EXPECT_FALSE(facyl::spansPlane(c, indices()));
+  // A point 1 mm off the line, 0.4 m long: the cross product is 4e-4 m^2, a plane.
+  c.push_back(pcl::PointXYZ(0.1f + 0.001f, 0.2f, 1.f));
+  EXPECT_TRUE(facyl::spansPlane(c, indices()));
+  const pcl::Indices all = indices();
+  EXPECT_FALSE(facyl::spansPlane(c, pcl::Indices(all.begin(), all.end() - 1))); // not indexed
+  // ... not at 1 micrometre, where PCL's plane model takes no sample either.
+  c.back() = pcl::PointXYZ(0.1f + 1e-6f, 0.2f, 1.f);
+  EXPECT_FALSE(facyl::spansPlane(c, indices()));
+}
+
 TEST(PlaneSearch, VoxelEuclideanClusters)
 {
   // Two blobs 10 cm apart, 2 cm tolerance: two clusters, the larger first, every point in one.

@@ -9,6 +9,7 @@
 #include <facyl/simulation/random.h>
 #include <facyl/simulation/tabletop_sequence.h>
 #include <facyl/tracking/cylinder_tracker.h>
+#include <facyl/tracking/tracker_steps.h>
 
 #include <pcl/io/pcd_io.h>
 
@@ -306,6 +307,410 @@ TEST(TrackingNumerics, FiltersAreRobustAndSignFree)
   EXPECT_NEAR(facyl::associationCost(t, o), 0.f, 1e-6f);
   o.centre.x() = 0.06f; // beside it: 3 sigmas
   EXPECT_GT(facyl::associationCost(t, o), 8.f);
+}
+
+// ------------------------------------------------------ the steps of update (tracker_steps.h)
+
+namespace {
+
+/** An upright cylinder observation (world frame): base centre \a base, \a radius, \a height. */
+facyl::TrackObservation
+cylinderObservation(const Eigen::Vector3f& base, float radius, float height)
+{
+  facyl::TrackObservation o;
+  o.valid = true;
+  o.points = 1000;
+  o.quality = 400.f;
+  o.p = 0.8f;
+  o.base = base;
+  o.top = base + height * Eigen::Vector3f::UnitZ();
+  o.geometry.cylinder = true;
+  o.geometry.axis = Eigen::Vector3f::UnitZ();
+  o.geometry.centre = 0.5f * (o.base + o.top);
+  o.geometry.centroid = o.geometry.centre;
+  o.geometry.radius = radius;
+  o.geometry.height = height;
+  return o;
+}
+
+/** A box-like observation (no cylinder) with its centroid at \a centroid. */
+facyl::TrackObservation
+boxObservation(const Eigen::Vector3f& centroid)
+{
+  facyl::TrackObservation o;
+  o.valid = true;
+  o.points = 1000;
+  o.p = 0.2f;
+  o.geometry.centroid = centroid;
+  return o;
+}
+
+/** A confirmed track started from \a o. */
+facyl::CylinderTrack
+confirmedTrack(const facyl::TrackObservation& o, int id)
+{
+  facyl::CylinderTrack t = facyl::newTrack(o, id, 0, facyl::CylinderTrackerParameters{});
+  t.confirmed = true;
+  return t;
+}
+
+} // namespace
+
+TEST(TrackerSteps, AnchorIsTheTableThenTheSupportMostObjectsStandOn)
+{
+  const facyl::CylinderTrackerParameters params;
+  // Three supports: the world's plane (identity), one tilted 30 degrees, one 40 cm higher.
+  std::vector<facyl::SupportPlane> supports(3);
+  supports[1].frame = Eigen::AngleAxisf(0.52f, Eigen::Vector3f::UnitX());
+  supports[2].frame = Eigen::Translation3f(0.f, 0.f, 0.4f);
+  std::vector<facyl::RecognizedObject> objects(4);
+  objects[0].cluster.support = 0;
+  objects[1].cluster.support = objects[2].cluster.support = objects[3].cluster.support = 2;
+  const Eigen::Affine3f identity = Eigen::Affine3f::Identity();
+  // A new world: the table, else the support most objects stand on.
+  auto c = facyl::chooseAnchor(supports, 1, objects, false, identity, params);
+  EXPECT_EQ(c.anchor, 1);
+  EXPECT_FALSE(c.plane_jump);
+  EXPECT_EQ(facyl::chooseAnchor(supports, -1, objects, false, identity, params).anchor, 2);
+  // A support without a finite frame is never the anchor.
+  auto broken = supports;
+  broken[2].frame.matrix()(0, 0) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(facyl::chooseAnchor(broken, -1, objects, false, identity, params).anchor, 0);
+  // Continuing the world's plane: the first in that order that continues it, the table or not.
+  c = facyl::chooseAnchor(supports, 1, objects, true, identity, params);
+  EXPECT_EQ(c.anchor, 0);
+  EXPECT_FALSE(c.plane_jump);
+  // None continues it: the first, a jump.
+  const Eigen::Affine3f away(Eigen::Translation3f(0.f, 0.f, 1.f));
+  c = facyl::chooseAnchor(supports, 1, objects, true, away, params);
+  EXPECT_EQ(c.anchor, 1);
+  EXPECT_TRUE(c.plane_jump);
+  EXPECT_EQ(facyl::chooseAnchor({}, -1, objects, true, identity, params).anchor, -1);
+  // continuesPlane: angle and height within the limits, the normal on the world's side.
+  EXPECT_TRUE(facyl::continuesPlane(identity, 0.35f, 0.15f));
+  EXPECT_TRUE(facyl::continuesPlane(
+    Eigen::Affine3f(Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitY())), 0.35f, 0.15f));
+  EXPECT_FALSE(facyl::continuesPlane(supports[1].frame, 0.35f, 0.15f));
+  EXPECT_FALSE(facyl::continuesPlane(supports[2].frame, 0.35f, 0.15f));
+  EXPECT_FALSE(facyl::continuesPlane(
+    Eigen::Affine3f(Eigen::AngleAxisf(kPi, Eigen::Vector3f::UnitX())), 0.35f, 0.15f));
+}
+
+TEST(TrackerSteps, RegistrationCandidatesAgreeInSizeAndHeight)
+{
+  std::vector<facyl::CylinderTrack> tracks{
+    confirmedTrack(cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f), 0),
+    confirmedTrack(boxObservation({0.3f, 0.f, 0.05f}), 1)};
+  std::vector<facyl::TrackObservation> objects{
+    cylinderObservation({0.1f, 0.f, 0.f}, 0.045f, 0.10f), // agrees with track 0
+    cylinderObservation({0.1f, 0.f, 0.f}, 0.07f, 0.12f),  // too wide for it
+    boxObservation({0.f, 0.2f, 0.09f}),                   // 4 cm off in height: agrees
+    boxObservation({0.f, 0.2f, 0.14f}),                   // 9 (8) cm off: does not
+    cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f)};
+  objects[4].valid = false;
+  auto c = facyl::registrationCandidates(objects, tracks);
+  // Object 0 with track 0 (two cylinders) and with track 1 (their reference heights: 5 and 5
+  // cm); object 1 with track 1 only; object 2 with both (4 and 3 cm apart).
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& k : c)
+    pairs.emplace_back(k.object, k.track);
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{0, 0}, {0, 1}, {1, 1}, {2, 0}, {2, 1}}));
+  EXPECT_FLOAT_EQ(c[0].weight, 1.f); // two cylinders, a confirmed track
+  EXPECT_FLOAT_EQ(c[0].tolerance, 0.02f);
+  EXPECT_FLOAT_EQ(c[1].weight, 0.4f); // a centroid counts less, within more
+  EXPECT_FLOAT_EQ(c[1].tolerance, 0.05f);
+  // A tentative track counts half; a tilted cylinder (45 degrees) agrees within 4 cm.
+  tracks[0].confirmed = false;
+  tracks[0].axis = Eigen::Vector3f(1.f, 0.f, 1.f).normalized();
+  c = facyl::registrationCandidates(objects, tracks);
+  EXPECT_FLOAT_EQ(c[0].weight, 0.5f);
+  EXPECT_FLOAT_EQ(c[0].tolerance, 0.04f);
+}
+
+TEST(TrackerSteps, RegistrationFallsBackToTheLastPoseWhenThePredictionMatchesLittle)
+{
+  // The objects are where the tracks are, moved 50 cm: beyond the search radius of the
+  // prediction (the identity), at the fallback's place.
+  std::vector<facyl::CylinderTrack> tracks;
+  std::vector<facyl::TrackObservation> objects;
+  const Eigen::Vector3f shift(-0.5f, 0.f, 0.f);
+  for (const Eigen::Vector3f& p : {Eigen::Vector3f(0.f, 0.f, 0.f), Eigen::Vector3f(0.2f, 0.f, 0.f),
+                                   Eigen::Vector3f(0.f, 0.25f, 0.f)}) {
+    tracks.push_back(confirmedTrack(cylinderObservation(p, 0.04f, 0.12f), 0));
+    objects.push_back(cylinderObservation(p + shift, 0.04f, 0.12f));
+  }
+  const facyl::RegistrationSettings settings;
+  const facyl::PlanarRigid prior;
+  const facyl::PlanarRigid fallback{0.f, Eigen::Vector2f(0.5f, 0.f)};
+  const auto alone = facyl::registerObservations(objects, tracks, prior, settings);
+  EXPECT_EQ(alone.matched_objects, 0u);
+  const auto with = facyl::registerObservations(objects, tracks, prior, settings, &fallback);
+  EXPECT_EQ(with.matched_objects, 3u);
+  EXPECT_LT((with.transform.t - fallback.t).norm(), 1e-4f);
+  EXPECT_NEAR(with.transform.yaw, 0.f, 1e-4f);
+}
+
+TEST(TrackerSteps, NewSceneWhenTooFewExpectedTracksMatch)
+{
+  // No confirmed track: never.
+  EXPECT_FALSE(facyl::isNewScene(0, 0, 5, 0, true, 0.3f));
+  // A plane jump with fewer than two matched objects.
+  EXPECT_TRUE(facyl::isNewScene(2, 2, 5, 1, true, 0.3f));
+  EXPECT_FALSE(facyl::isNewScene(2, 2, 5, 2, true, 0.3f));
+  EXPECT_FALSE(facyl::isNewScene(2, 2, 5, 1, false, 0.3f));
+  // Fewer than min_overlap of at least three expected (and seen) tracks.
+  EXPECT_TRUE(facyl::isNewScene(10, 10, 10, 2, false, 0.3f));
+  EXPECT_FALSE(facyl::isNewScene(10, 10, 10, 3, false, 0.3f));
+  EXPECT_FALSE(facyl::isNewScene(10, 10, 2, 0, false, 0.3f)); // two objects seen: too few
+  EXPECT_FALSE(facyl::isNewScene(10, 2, 10, 0, false, 0.3f)); // two expected in view
+  EXPECT_FALSE(facyl::isNewScene(10, 10, 10, 0, false, 0.f)); // never by share
+}
+
+TEST(TrackerSteps, ObservationTakesTheDecisionsSideAndAFittedCylinder)
+{
+  facyl::RecognizedObject r;
+  r.cluster.centroid = Eigen::Vector3f(0.f, 0.f, 1.f);
+  r.cluster.indices.indices.resize(500);
+  r.cluster.support = 1;
+  r.is_cylinder = true;
+  r.evidence.fitted = true;
+  r.cylinder.base = Eigen::Vector3f(0.f, 0.1f, 1.f);
+  r.cylinder.top = Eigen::Vector3f(0.f, -0.1f, 1.f);
+  r.cylinder.axis = Eigen::Vector3f(0.f, -1.f, 0.f);
+  r.cylinder.radius = 0.04f;
+  r.cylinder.angular_coverage = 0.01f;
+  const Eigen::Affine3f pose(Eigen::Translation3f(1.f, 0.f, 0.f));
+  auto o = facyl::observe(r, pose, 0.6f);
+  EXPECT_TRUE(o.valid);
+  EXPECT_EQ(o.support, 1);
+  EXPECT_EQ(o.points, 500u);
+  EXPECT_TRUE(o.geometry.centroid.isApprox(Eigen::Vector3f(1.f, 0.f, 1.f)));
+  ASSERT_TRUE(o.geometry.cylinder);
+  EXPECT_TRUE(o.geometry.centre.isApprox(Eigen::Vector3f(1.f, 0.f, 1.f)));
+  EXPECT_TRUE(o.geometry.axis.isApprox(Eigen::Vector3f(0.f, -1.f, 0.f)));
+  EXPECT_NEAR(o.geometry.height, 0.2f, 1e-6f);
+  EXPECT_FLOAT_EQ(o.quality, 500.f * 0.05f); // coverage counts at least 5%
+  // The decision sets the side, p_cylinder the strength.
+  EXPECT_FLOAT_EQ(o.p, 0.6f); // no classifier
+  r.evidence.p_cylinder = 0.3f;
+  EXPECT_FLOAT_EQ(facyl::observe(r, pose, 0.6f).p, 0.6f);
+  r.evidence.p_cylinder = 0.9f;
+  EXPECT_FLOAT_EQ(facyl::observe(r, pose, 0.6f).p, 0.9f);
+  r.is_cylinder = false;
+  EXPECT_FLOAT_EQ(facyl::observe(r, pose, 0.6f).p, 0.4f);
+  EXPECT_FALSE(facyl::observe(r, pose, 0.6f).geometry.cylinder); // rejected: no cylinder
+  // Ends that coincide: the fit's axis; a radius that is not finite: no cylinder.
+  r.is_cylinder = true;
+  r.cylinder.top = r.cylinder.base;
+  EXPECT_TRUE(
+    facyl::observe(r, pose, 0.6f).geometry.axis.isApprox(Eigen::Vector3f(0.f, -1.f, 0.f)));
+  r.cylinder.radius = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(facyl::observe(r, pose, 0.6f).geometry.cylinder);
+  r.cluster.centroid.x() = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(facyl::observe(r, pose, 0.6f).valid);
+}
+
+TEST(TrackerSteps, AssociationGivesASecondChanceButNotToATakenAwayObject)
+{
+  const facyl::AssociationSettings s; // sigma_centroid 4 cm, gate 9: 12 cm
+  std::vector<facyl::CylinderTrack> tracks{confirmedTrack(boxObservation({0.f, 0.f, 0.f}), 0),
+                                           confirmedTrack(boxObservation({1.f, 0.f, 0.f}), 1)};
+  // 2 cm and 15 cm from their tracks: the second matches only with doubled sigmas (24 cm).
+  std::vector<facyl::TrackObservation> obs{boxObservation({1.02f, 0.f, 0.f}),
+                                           boxObservation({0.15f, 0.f, 0.f}),
+                                           boxObservation({0.5f, 0.f, 0.f})};
+  EXPECT_EQ(facyl::associate(obs, tracks, s), (std::vector<int>{1, 0, -1}));
+  // A track whose place the sensor saw through takes only an object right at it (a quarter
+  // of the gate: 6 cm), and gets no second chance.
+  tracks[0].seen_through = 1;
+  EXPECT_EQ(facyl::associate(obs, tracks, s), (std::vector<int>{1, -1, -1}));
+  obs[1].geometry.centroid.x() = 0.05f;
+  EXPECT_EQ(facyl::associate(obs, tracks, s), (std::vector<int>{1, 0, -1}));
+  obs[0].valid = false;
+  EXPECT_EQ(facyl::associate(obs, tracks, s), (std::vector<int>{-1, 0, -1}));
+}
+
+TEST(TrackerSteps, TracksStartUpAndCorrectTheirExtentAroundTheCentre)
+{
+  facyl::CylinderTrackerParameters params;
+  params.confirm_hits = 2;
+  // Seen upside down: the track's axis is turned up, its extent with it.
+  auto o = cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f);
+  std::swap(o.base, o.top);
+  o.geometry.axis = -o.geometry.axis;
+  facyl::CylinderTrack t = facyl::newTrack(o, 7, 3, params);
+  EXPECT_EQ(t.id, 7);
+  EXPECT_EQ(t.object, 3);
+  EXPECT_FALSE(t.confirmed);
+  EXPECT_TRUE(t.has_cylinder);
+  EXPECT_GT(t.axis.z(), 0.99f);
+  EXPECT_FLOAT_EQ(t.lo, -0.06f);
+  EXPECT_FLOAT_EQ(t.hi, 0.06f);
+  EXPECT_EQ(t.fits.size(), 1u);
+  // A taller observation: the top end beyond the extent pulls it; the centre stays in the
+  // middle of the extent; the second hit confirms the track.
+  t.misses = 2;
+  facyl::correctTrack(t, cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.16f), 1.f, params);
+  EXPECT_TRUE(t.confirmed);
+  EXPECT_EQ(t.misses, 0);
+  EXPECT_EQ(t.status, facyl::TrackStatus::Seen);
+  EXPECT_EQ(t.fits.size(), 2u);
+  EXPECT_GT(t.hi - t.lo, 0.12f);
+  EXPECT_NEAR(t.lo, -t.hi, 1e-6f);
+  EXPECT_GT(t.centre.z(), 0.06f);
+  // An observation without a cylinder moves the centroid and the confidence only.
+  const float height = t.hi - t.lo;
+  facyl::correctTrack(t, boxObservation({0.f, 0.f, 0.06f}), 1.f, params);
+  EXPECT_EQ(t.hits, 3u);
+  EXPECT_EQ(t.cylinder_hits, 2u);
+  EXPECT_FLOAT_EQ(t.hi - t.lo, height);
+  EXPECT_LT(t.log_odds, facyl::updateLogOdds(facyl::updateLogOdds(0.f, 0.8f, 4.6f), 0.8f, 4.6f));
+}
+
+TEST(TrackerSteps, CylinderFromHistoryOutvotesAWrongFit)
+{
+  // One wrong fit (tilted, wide) and three that agree (either sign), one of which is off
+  // across the axis: the axis, line and radius are the agreeing ones' (weighted medians).
+  facyl::CylinderTrack t;
+  t.has_cylinder = true;
+  t.axis = Eigen::Vector3f(1.f, 0.f, 0.2f).normalized();
+  t.lo = -0.05f;
+  t.hi = 0.05f;
+  t.radius = 0.08f;
+  t.fits = {{t.axis, Eigen::Vector3f(0.1f, 0.f, 0.f), 0.08f, 1.5f},
+            {Eigen::Vector3f::UnitZ(), Eigen::Vector3f(0.01f, 0.f, 0.f), 0.040f, 1.f},
+            {-Eigen::Vector3f::UnitZ(), Eigen::Vector3f(0.012f, 0.f, 0.05f), 0.041f, 1.f},
+            {Eigen::Vector3f::UnitZ(), Eigen::Vector3f(0.3f, 0.f, 0.f), 0.05f, 1.f}};
+  facyl::cylinderFromHistory(t, 0.14f);
+  EXPECT_GT(t.axis.z(), 0.9999f); // the track's sense kept
+  EXPECT_NEAR(t.radius, 0.041f, 1e-6f);
+  EXPECT_NEAR(t.centre.x(), 0.012f, 1e-5f);
+  EXPECT_NEAR(t.centre.y(), 0.f, 1e-5f);
+  EXPECT_NEAR(t.centre.z(), 0.f, 1e-5f); // moved across the axis only
+  EXPECT_FLOAT_EQ(t.hi - t.lo, 0.1f);
+}
+
+TEST(TrackerSteps, FragmentsLieInsideTheCylinderOrBringItsCentroidNearer)
+{
+  auto t = confirmedTrack(cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f), 0);
+  const auto matched = cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f);
+  EXPECT_FLOAT_EQ(facyl::fragmentGain(boxObservation({0.06f, 0.f, 0.1f}), t, matched, 0.03f, 0.04f),
+                  1.f); // within the radius and the margin
+  EXPECT_FLOAT_EQ(facyl::fragmentGain(boxObservation({0.08f, 0.f, 0.1f}), t, matched, 0.03f, 0.04f),
+                  0.f); // beyond them, and the pieces' centroid is farther than the match's
+  // A box-like track matched to a piece 3 cm off its centroid: the other piece, 5 cm on the
+  // other side, brings the centroid to 1 cm (gain 2/3); one 20 cm away is too far.
+  auto box = confirmedTrack(boxObservation({0.f, 0.f, 0.f}), 1);
+  const auto piece = boxObservation({0.03f, 0.f, 0.f});
+  EXPECT_NEAR(facyl::fragmentGain(boxObservation({-0.05f, 0.f, 0.f}), box, piece, 0.03f, 0.04f),
+              2.f / 3.f, 1e-5f);
+  EXPECT_FLOAT_EQ(facyl::fragmentGain(boxObservation({-0.2f, 0.f, 0.f}), box, piece, 0.03f, 0.04f),
+                  0.f);
+}
+
+TEST(TrackerSteps, ViewStatusTellsWhyATrackIsNotSeen)
+{
+  facyl::TrackerView view;
+  view.camera = facyl::PinholeCamera{500.f, 500.f, 320.f, 240.f, 640, 480};
+  const Eigen::Affine3f identity = Eigen::Affine3f::Identity();
+  auto box = confirmedTrack(boxObservation({0.f, 0.f, 1.f}), 0); // 1 m in front of the sensor
+  int inside = 0;
+  std::vector<facyl::RecognizedObject> objects(2);
+  objects[1].cluster.box = {300, 200, 340, 280};
+  // Without depth the sensor cannot tell; outside the image or behind it: out of view.
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside), facyl::TrackStatus::Missed);
+  EXPECT_EQ(inside, -1);
+  EXPECT_EQ(facyl::viewStatus(box, Eigen::Affine3f(Eigen::Translation3f(1.f, 0.f, 0.f)), view,
+                              objects, inside),
+            facyl::TrackStatus::OutOfView);
+  EXPECT_EQ(facyl::viewStatus(box, Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, -2.f)), view,
+                              objects, inside),
+            facyl::TrackStatus::OutOfView);
+  float depth = 0.5f;
+  view.depth = [&depth](int, int) { return depth; };
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside), facyl::TrackStatus::Occluded);
+  depth = 1.5f;
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside),
+            facyl::TrackStatus::SeenThrough);
+  depth = 1.f; // a surface at its depth, inside object 1's box: merged into it
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside), facyl::TrackStatus::Merged);
+  EXPECT_EQ(inside, 1);
+  objects[1].cluster.box = {0, 0, 10, 10};
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside), facyl::TrackStatus::Missed);
+  depth = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(facyl::viewStatus(box, identity, view, objects, inside), facyl::TrackStatus::Missed);
+  // A cylinder's probes lie on its front: its surface 4 cm before its axis is no occluder.
+  auto can = confirmedTrack(cylinderObservation({0.f, 0.06f, 1.f}, 0.04f, 0.12f), 1);
+  can.axis = Eigen::Vector3f(0.f, -1.f, 0.f);
+  can.centre = Eigen::Vector3f(0.f, 0.f, 1.f);
+  depth = 0.96f;
+  EXPECT_EQ(facyl::viewStatus(can, identity, view, objects, inside), facyl::TrackStatus::Missed);
+  depth = 0.9f;
+  EXPECT_EQ(facyl::viewStatus(can, identity, view, objects, inside), facyl::TrackStatus::Occluded);
+  view.camera = facyl::PinholeCamera{};
+  EXPECT_EQ(facyl::viewStatus(can, identity, view, objects, inside), facyl::TrackStatus::Missed);
+}
+
+TEST(TrackerSteps, TwoTracksOfOneObjectBecomeTheOlder)
+{
+  const facyl::CylinderTrackerParameters params;
+  auto older = confirmedTrack(cylinderObservation({0.f, 0.f, 0.f}, 0.04f, 0.12f), 1);
+  auto younger = confirmedTrack(cylinderObservation({0.005f, 0.f, 0.f}, 0.041f, 0.12f), 4);
+  older.status = facyl::TrackStatus::Occluded;
+  older.occluded = 3;
+  older.hits = 10;
+  older.log_odds = 4.f;
+  younger.hits = 2;
+  younger.log_odds = 2.f;
+  younger.object = 5;
+  EXPECT_TRUE(facyl::areOneObject(older, younger, params.association));
+  EXPECT_FALSE(facyl::areOneObject(younger, older, params.association)); // the older keeps its id
+  older.status = facyl::TrackStatus::Seen; // both seen in one frame: two objects
+  EXPECT_FALSE(facyl::areOneObject(older, younger, params.association));
+  older.status = facyl::TrackStatus::Occluded;
+  auto far = younger;
+  far.centre.x() += 0.05f;
+  EXPECT_FALSE(facyl::areOneObject(older, far, params.association));
+  younger.confirmed = false;
+  EXPECT_FALSE(facyl::areOneObject(older, younger, params.association));
+  younger.confirmed = true;
+
+  facyl::absorbTrack(older, younger, 1, params.confidence_limit);
+  EXPECT_EQ(older.status, facyl::TrackStatus::Seen); // takes the younger one's object
+  EXPECT_EQ(older.object, 5);
+  EXPECT_EQ(older.occluded, 0);
+  EXPECT_EQ(older.hits, 12u);
+  EXPECT_FLOAT_EQ(older.log_odds, params.confidence_limit);
+  EXPECT_EQ(older.fits.size(), 1u); // the last history (1) kept
+  EXPECT_TRUE(older.centre.isApprox(younger.centre));
+  EXPECT_FALSE(younger.confirmed);
+  EXPECT_TRUE(facyl::trackEnded(younger, params));
+}
+
+TEST(TrackerSteps, TracksEndAfterTheirLimits)
+{
+  facyl::CylinderTrackerParameters p;
+  p.max_tentative_misses = 0;
+  p.max_misses = 5;
+  p.max_occluded = 60;
+  p.max_out_of_view = 300;
+  facyl::CylinderTrack t;
+  EXPECT_FALSE(facyl::trackEnded(t, p));
+  t.misses = 1;
+  EXPECT_TRUE(facyl::trackEnded(t, p)); // tentative: at its first miss
+  t.confirmed = true;
+  t.misses = 5;
+  EXPECT_FALSE(facyl::trackEnded(t, p));
+  t.misses = 6;
+  EXPECT_TRUE(facyl::trackEnded(t, p));
+  t.misses = 0;
+  t.occluded = 61;
+  EXPECT_TRUE(facyl::trackEnded(t, p));
+  t.occluded = 60;
+  t.out_of_view = 300;
+  EXPECT_FALSE(facyl::trackEnded(t, p));
+  t.out_of_view = 301;
+  EXPECT_TRUE(facyl::trackEnded(t, p));
 }
 
 TEST(CylinderTracker, ParametersAreChecked)

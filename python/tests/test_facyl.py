@@ -117,6 +117,31 @@ def test_defaults_are_facyl_fits():
             assert c.radius == pytest.approx(ref["radius"], rel=1e-5), name
 
 
+def test_fit_cylinders_takes_every_option_of_facyl_fit():
+    """Issue 41: fit_cylinders takes facyl_fit's options under the same names (point_candidates,
+    coarse_scale, method and any_normal_sign were missing), and an unknown keyword raises
+    ValueError naming it alone (pybind's TypeError printed the whole array)."""
+    sim = cylinder(seed=9, noise=0.02)
+    pts, radius = sim["points"], sim["truth"]["radius"]
+    c = facyl.fit_cylinders(pts, point_candidates=0, coarse_scale=0.5, any_normal_sign=True)
+    assert c[0].radius == pytest.approx(radius, rel=0.05)
+    ransac = facyl.fit_cylinders(pts, method="pcl-ransac")
+    assert ransac and ransac[0].radius == pytest.approx(radius, rel=0.1)
+    with pytest.raises(ValueError, match="^unknown option bogus$"):
+        facyl.fit_cylinders(pts, bogus=1)
+    with pytest.raises(ValueError, match="^give neighbours once"):
+        facyl.fit_cylinders(pts, k=12, neighbours=14)
+    if FACYL_FIT:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "c.pcd")
+            write_pcd(path, pts.astype(np.float32))
+            out = subprocess.run([FACYL_FIT, "--method", "pcl-ransac", path], check=True,
+                                 capture_output=True, text=True).stdout
+        ref = json.loads(out)["cylinders"][0]
+        mine = facyl.fit_cylinders(pts.astype(np.float32), method="pcl-ransac")[0]
+        assert mine.radius == pytest.approx(ref["radius"], rel=1e-5)
+
+
 def test_open3d_vectors_are_taken_as_they_are():
     o3d = pytest.importorskip("open3d")
     sim = cylinder(seed=4)
@@ -308,6 +333,8 @@ def test_bundled_scene_matches_facyl_detect():
     (np.zeros((0, 3)), ValueError, "empty"),
     (np.full((50, 3), np.nan), ValueError, "no row is finite"),
     (np.zeros((50, 3), np.int32), TypeError, "float32 or float64"),
+    # Issue 41: float16 was taken silently (3 significant digits: 2.0 m and 2.001 m are one).
+    (np.zeros((50, 3), np.float16), TypeError, "float32 or float64 values, got dtype float16"),
     ([[0.0, 0.0, 0.0]] * 50, TypeError, "numpy array"),
     (np.zeros((4, 3)), ValueError, "fewer than k"),
     (np.zeros(9), ValueError, "expected shape"),
@@ -338,6 +365,58 @@ def test_bad_parameters(kwargs, message):
         facyl.fit_cylinders(pts, **kwargs)
 
 
+def test_settings_errors_name_the_keyword():
+    """Keywords are the tools' options (one table with the tools): an unknown keyword, or a
+    value out of its range (the settings struct's validate() says which), raises ValueError
+    naming the keyword, with the value as given."""
+    pts = cylinder(seed=1)["points"]
+    frame = np.zeros((4, 4, 3))
+
+    def detect(**kw):
+        return facyl.detect(frame, model="none", **kw)
+
+    def tracker(**kw):
+        return facyl.Tracker(model="none", **kw)
+
+    for call, keyword, value, message in [
+            (detect, "neighbours", 3, r"^neighbours: 3 is not in \[5, 200\]$"),
+            (detect, "k", 300, r"^k: 300 is not in \[5, 200\]$"),
+            (detect, "max_taper", 0, r"^max_taper: 0 is not in \(0, 1\]$"),
+            (detect, "voting", "majority",
+             r"^voting: 'majority' is not soft-curvature, soft-normal or rabbani$"),
+            (tracker, "min_score", 2, r"^min_score: 2 is not in \[0, 1\]$"),
+            (tracker, "track_max_misses", 0, r"^track_max_misses: max_misses 0 is not in"),
+            (facyl.fit_cylinders, "orientations", 5, r"^orientations: 5 is not in \[10, 100000\]$"),
+            (facyl.fit_cylinders, "max_cylinders", 101, r"^max_cylinders: 101 is not in"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            if call is facyl.fit_cylinders:
+                call(pts, **{keyword: value})
+            else:
+                call(**{keyword: value})
+    for call in (detect, tracker):
+        with pytest.raises(ValueError, match="^unknown option bogus$"):
+            call(bogus=1)
+    with pytest.raises(TypeError, match="^any_normal_sign: expected True or False"):
+        detect(any_normal_sign="yes")
+    with pytest.raises(ValueError, match="exclude each other"):  # numpy's bools are bools
+        detect(any_normal_sign=np.True_, outward_normals=True)
+
+
+def test_values_are_echoed_as_written():
+    """Issue 41: radius_limits=0.1 said "got '0.10000000000000001'"; a message echoes the value
+    as the user wrote it (its repr)."""
+    pts = cylinder(seed=1)["points"]
+    with pytest.raises(ValueError, match=r"^radius_limits: expected two numbers \(A, B\), got 0\.1$"):
+        facyl.fit_cylinders(pts, radius_limits=0.1)
+    with pytest.raises(ValueError, match=r"^min_score: 1\.1 is not in \[0, 1\]$"):
+        facyl.detect(np.zeros((4, 4, 3)), model="none", min_score=1.1)
+    with pytest.raises(ValueError, match=r"^up: expected three numbers \(x, y, z\), got \(0, 1\)$"):
+        facyl.fit_cylinders(pts, up=(0, 1))
+    with pytest.raises(ValueError, match=r"^orientations: 450\.5 is not an integer$"):
+        facyl.fit_cylinders(pts, orientations=450.5)
+
+
 def test_bad_normals_and_frames():
     pts = cylinder(seed=1)["points"]
     with pytest.raises(ValueError, match="normals"):
@@ -346,7 +425,12 @@ def test_bad_normals_and_frames():
         facyl.detect(np.full((4, 4, 3), np.nan))
     with pytest.raises(TypeError, match="colors"):
         facyl.detect(np.zeros((4, 4, 3)), np.zeros((4, 4, 3)))
-    with pytest.raises(ValueError, match="model"):
+    with pytest.raises(TypeError, match="^points: .*got dtype float16"):
+        facyl.detect(np.zeros((4, 4, 3), np.float16))
+    with pytest.raises(TypeError, match="^normals: .*got dtype float16"):
+        facyl.fit_cylinders(pts, pts.astype(np.float16))
+    # Issue 41: the message named "/nonexistent.cfg".
+    with pytest.raises(ValueError, match="^model: .*/nonexistent.onnx: no such file"):
         facyl.detect(np.random.default_rng(0).random((20, 20, 3)), model="/nonexistent.onnx")
     # No support in view is not an error: the frame's objects, with "found" False.
     nothing = facyl.detect(cylinder(seed=1)["points"], model="none")
@@ -454,6 +538,25 @@ def test_tracker_keeps_ids_on_a_simulated_stream():
     assert cylinders and all(t["cylinder"]["radius"] > 0 for t in cylinders)
 
 
+def test_degenerate_points_fail_with_one_line(capfd):
+    # Identical or collinear points hold no plane: one line says so (before: PCL's "Sample
+    # points too similar or collinear!" 1,000 times, on every call, and no error).
+    same = np.tile(np.array([[0.1, 0.2, 1.0]], np.float32), (10, 1))
+    line = np.array([[0.1 + 0.01 * i, 0.2 + 0.02 * i, 1.0 + 0.005 * i] for i in range(50)],
+                    np.float32)
+    for points in (same, line):
+        capfd.readouterr()
+        with pytest.raises(ValueError, match="recognition failed"):
+            facyl.detect(points)
+        err = capfd.readouterr().err
+        assert len(err.splitlines()) == 1 and "lie on one line" in err, err[:500]
+        tracker = facyl.Tracker()
+        with pytest.raises(ValueError, match="recognition failed"):
+            tracker.update(points)
+        err = capfd.readouterr().err
+        assert len(err.splitlines()) == 1 and "lie on one line" in err, err[:500]
+
+
 def test_tracker_bad_frames_keep_the_tracks():
     tracker = facyl.Tracker()
     for k in range(3):
@@ -513,3 +616,22 @@ def test_stub_defaults_are_the_module_defaults():
             assert module_value == stub_value, (node.name, arg.arg, module_value, stub_value)
             checked += 1
     assert checked >= 10
+    # fit_cylinders takes **options: its keywords and their defaults are listed in its
+    # docstring, from the same table as facyl_fit's options.
+    listed_text = facyl.fit_cylinders.__doc__.split("Every keyword and its default: ")[1]
+    values, switches = listed_text.split(".\n")[0].replace("\n", " ").split(
+        "; switches (True gives one): ")
+    listed = dict(pair.split("=", 1) for pair in values.split(", ")
+                  if "=" in pair and "(" not in pair and ")" not in pair)
+    listed.update((name, "False") for name in switches.split(", "))
+    stub_fit = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and
+                    n.name == "fit_cylinders")
+    compared = 0
+    for arg, default in zip(stub_fit.args.kwonlyargs, stub_fit.args.kw_defaults):
+        stub_value = ast.literal_eval(default)
+        if stub_value is None:
+            continue
+        assert arg.arg in listed, arg.arg
+        assert ast.literal_eval(listed[arg.arg]) == stub_value, (arg.arg, listed[arg.arg])
+        compared += 1
+    assert compared >= 10

@@ -122,11 +122,12 @@ CylinderClassifier::load(const std::string& onnx_path)
                              ? onnx_path
                              : onnx_path.substr(0, dot);
   const std::string cfg = stem + ".cfg";
+  // The model first: a wrong path is named as given, not by the description beside it.
+  if (!isRegularFile(onnx_path))
+    throw std::runtime_error(call + " " + onnx_path + ": no such file");
   const std::string why = parseClassifierModelInfo(readText(cfg, call), info_);
   if (!why.empty())
     throw std::runtime_error(call + " " + cfg + ": " + why);
-  if (!isRegularFile(onnx_path))
-    throw std::runtime_error(call + " " + onnx_path + ": no such file");
   auto network = std::make_unique<Network>();
   try {
     network->net = cv::dnn::readNetFromONNX(onnx_path);

@@ -3,6 +3,8 @@
  */
 #include <facyl/recognition/cylinder_evidence.h>
 
+#include <facyl/features/setting_problem.h>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -11,22 +13,26 @@
 namespace facyl {
 
 std::string
-validate(const CylinderDecision& d)
+validate(const CylinderDecision& d, std::string* rule)
 {
-  std::ostringstream s;
-  if (!(d.min_score >= 0.f && d.min_score <= 1.f))
-    s << "min_score " << d.min_score << " must be in [0, 1]";
-  else if (!(d.max_curvature_ratio > 0.f && d.max_curvature_ratio <= 1.f))
-    s << "max_curvature_ratio " << d.max_curvature_ratio << " must be in (0, 1]";
-  else if (!(d.min_angular_coverage >= 0.f && d.min_angular_coverage <= 1.f))
-    s << "min_angular_coverage " << d.min_angular_coverage << " must be in [0, 1]";
-  else if (!(d.min_probability >= 0.f && d.min_probability <= 1.f))
-    s << "min_probability " << d.min_probability << " must be in [0, 1]";
-  else if (!(d.max_arc_gap >= 0.f && d.max_arc_gap <= 1.f))
-    s << "max_arc_gap " << d.max_arc_gap << " must be in [0, 1]";
-  else if (!(d.max_taper > 0.f && d.max_taper <= 1.f))
-    s << "max_taper " << d.max_taper << " must be in (0, 1]";
-  return s.str();
+  if (rule)
+    rule->clear();
+  const auto in = [](float v, bool open_below) {
+    return (open_below ? v > 0.f : v >= 0.f) && v <= 1.f;
+  };
+  if (!in(d.min_score, false))
+    return settingProblem("min_score", d.min_score, "is not in [0, 1]", rule);
+  if (!in(d.max_curvature_ratio, true))
+    return settingProblem("max_curvature_ratio", d.max_curvature_ratio, "is not in (0, 1]", rule);
+  if (!in(d.min_angular_coverage, false))
+    return settingProblem("min_angular_coverage", d.min_angular_coverage, "is not in [0, 1]", rule);
+  if (!in(d.min_probability, false))
+    return settingProblem("min_probability", d.min_probability, "is not in [0, 1]", rule);
+  if (!in(d.max_arc_gap, false))
+    return settingProblem("max_arc_gap", d.max_arc_gap, "is not in [0, 1]", rule);
+  if (!in(d.max_taper, true))
+    return settingProblem("max_taper", d.max_taper, "is not in (0, 1]", rule);
+  return {};
 }
 
 bool

@@ -4,40 +4,41 @@
  */
 #include <facyl/recognition/impl/tabletop_cylinder_recognizer.hpp>
 
+#include <facyl/features/setting_problem.h>
+
 #include <sstream>
 
 namespace facyl {
 
 std::string
-validate(const TabletopRecognizerParameters& p)
+validate(const TabletopRecognizerParameters& p, std::string* rule)
 {
-  std::string why = validate(p.segmentation);
-  if (!why.empty())
+  if (rule)
+    rule->clear();
+  if (const std::string why = validate(p.segmentation); !why.empty())
     return "segmentation: " + why;
-  why = validate(p.hough);
-  if (!why.empty())
+  if (const std::string why = validate(p.hough, rule); !why.empty())
     return "fit: " + why;
-  why = validate(p.decision);
-  if (!why.empty())
+  if (const std::string why = validate(p.decision, rule); !why.empty())
     return "decision: " + why;
-  std::ostringstream s;
   if (!(p.fit_point_angle >= 0.f && p.fit_point_angle <= 0.1f))
-    s << "fit_point_angle " << p.fit_point_angle << " must be in [0, 0.1] rad";
-  else if (p.max_fit_points < 50 || p.max_fit_points > 1000000)
-    s << "max_fit_points " << p.max_fit_points << " must be in [50, 1000000]";
-  else if (p.neighbours < 5 || p.neighbours > 200)
-    s << "neighbours " << p.neighbours << " must be in [5, 200]";
-  else if (p.max_cylinders_per_cluster < 1 || p.max_cylinders_per_cluster > 20)
-    s << "max_cylinders_per_cluster " << p.max_cylinders_per_cluster << " must be in [1, 20]";
-  else if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))
-    s << "min_explained_share " << p.min_explained_share << " must be in (0, 1]";
-  else if (!(p.reject_below >= 0.f && p.reject_below <= 1.f))
-    s << "reject_below " << p.reject_below << " must be in [0, 1]";
-  else if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))
-    s << "recovery_margin " << p.recovery_margin << " must be in [0, 1] m";
-  else if (p.threads < 0 || p.threads > 64)
-    s << "threads " << p.threads << " must be in [0, 64]";
-  return s.str();
+    return settingProblem("fit_point_angle", p.fit_point_angle, "is not in [0, 0.1] (rad)", rule);
+  if (p.max_fit_points < 50 || p.max_fit_points > 1000000)
+    return settingProblem("max_fit_points", p.max_fit_points, "is not in [50, 1000000]", rule);
+  if (p.neighbours < 5 || p.neighbours > 200)
+    return settingProblem("neighbours", p.neighbours, "is not in [5, 200]", rule);
+  if (p.max_cylinders_per_cluster < 1 || p.max_cylinders_per_cluster > 20)
+    return settingProblem("max_cylinders_per_cluster", p.max_cylinders_per_cluster,
+                          "is not in [1, 20]", rule);
+  if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))
+    return settingProblem("min_explained_share", p.min_explained_share, "is not in (0, 1]", rule);
+  if (!(p.reject_below >= 0.f && p.reject_below <= 1.f))
+    return settingProblem("reject_below", p.reject_below, "is not in [0, 1]", rule);
+  if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))
+    return settingProblem("recovery_margin", p.recovery_margin, "is not in [0, 1] (m)", rule);
+  if (p.threads < 0 || p.threads > 64)
+    return settingProblem("threads", p.threads, "is not in [0, 64]", rule);
+  return {};
 }
 
 void

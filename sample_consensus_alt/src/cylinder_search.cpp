@@ -6,6 +6,7 @@
 #include "fitting_detail.h"
 
 #include <facyl/features/point_cues.h>
+#include <facyl/features/setting_problem.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -23,36 +24,46 @@ using detail::medianOf;
 using detail::normalScatter;
 
 std::string
-validate(const HoughCylinderParameters& p)
+validate(const HoughCylinderParameters& p, std::string* rule)
 {
-  std::ostringstream why;
+  const auto in = [](std::size_t lo, std::size_t hi) {
+    return "is not in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  };
+  if (rule)
+    rule->clear();
   if (p.orientations < kMinOrientations || p.orientations > kMaxOrientations)
-    why << "orientations (N_d) " << p.orientations << " is not in [" << kMinOrientations << ", "
-        << kMaxOrientations << "]";
-  else if (p.accumulators < 1 || p.accumulators > kMaxAccumulators)
-    why << "accumulators " << p.accumulators << " is not in [1, " << kMaxAccumulators << "]";
-  else if (p.kernel_exponent < 1 || p.kernel_exponent > 16)
-    why << "kernel exponent " << p.kernel_exponent << " is not in [1, 16]";
-  else if (!(p.radius_min >= 0.f) || !std::isfinite(p.radius_min))
-    why << "minimum radius " << p.radius_min << " is not a finite value >= 0";
-  else if (!(p.radius_max > p.radius_min))
-    why << "radius limits [" << p.radius_min << ", " << p.radius_max << "] are empty or inverted";
-  else if (!(p.distance_threshold >= 0.f) || !std::isfinite(p.distance_threshold))
-    why << "distance threshold " << p.distance_threshold << " is not a finite value >= 0";
-  else if (!(p.normal_angle_threshold > 0.f) ||
-           !(p.normal_angle_threshold <= static_cast<float>(M_PI / 2) + 1e-6f))
-    why << "normal angle threshold " << p.normal_angle_threshold << " rad is not in (0, pi/2]";
-  else if (p.orientation_candidates < 1)
-    why << "at least one orientation candidate is needed";
-  else if (p.max_cylinders < 1)
-    why << "max cylinders must be at least 1";
-  else if (p.circle_grid < 8 || p.circle_grid > 4096)
-    why << "circle grid " << p.circle_grid << " is not in [8, 4096]";
-  else if (!(p.noisy_cues_ratio > 0.f) || !std::isfinite(p.noisy_cues_ratio))
-    why << "noisy cues ratio " << p.noisy_cues_ratio << " is not a finite value > 0";
-  else if (!(p.coarse_scale >= 0.f) || !(p.coarse_scale <= 2.f))
-    why << "coarse scale " << p.coarse_scale << " is not in [0, 2]";
-  return why.str();
+    return settingProblem("orientations (N_d)", p.orientations,
+                          in(kMinOrientations, kMaxOrientations), rule);
+  if (p.accumulators < 1 || p.accumulators > kMaxAccumulators)
+    return settingProblem("accumulators", p.accumulators, in(1, kMaxAccumulators), rule);
+  if (p.kernel_exponent < 1 || p.kernel_exponent > 16)
+    return settingProblem("kernel exponent", p.kernel_exponent, "is not in [1, 16]", rule);
+  if (!(p.radius_min >= 0.f) || !std::isfinite(p.radius_min))
+    return settingProblem("minimum radius", p.radius_min, "is not a finite value >= 0", rule);
+  if (!(p.radius_max > p.radius_min)) { // two settings: no rule of one value
+    std::ostringstream limits;
+    limits << "[" << p.radius_min << ", " << p.radius_max << "]";
+    return settingProblem("radius limits", limits.str(), "are empty or inverted", nullptr);
+  }
+  if (!(p.distance_threshold >= 0.f) || !std::isfinite(p.distance_threshold))
+    return settingProblem("distance threshold", p.distance_threshold, "is not a finite value >= 0",
+                          rule);
+  if (!(p.normal_angle_threshold > 0.f) ||
+      !(p.normal_angle_threshold <= static_cast<float>(M_PI / 2) + 1e-6f))
+    return settingProblem("normal angle threshold", p.normal_angle_threshold,
+                          "rad is not in (0, pi/2]", rule);
+  if (p.orientation_candidates < 1)
+    return "at least one orientation candidate is needed";
+  if (p.max_cylinders < 1)
+    return "max cylinders must be at least 1";
+  if (p.circle_grid < 8 || p.circle_grid > 4096)
+    return settingProblem("circle grid", p.circle_grid, "is not in [8, 4096]", rule);
+  if (!(p.noisy_cues_ratio > 0.f) || !std::isfinite(p.noisy_cues_ratio))
+    return settingProblem("noisy cues ratio", p.noisy_cues_ratio, "is not a finite value > 0",
+                          rule);
+  if (!(p.coarse_scale >= 0.f) || !(p.coarse_scale <= 2.f))
+    return settingProblem("coarse scale", p.coarse_scale, "is not in [0, 2]", rule);
+  return {};
 }
 
 std::size_t
@@ -983,8 +994,9 @@ competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
   return std::move(competition).contenders();
 }
 
-/** Neighbours of a coarse cue at most: four times the usual k = 16, a normal's noise halved. */
-constexpr int kCoarseNeighbours = 64;
+/** Neighbours of a coarse cue at most: four times the usual k (kDefaultNeighbours, 16), a
+ * normal's noise halved. */
+constexpr int kCoarseNeighbours = 4 * kDefaultNeighbours;
 /** Coarse neighbourhoods are searched for every second point, and shared with the points they
  * hold (estimatePointCues): the search is most of the coarse cues' cost, and a neighbourhood
  * of up to 64 points moved by one point's spacing is nearly the same set (its normal turns

@@ -411,7 +411,7 @@ ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double sc
     for (std::size_t i = 0; i < n; ++i)
       if (!taken[i])
         remaining->push_back(static_cast<pcl::index_t>(i));
-    if (remaining->size() < 10)
+    if (remaining->size() < 10 || !spansPlane(*cues.cloud, *remaining))
       break;
     sac.setIndices(remaining);
     pcl::PointIndices inliers;

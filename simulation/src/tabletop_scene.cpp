@@ -2,10 +2,10 @@
  * facyl: fast cylinder detection for PCL.
  */
 #include <facyl/simulation/scene_rendering.h>
+#include <facyl/tools/json_writer.h>
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -243,133 +243,159 @@ simulateTabletopScene(const TabletopSceneParameters& params)
 }
 
 namespace {
-std::string
+
+using facyl_cli::Json;
+
+/** Ground truth numbers are written with 7 significant digits (what a float holds). */
+constexpr int kDigits = 7;
+
+Json
+number(float v)
+{
+  return static_cast<double>(v);
+}
+
+Json
 vec(const Eigen::Vector3f& v)
 {
-  std::ostringstream s;
-  s << std::setprecision(7) << "[" << v.x() << "," << v.y() << "," << v.z() << "]";
-  return s.str();
+  return Json::array({number(v.x()), number(v.y()), number(v.z())});
 }
 
-/** ,"key":{material} when \a m is not the reference material, else nothing. */
-std::string
-materialJson(const char* key, const SurfaceMaterial& m)
+/** Sets j[key] to \a m when it is not the reference material. */
+void
+addMaterial(Json& j, const char* key, const SurfaceMaterial& m)
 {
   if (m.isReference())
-    return "";
-  std::ostringstream s;
-  s << std::setprecision(7) << ",\"" << key << "\":{\"reflectance\":" << m.reflectance
-    << ",\"gloss\":" << m.gloss << ",\"transparency\":" << m.transparency << "}";
-  return s.str();
+    return;
+  j[key] = Json{{"reflectance", number(m.reflectance)},
+                {"gloss", number(m.gloss)},
+                {"transparency", number(m.transparency)}};
 }
 
-/** ,"scenery":[...] when the scene has scenery, else nothing. */
-std::string
+/** The scenery items (ids, kinds and part counts). */
+Json
 sceneryJson(const TabletopScene& scene)
 {
-  if (scene.scenery.empty())
-    return "";
-  std::ostringstream s;
-  s << ",\"scenery\":[";
+  Json items = Json::array();
   for (std::size_t j = 0; j < scene.scenery.size(); ++j)
-    s << (j ? "," : "") << "{\"id\":" << kFirstSceneryId + j << ",\"kind\":\""
-      << scene.scenery[j].kind << "\",\"parts\":" << scene.scenery[j].parts.size() << "}";
-  s << "]";
-  return s.str();
+    items.push_back(Json{{"id", kFirstSceneryId + j},
+                         {"kind", scene.scenery[j].kind},
+                         {"parts", scene.scenery[j].parts.size()}});
+  return items;
 }
 
-/** ,"sensor":{...} when the sensor was drawn, else nothing. */
-std::string
-drawnSensorJson(const RenderedScene& r)
+/** The drawn sensor's family and model. */
+Json
+drawnSensorJson(SensorFamily family, const DepthSensorModel& m)
 {
-  if (!r.sensor_family)
-    return "";
-  const DepthSensorModel& m = r.sensor;
-  std::ostringstream s;
-  s << std::setprecision(7) << ",\"sensor\":{\"family\":\"" << toString(*r.sensor_family)
-    << "\",\"noise_coefficient\":" << m.noise_coefficient
-    << ",\"noise_constant\":" << m.noise_constant << ",\"noise_linear\":" << m.noise_linear
-    << ",\"baseline_focal\":" << m.baseline_focal << ",\"disparity_step\":" << m.disparity_step
-    << ",\"edge_jump\":" << m.edge_jump << ",\"grazing_cos\":" << m.grazing_cos
-    << ",\"dropout\":" << m.dropout << ",\"hole_rate\":" << m.hole_rate
-    << ",\"hole_radius\":" << m.hole_radius << ",\"edge_fattening\":" << m.edge_fattening
-    << ",\"flying_pixels\":" << m.flying_pixels << ",\"colour_shift\":[" << m.colour_shift_u << ","
-    << m.colour_shift_v << "],\"min_range\":" << m.min_range << ",\"max_range\":" << m.max_range
-    << ",\"colour_noise\":" << m.colour_noise << ",\"depth_scale_error\":" << m.depth_scale_error
-    << ",\"radial_depth_bias\":" << m.radial_depth_bias
-    << ",\"incidence_bias\":" << m.incidence_bias
-    << ",\"weak_return_dropout\":" << m.weak_return_dropout
-    << ",\"highlight_width\":" << m.highlight_width << ",\"see_through\":" << m.see_through << "}";
-  return s.str();
+  return Json{{"family", toString(family)},
+              {"noise_coefficient", number(m.noise_coefficient)},
+              {"noise_constant", number(m.noise_constant)},
+              {"noise_linear", number(m.noise_linear)},
+              {"baseline_focal", number(m.baseline_focal)},
+              {"disparity_step", number(m.disparity_step)},
+              {"edge_jump", number(m.edge_jump)},
+              {"grazing_cos", number(m.grazing_cos)},
+              {"dropout", number(m.dropout)},
+              {"hole_rate", number(m.hole_rate)},
+              {"hole_radius", number(m.hole_radius)},
+              {"edge_fattening", number(m.edge_fattening)},
+              {"flying_pixels", number(m.flying_pixels)},
+              {"colour_shift", Json::array({number(m.colour_shift_u), number(m.colour_shift_v)})},
+              {"min_range", number(m.min_range)},
+              {"max_range", number(m.max_range)},
+              {"colour_noise", number(m.colour_noise)},
+              {"depth_scale_error", number(m.depth_scale_error)},
+              {"radial_depth_bias", number(m.radial_depth_bias)},
+              {"incidence_bias", number(m.incidence_bias)},
+              {"weak_return_dropout", number(m.weak_return_dropout)},
+              {"highlight_width", number(m.highlight_width)},
+              {"see_through", number(m.see_through)}};
+}
+
+/** Object \a i of the scene, in the camera frame (\a world_to_camera). */
+Json
+objectJson(const RenderedScene& r, std::size_t i, const Eigen::Isometry3f& world_to_camera)
+{
+  const SceneObject& o = r.scene.objects[i];
+  const Eigen::Isometry3f pose = world_to_camera * o.pose;
+  Json j{{"id", i + 2},
+         {"class", toString(o.cls)},
+         {"kind", o.kind},
+         {"visible_pixels", r.visible_pixels[i]},
+         {"position", vec(pose.translation())},
+         {"axis", vec(pose.linear().col(2))}};
+  j["on"] = o.support >= 0 ? Json(o.support + 2) : Json("table");
+  j["leaning"] = o.leaning;
+  Json touches = Json::array();
+  for (const int k : o.touches)
+    touches.push_back(k + 2);
+  j["touches"] = touches;
+  if (o.cls == SceneClass::Box)
+    j["size"] = vec(o.size);
+  else
+    j["radius"] = number(o.radius);
+  if (o.cls == SceneClass::Cylinder) {
+    const CylinderTruth ct = cylinderTruth(r.scene, o);
+    j["pose"] = o.lying ? "lying" : "upright";
+    j["open_top"] = o.open_top;
+    j["handle"] = o.handle;
+    j["cylinder"] = Json{{"point_on_axis", vec(ct.base)},
+                         {"axis", vec(ct.axis)},
+                         {"radius", number(ct.radius)},
+                         {"height", number(ct.height)}};
+  }
+  else if (o.cls == SceneClass::Cone)
+    j["height"] = number(o.height);
+  addMaterial(j, "material", o.material);
+  return j;
 }
 } // namespace
 
 std::string
 groundTruthJson(const RenderedScene& r)
 {
-  std::ostringstream s;
-  s << std::setprecision(7);
   const auto& c = r.camera;
-  s << "{\"camera\":{\"width\":" << c.width << ",\"height\":" << c.height << ",\"fx\":" << c.fx
-    << ",\"fy\":" << c.fy << ",\"cx\":" << c.cx << ",\"cy\":" << c.cy << "},";
+  Json j;
+  j["camera"] = Json{{"width", c.width},   {"height", c.height}, {"fx", number(c.fx)},
+                     {"fy", number(c.fy)}, {"cx", number(c.cx)}, {"cy", number(c.cy)}};
   const Eigen::Isometry3f& t = r.scene.camera_to_world;
-  s << "\"camera_to_world\":{\"rotation\":[" << vec(t.linear().row(0)) << ","
-    << vec(t.linear().row(1)) << "," << vec(t.linear().row(2))
-    << "],\"translation\":" << vec(t.translation()) << "},";
+  j["camera_to_world"] =
+    Json{{"rotation",
+          Json::array({vec(t.linear().row(0)), vec(t.linear().row(1)), vec(t.linear().row(2))})},
+         {"translation", vec(t.translation())}};
   const TabletopScene& sc = r.scene;
-  s << "\"table\":{\"coefficients\":[" << r.table_plane[0] << "," << r.table_plane[1] << ","
-    << r.table_plane[2] << "," << r.table_plane[3] << "],\"shape\":\""
-    << (sc.table_shape == TableShape::Round ? "round" : "rectangle") << "\",";
+  Json table{{"coefficients", Json::array({number(r.table_plane[0]), number(r.table_plane[1]),
+                                           number(r.table_plane[2]), number(r.table_plane[3])})},
+             {"shape", sc.table_shape == TableShape::Round ? "round" : "rectangle"}};
   if (sc.table_shape == TableShape::Round)
-    s << "\"radius\":" << sc.table_radius;
-  else
-    s << "\"width\":" << sc.table_width << ",\"depth\":" << sc.table_depth;
-  s << ",\"height\":" << sc.table_height
-    << ",\"legs\":" << (sc.furniture.size() > 1 ? "true" : "false");
+    table["radius"] = number(sc.table_radius);
+  else {
+    table["width"] = number(sc.table_width);
+    table["depth"] = number(sc.table_depth);
+  }
+  table["height"] = number(sc.table_height);
+  table["legs"] = sc.furniture.size() > 1;
   if (const SceneObject* top = sc.tableTop()) {
     if (top->top_sag != 0.f)
-      s << ",\"sag\":" << top->top_sag;
-    s << materialJson("material", top->material);
+      table["sag"] = number(top->top_sag);
+    addMaterial(table, "material", top->material);
   }
-  s << "},\"wall\":" << (sc.wall ? "true" : "false") << ",";
-  s << "\"pixel_ids\":\"0 background (floor, wall), 1 table, 2+i object i"
-    << (sc.scenery.empty() ? "" : ", 1000+j scenery item j") << "\",\"objects\":[";
+  j["table"] = table;
+  j["wall"] = sc.wall;
+  j["pixel_ids"] = std::string("0 background (floor, wall), 1 table, 2+i object i") +
+                   (sc.scenery.empty() ? "" : ", 1000+j scenery item j");
   const Eigen::Isometry3f world_to_camera = t.inverse();
-  for (std::size_t i = 0; i < r.scene.objects.size(); ++i) {
-    const SceneObject& o = r.scene.objects[i];
-    const Eigen::Isometry3f pose = world_to_camera * o.pose;
-    s << (i ? "," : "") << "{\"id\":" << i + 2 << ",\"class\":\"" << toString(o.cls)
-      << "\",\"kind\":\"" << o.kind << "\",\"visible_pixels\":" << r.visible_pixels[i]
-      << ",\"position\":" << vec(pose.translation()) << ",\"axis\":" << vec(pose.linear().col(2))
-      << ",\"on\":";
-    if (o.support >= 0)
-      s << o.support + 2;
-    else
-      s << "\"table\"";
-    s << ",\"leaning\":" << (o.leaning ? "true" : "false") << ",\"touches\":[";
-    for (std::size_t k = 0; k < o.touches.size(); ++k)
-      s << (k ? "," : "") << o.touches[k] + 2;
-    s << "]";
-    if (o.cls == SceneClass::Box)
-      s << ",\"size\":" << vec(o.size);
-    else
-      s << ",\"radius\":" << o.radius;
-    if (o.cls == SceneClass::Cylinder) {
-      const CylinderTruth ct = cylinderTruth(r.scene, o);
-      s << ",\"pose\":\"" << (o.lying ? "lying" : "upright")
-        << "\",\"open_top\":" << (o.open_top ? "true" : "false")
-        << ",\"handle\":" << (o.handle ? "true" : "false")
-        << ",\"cylinder\":{\"point_on_axis\":" << vec(ct.base) << ",\"axis\":" << vec(ct.axis)
-        << ",\"radius\":" << ct.radius << ",\"height\":" << ct.height << "}";
-    }
-    else if (o.cls == SceneClass::Cone) {
-      s << ",\"height\":" << o.height;
-    }
-    s << materialJson("material", o.material) << "}";
-  }
-  s << "]" << materialJson("floor_material", sc.floor_material) << sceneryJson(sc)
-    << drawnSensorJson(r) << "}";
-  return s.str();
+  Json objects = Json::array();
+  for (std::size_t i = 0; i < r.scene.objects.size(); ++i)
+    objects.push_back(objectJson(r, i, world_to_camera));
+  j["objects"] = objects;
+  addMaterial(j, "floor_material", sc.floor_material);
+  if (!sc.scenery.empty())
+    j["scenery"] = sceneryJson(sc);
+  if (r.sensor_family)
+    j["sensor"] = drawnSensorJson(*r.sensor_family, r.sensor);
+  return facyl_cli::dumpJsonWithDigits(j, kDigits);
 }
 
 } // namespace facyl

@@ -3,10 +3,10 @@
  */
 #include <facyl/simulation/random.h>
 #include <facyl/simulation/tabletop_sequence.h>
+#include <facyl/tools/json_writer.h>
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -264,37 +264,35 @@ sequenceFrameSeed(std::uint64_t seed, std::size_t frame)
 std::string
 sequenceJson(const TabletopSequence& sequence)
 {
-  std::ostringstream s;
-  s << std::setprecision(7) << "{\"frames\":" << sequence.cameras.size() << ",\"change\":\""
-    << toString(sequence.change) << "\",\"changed_object\":";
-  if (sequence.changed_object >= 0)
-    s << sequence.changed_object + 2 << ",\"change_frame\":" << sequence.change_frame;
+  using facyl_cli::Json;
+  Json j{{"frames", sequence.cameras.size()}, {"change", toString(sequence.change)}};
+  if (sequence.changed_object >= 0) {
+    j["changed_object"] = sequence.changed_object + 2;
+    j["change_frame"] = sequence.change_frame;
+  }
   else
-    s << "null";
-  s << ",\"objects\":[";
+    j["changed_object"] = nullptr;
+  Json objects = Json::array();
   for (std::size_t i = 0; i < sequence.scene.objects.size(); ++i) {
     const auto& o = sequence.scene.objects[i];
-    s << (i ? "," : "") << "{\"id\":" << i + 2 << ",\"class\":\"" << toString(o.cls)
-      << "\",\"kind\":\"" << o.kind << "\"}";
+    objects.push_back(Json{{"id", i + 2}, {"class", toString(o.cls)}, {"kind", o.kind}});
   }
-  s << "],\"cameras\":[";
+  j["objects"] = objects;
+  Json cameras = Json::array();
   for (std::size_t k = 0; k < sequence.cameras.size(); ++k) {
     const Eigen::Matrix4f m = sequence.cameras[k].matrix();
-    s << (k ? "," : "") << "{\"frame\":" << k << ",\"camera_to_world\":[";
+    Json pose = Json::array();
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c)
-        s << (r || c ? "," : "") << m(r, c);
-    s << "],\"present\":[";
-    bool first = true;
+        pose.push_back(static_cast<double>(m(r, c)));
+    Json present = Json::array();
     for (std::size_t i = 0; i < sequence.scene.objects.size(); ++i)
-      if (sequence.present(i, k)) {
-        s << (first ? "" : ",") << i + 2;
-        first = false;
-      }
-    s << "]}";
+      if (sequence.present(i, k))
+        present.push_back(i + 2);
+    cameras.push_back(Json{{"frame", k}, {"camera_to_world", pose}, {"present", present}});
   }
-  s << "]}";
-  return s.str();
+  j["cameras"] = cameras;
+  return facyl_cli::dumpJsonWithDigits(j, 7); // a float's 7 significant digits
 }
 
 } // namespace facyl

@@ -11,6 +11,11 @@
 
 namespace facyl {
 
+/** \brief facyl's neighbourhood for normals and principal curvatures: the k nearest points
+ * (NormalCurvatureEstimation::setKSearch) of the recognizer, of the tools and of the
+ * estimator's own curvatures (HoughCylinderEstimation with normals only). */
+constexpr int kDefaultNeighbours = 16;
+
 /** \brief Neighbour lists in compressed-row form: the neighbours of query i are
  * indices[offsets[i]] .. indices[offsets[i + 1] - 1], nearest first. */
 struct Neighbourhoods {

@@ -24,7 +24,7 @@ namespace facyl {
  * Usage is that of any pcl::Feature: setInputCloud, optionally setIndices and
  * setSearchSurface, then setKSearch(k) or setRadiusSearch(r), then compute(output). Unless a
  * search method is given with setSearchMethod, neighbours come from an internal nanoflann
- * kd-tree (exact, and several times faster than pcl::search::KdTree on small clouds), or, for
+ * kd-tree (exact), or, for
  * an organized input (height > 1) searched by k without a search surface, from the image grid
  * (facyl::nearestInImage: the k nearest pixels of a window around each point, no tree; as PCL
  * features take pcl::search::OrganizedNeighbor for organized input; see

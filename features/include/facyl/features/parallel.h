@@ -3,10 +3,10 @@
  * A parallel loop that never spins: blocks of a range run on the calling thread and on a few
  * helper threads that sleep in the kernel while there is no work (a condition variable, never
  * a busy wait). facyl runs beside other processes on few cores; OpenMP's default wait policy
- * busy-waits there and multiplies the time of short parallel regions (measured: 8x with two
- * competing processes on two cores). The helpers are started on first use and kept, asleep,
- * for the process's life: starting and joining threads for every loop cost about 40 us per
- * loop on two cores, waking a sleeping helper a few microseconds (docs/speed.md).
+ * busy-waits there and multiplies the time of short parallel regions. The helpers are started
+ * on first use and kept, asleep, for the process's life: waking a sleeping helper costs far
+ * less than starting and joining threads for every loop. Both costs are measured in
+ * docs/speed.md ("Parallel loops on sleeping helpers").
  */
 #pragma once
 

@@ -61,8 +61,9 @@ struct CylinderDecision {
   std::array<float, kEvidenceFeatures> geometry_weights{kGeometryWeights};
 };
 
-/** \brief Checks \a decision. \return an empty string, or what is wrong. */
-std::string validate(const CylinderDecision& decision);
+/** \brief Checks \a decision. \return an empty string, or what is wrong; \a rule, when given,
+ * receives the rule broken alone (see settingProblem). */
+std::string validate(const CylinderDecision& decision, std::string* rule = nullptr);
 
 /** \brief What the decision looks at for one object. */
 struct CylinderEvidence {

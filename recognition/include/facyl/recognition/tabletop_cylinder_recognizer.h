@@ -27,8 +27,8 @@
 namespace facyl {
 
 /** \brief The Hough settings of the recognizer: defaults, with the "mostly vertical" prior
- * (in the table frame), radii in [0.01, 0.25] m, outward normals only, and the best candidate
- * refined on its inliers alone
+ * (in the table frame), radii in [kDefaultRadiusMin, kDefaultRadiusMax] (0.01-0.25 m),
+ * outward normals only, and the best candidate refined on its inliers alone
  * (point_candidates = 0): the decision (CylinderDecision) is calibrated on those fits, and a
  * refinement on the points can bend a cylinder around a box's edge, which the decision then
  * accepts (test_clutter, StackedCoaxialCylindersAndACanAgainstABox). */
@@ -37,8 +37,8 @@ tabletopHoughDefaults()
 {
   HoughCylinderParameters p;
   p.prior = OrientationPrior::Vertical; // expressed in the table frame (up = table normal)
-  p.radius_min = 0.01f;
-  p.radius_max = 0.25f;
+  p.radius_min = static_cast<float>(kDefaultRadiusMin);
+  p.radius_max = static_cast<float>(kDefaultRadiusMax);
   p.outward_normals = true; // objects on a table are seen from outside
   p.point_candidates = 0;
   return p;
@@ -81,7 +81,7 @@ struct TabletopRecognizerParameters {
    * and the network is one piece of evidence beside the fit's (a network trained on one
    * sensor's views misjudges another's: docs/classifier.md). */
   float reject_below{0.f};
-  int neighbours{16}; ///< k of the normal/curvature estimation, in [5, 200]
+  int neighbours{kDefaultNeighbours}; ///< k of the normal/curvature estimation, in [5, 200]
   /** Clusters fitted at once, each thread with a cue estimation and estimators of its own;
    * threads that no cluster takes help with a cluster's cues and retries. 0 (default) the
    * hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting threads sleep
@@ -89,8 +89,9 @@ struct TabletopRecognizerParameters {
   int threads{0};
 };
 
-/** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string validate(const TabletopRecognizerParameters& params);
+/** \brief Checks \a params. \return an empty string, or what is wrong; \a rule, when given,
+ * receives the rule broken alone (see settingProblem; empty for the segmentation's settings). */
+std::string validate(const TabletopRecognizerParameters& params, std::string* rule = nullptr);
 
 /** \brief One object on the table and what was decided about it. */
 struct RecognizedObject {

@@ -207,6 +207,10 @@ constexpr std::size_t kMinOrientations = 10;
 constexpr std::size_t kMaxOrientations = 100000;
 /** \brief Most accumulators per fit (HoughCylinderParameters::accumulators). */
 constexpr std::size_t kMaxAccumulators = 64;
+/** \brief The radius limits (m) of the tabletop recognizer (tabletopHoughDefaults) and of the
+ * tools' bare fit (facyl_fit, Python's fit_cylinders): cans to buckets. */
+constexpr double kDefaultRadiusMin = 0.01;
+constexpr double kDefaultRadiusMax = 0.25;
 
 /** \brief Every setting of the estimator, with its default (see HoughCylinderEstimation). Each
  * setting has its home here: the tools, the recognizer and the Python module read their
@@ -244,9 +248,9 @@ struct HoughCylinderParameters {
   /** The coarse scale, in [0, 2]: neighbours within this share of the winner's radius (at
    * most 64). The coarse cues also judge the candidates: their normals' noise sets the
    * gate that keeps a plane beside the cylinder out of its refinement, so wide patches pay
-   * where a plane lies within a few sigma (facyl_bench, practical setting, noise 20% and 30%
-   * of r, six seeds: 28 and 73 of 360 failures at 0.5, 17 and 52 at 1; random setting and
-   * lids unchanged within a cloud or two). 0: cues are never estimated again. */
+   * where a plane lies within a few sigma (the failures at 0.5 to 1.5, beside a plane and
+   * elsewhere: docs/benchmark.md, "The coarse scale and more seeds"). 0: cues are never
+   * estimated again. */
   float coarse_scale{1.f};
   std::size_t max_cylinders{1}; ///< >= 1
   /** A cylinder needs this many points: its inliers and the points of its end caps
@@ -261,8 +265,9 @@ struct HoughCylinderParameters {
   bool outward_normals{false};
 };
 
-/** \brief Checks \a params. \return an empty string, or what is wrong. */
-std::string validate(const HoughCylinderParameters& params);
+/** \brief Checks \a params. \return an empty string, or what is wrong ("NAME VALUE RULE",
+ * settingProblem); \a rule, when given, receives the RULE alone (see settingProblem). */
+std::string validate(const HoughCylinderParameters& params, std::string* rule = nullptr);
 
 /** \brief The points a cylinder needs among \a n (HoughCylinderParameters::min_inliers, or
  * its automatic value when 0). */

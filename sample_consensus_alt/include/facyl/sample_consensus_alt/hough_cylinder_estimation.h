@@ -74,9 +74,9 @@ enum class HoughFailure {
  * the 16 nearest points, then the spread of those normals), whatever scale the given normals
  * have: with curvatures from normals smoothed over k = 50 neighbours (the tutorial's
  * pcl::NormalEstimation, then pcl::PrincipalCurvaturesEstimation at k = 50) the axis found on
- * the tutorial's mug is 81 degrees off. The given normals stay the normals of the vote and of
- * the inlier test. setEstimateCurvatures(false) turns this off: segment() then fails with
- * HoughFailure::NoCurvatures. The other voting modes need normals only.
+ * the tutorial's mug is far off (README, "Use it from C++"). The given normals stay the normals
+ * of the vote and of the inlier test. setEstimateCurvatures(false) turns this off: segment()
+ * then fails with HoughFailure::NoCurvatures. The other voting modes need normals only.
  *
  * Inputs that cannot give an answer (no cloud, no normals, sizes that differ, no finite point,
  * invalid parameters, SoftCurvature without curvatures when their estimation is off) are

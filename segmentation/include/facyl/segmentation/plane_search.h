@@ -132,11 +132,53 @@ struct SampledPlaneCues {
 SampledPlaneCues sampledPlaneCues(const pcl::PointCloud<pcl::PointXYZ>::Ptr& sample,
                                   const Eigen::Vector3f& viewpoint, float plane_distance);
 
+/** \brief True when three of the finite points of \a cloud at \a indices span a plane: the
+ * cross product of two sides of their triangle is at least \a min_cross long (m^2; PCL's plane
+ * model takes a sample from 1e-5 on). False for coincident or collinear points, fewer than 3:
+ * there a plane RANSAC finds no sample and PCL prints an error for every one of its tries.
+ * Found against the first point and the farthest from it; stops at the first that spans one
+ * (a few points of a real frame). */
+template <typename PointT>
+bool
+spansPlane(const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices,
+           float min_cross = 1e-5f)
+{
+  bool have_first = false;
+  Eigen::Vector3f first = Eigen::Vector3f::Zero(), far = Eigen::Vector3f::Zero();
+  float far2 = 0.f;
+  for (const auto i : indices) {
+    const auto& p = cloud[static_cast<std::size_t>(i)];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      continue;
+    const Eigen::Vector3f d = p.getVector3fMap() - first;
+    if (!have_first) {
+      first = p.getVector3fMap();
+      have_first = true;
+    }
+    else if (far.cross(d).norm() >= min_cross)
+      return true;
+    else if (d.squaredNorm() > far2) {
+      far2 = d.squaredNorm();
+      far = d;
+    }
+  }
+  if (far2 == 0.f)
+    return false;
+  for (const auto i : indices) { // against the farthest point
+    const auto& p = cloud[static_cast<std::size_t>(i)];
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
+        far.cross(p.getVector3fMap() - first).norm() >= min_cross)
+      return true;
+  }
+  return false;
+}
+
 /** \brief Plane seeds of a point sample, one after another on what the previous ones left
  * (RANSAC on positions, 200 iterations, then the inliers whose normal is within 0.3 rad of the
  * plane's): each seed of at least \a min_plane_points (each sample standing for \a scale
  * points) goes to \a grow, which may mark samples \a taken; the RANSAC inliers are taken after
- * it. At most \a max_planes seeds; stops at the first too small. */
+ * it. At most \a max_planes seeds; stops at the first too small, or when what is left spans no
+ * plane (spansPlane). */
 void ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double scale,
                       std::size_t min_plane_points,
                       const std::function<void(const std::vector<std::uint8_t>&)>& grow,

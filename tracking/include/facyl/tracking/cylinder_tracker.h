@@ -20,6 +20,8 @@
 
 namespace facyl {
 
+struct TrackObservation; // tracker_steps.h
+
 /** \brief Settings of CylinderTracker. Lengths in metres, angles in radians, counts in frames
  * given to update(). */
 struct CylinderTrackerParameters {
@@ -80,11 +82,11 @@ struct CylinderTrackerParameters {
   int history{30};
   float axis_agreement{0.14f}; ///< rad (8 degrees), in (0, pi/2]
   /** How much an observation counts grows with what the frame saw of the object: its points
-   * times the angular coverage of its fit (a cylinder seen in 500 points errs ten times more
-   * in radius than one seen in 2500). The measurement variances above are those of an object
-   * of this quality (points x coverage, > 0), divided by an observation's quality over it
-   * (within [1/4, 4]); the history weighs each observation by its quality squared (the inverse
-   * of its variance). */
+   * times the angular coverage of its fit (a fit on few points, or on a narrow arc, errs more
+   * in radius: docs/tracking.md, "Design in brief"). The measurement variances above are those
+   * of an object of this quality (points x coverage, > 0), divided by an observation's quality
+   * over it (within [1/4, 4]); the history weighs each observation by its quality squared (the
+   * inverse of its variance). */
   float reference_quality{600.f};
 
   // ---- confidence
@@ -264,8 +266,8 @@ struct TrackerFrameInfo {
  * }
  * \endcode
  * Thread safety: update() and skipFrame() are not reentrant on one tracker; the const members
- * may be called concurrently while neither runs. Distinct trackers are independent. Cost: well
- * under a millisecond per frame for tens of objects (facyl_benchmarks BM_TrackerUpdate).
+ * may be called concurrently while neither runs. Distinct trackers are independent. Cost per
+ * frame: docs/tracking.md, "Cost" (facyl_benchmarks BM_TrackerUpdate).
  */
 class CylinderTracker {
 public:
@@ -368,14 +370,40 @@ public:
   }
 
 private:
-  /** An object of the frame in the world. */
-  struct Observation;
-  /** The in-view state of an unmatched track. */
-  TrackStatus viewStatus(const CylinderTrack& t, const TrackerView& view,
-                         const std::vector<RecognizedObject>& objects, int& inside) const;
+  // The steps of update(), in order (the rules are free functions, tracker_steps.h).
+  /** The frame's anchor and its pose in the world (frame_to_world_; \a info's anchor, scene
+   * and registration): the tracks move into the support's plane when the world becomes one,
+   * and end when the frame starts a new scene. */
+  void locateFrame(const std::vector<SupportPlane>& supports, int table,
+                   const std::vector<RecognizedObject>& objects, const TrackerView& view,
+                   TrackerFrameInfo& info);
+  /** The frame, anchored on the support at \a plane_to_cloud that continues the tracks' plane,
+   * registered against the tracks (\a pose: cloud to world). \return true when it starts a
+   * new scene (the tracks ended, \a pose the support's plane). */
+  bool registerFrame(const std::vector<RecognizedObject>& objects, const TrackerView& view,
+                     const Eigen::Affine3f& plane_to_cloud, const Eigen::Affine3f& cloud_to_plane,
+                     const Eigen::Affine3f& predicted, const Eigen::Affine3f& last_pose,
+                     bool plane_jump, Eigen::Affine3f& pose, TrackerFrameInfo& info);
+  /** The tracks matched (\a match) corrected by their objects, counting with \a weight.
+   * \return a flag per track: matched. */
+  std::vector<char> correctMatched(const std::vector<RecognizedObject>& objects,
+                                   const std::vector<TrackObservation>& obs,
+                                   const std::vector<int>& match, float weight);
+  /** Each object left: a fragment of the matched track it looks most like a piece of
+   * (fragmentGain), else a new track. */
+  void startOrAttach(const std::vector<TrackObservation>& obs, const std::vector<int>& match,
+                     const std::vector<char>& matched_track);
+  /** The tracks not matched: their status (viewStatus) and counters; without an anchor only
+   * the tentative ones' misses count. */
+  void updateUnseen(const TrackerView& view, const std::vector<RecognizedObject>& objects,
+                    const std::vector<TrackObservation>& obs,
+                    const std::vector<char>& matched_track, bool anchored);
+  /** Confirmed track \a t, merged into \a object that started a new track, takes it back. */
+  void takeBack(CylinderTrack& t, int object, const TrackObservation& o);
+  /** Two tracks of one object become the older one (areOneObject, absorbTrack); the tracks
+   * that end go (trackEnded); the rest sorted by id. */
+  void joinAndEndTracks();
   void predict();
-  void startTrack(const Observation& o, int object);
-  void correct(CylinderTrack& t, const Observation& o, float weight);
   void endTracks();
 
   CylinderTrackerParameters params_;

@@ -1,13 +1,17 @@
 /*
  * facyl: the options of a bare cylinder fit (no table), shared by facyl_fit and the Python
- * module's fit_cylinders: one parser, one help text, one set of defaults. The Python keywords
- * are these options' names with '_' for '-' (radius_limits= is --radius-limits).
+ * module's fit_cylinders: one table (settings_table.h), hence one parser, one help text, the
+ * defaults of FitSettings and the ranges of its validate(). The Python keywords are these
+ * options' names with '_' for '-' (radius_limits= is --radius-limits).
  */
 #pragma once
 
 #include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_fit.h>
+#include <facyl/tools/settings_table.h>
 
+#include <facyl/features/neighbourhoods.h>
+#include <facyl/features/setting_problem.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 
 #include <pcl/common/point_tests.h>
@@ -19,6 +23,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace facyl_cli {
@@ -43,187 +48,288 @@ metresPerUnitExact(Units u)
 
 /** The settings of a bare fit. */
 struct FitSettings : HoughSettings {
-  std::string method{"facyl"}; ///< facyl | pcl-ransac
-  int neighbours{16};          ///< k of the normal and curvature estimation
-  unsigned threads{0};         ///< 0: all cores
+  std::string method{"facyl"};               ///< facyl | pcl-ransac
+  int neighbours{facyl::kDefaultNeighbours}; ///< k of the normal and curvature estimation
+  int threads{0};                            ///< 0: all cores
   Units units{Units::Auto};
-  bool radius_given{false}; ///< radius limits were given (not the data-driven default)
+  bool radius_given{false}; ///< radius limits were given (not the tools' default)
+
+  FitSettings()
+  {
+    params.radius_min = static_cast<float>(facyl::kDefaultRadiusMin);
+    params.radius_max = static_cast<float>(facyl::kDefaultRadiusMax);
+  }
 };
 
-/** Options with a value that applyFitOptions reads. */
-inline std::set<std::string>
-fitValueOptions()
+/** Checks \a s: the fit's own settings, then its estimator's (facyl::validate).
+ * \return an empty string, or what is wrong; \a rule: see facyl::settingProblem. */
+inline std::string
+validate(const FitSettings& s, std::string* rule = nullptr)
 {
-  return {
-    "--method",           "--voting",        "--prior",      "--up",         "--orientations",
-    "--accumulators",     "--radius-limits", "--radius-min", "--radius-max", "--distance-threshold",
-    "--max-cylinders",    "--neighbours",    "--seed",       "--threads",    "--units",
-    "--point-candidates", "--coarse-scale"};
+  if (s.neighbours < 3 || s.neighbours > 1000)
+    return facyl::settingProblem("neighbours", s.neighbours, "is not in [3, 1000]", rule);
+  if (s.threads < 0 || s.threads > 256)
+    return facyl::settingProblem("threads", s.threads, "is not in [0, 256]", rule);
+  return facyl::validate(s.params, rule);
 }
 
-/** Switches that applyFitOptions reads. */
-inline std::set<std::string>
-fitSwitches()
+namespace detail {
+
+/** With Units::Auto: radius limits up to \a r_max (as \a written) that look like millimetres
+ * are refused. \throws std::invalid_argument. */
+inline void
+refuseMillimetreRadii(const FitSettings& s, double r_max, const std::string& written,
+                      const Vocabulary& say)
 {
-  return {"--outward-normals", "--any-normal-sign"};
+  if (s.units == Units::Auto && std::isfinite(r_max) && r_max > 1.0)
+    throw std::invalid_argument(
+      "radii up to " + written +
+      ": facyl works in metres, and radii beyond 1 m look like millimetres. Give the cloud and "
+      "the limits in metres, or " +
+      say.option("units", "mm") +
+      " (a cloud in millimetres, converted to metres and the results back), or " +
+      say.option("units", "m") + " for cylinders that large");
 }
 
-/** Old spellings kept for a release. (--radius-min/--radius-max and --method with a voting
- * mode are read by applyFitOptions itself.) */
-inline Arguments::Aliases
-fitAliases()
+/** Radius limits given in the cloud's units, in metres. */
+inline void
+setRadii(FitSettings& s, double r_min, double r_max)
 {
-  return {{"--k", "--neighbours"}};
+  const float scale = metresPerUnit(s.units);
+  s.params.radius_min = static_cast<float>(r_min) * scale;
+  s.params.radius_max = static_cast<float>(r_max) * scale;
+  s.radius_given = true;
 }
 
-/** The help lines of those options. */
+} // namespace detail
+
+/** The options of a bare fit (facyl_fit; Python's fit_cylinders). Lengths are given in the
+ * cloud's units (--units, applied first) and kept in metres. */
+inline const SettingsTable<FitSettings>&
+fitOptions()
+{
+  using S = FitSettings;
+  static const SettingsTable<S> table = [] {
+    const S d;
+    SettingsTable<S> t;
+    t.column = 23;
+    t.validate = [](const S& s, std::string* rule) { return validate(s, rule); };
+    const std::string once = "give the radius limits once: --radius-limits A,B (--radius-min "
+                             "and --radius-max are its old spellings)";
+    t.exclusive = {{"outward-normals", "any-normal-sign", ""},
+                   {"radius-limits", "radius-min", once},
+                   {"radius-limits", "radius-max", once}};
+    auto& o = t.options;
+
+    Option<S> radii;
+    radii.name = "radius-limits";
+    radii.metavar = "A,B";
+    radii.kind = ValueKind::Pair;
+    radii.words = {"auto"};
+    radii.help = "radius interval (default {}: cans to buckets, as in\nevery facyl tool); auto: 0 "
+                 "to twice the extent of the data\nacross each candidate axis (pipes, tanks)";
+    radii.set = [](S& s, const OptionValue& v, const OptionContext& c) {
+      double r_min = 0.0, r_max = std::numeric_limits<double>::infinity(); // auto
+      if (v.word.empty()) {
+        std::tie(r_min, r_max) = v.pair;
+        if (!(r_min >= 0.0 && r_max > r_min && r_max <= 1e4))
+          throw std::invalid_argument("expected 0 <= A < B <= 1e4");
+      }
+      detail::refuseMillimetreRadii(s, r_max, v.written, c.say);
+      detail::setRadii(s, r_min, r_max);
+    };
+    radii.show = [](const S& s) { return shownPair(s.params.radius_min, s.params.radius_max); };
+    o.push_back(radii);
+
+    Option<S> up;
+    up.name = "up";
+    up.metavar = "x,y,z";
+    up.kind = ValueKind::Vector3;
+    up.help = "gravity's opposite in the cloud's frame (default: unknown)";
+    up.set = [](S& s, const OptionValue& v, const OptionContext&) {
+      if (!(v.vector.norm() > 0.f))
+        throw std::invalid_argument("must not be zero");
+      s.up = v.vector;
+      // One rule with the tabletop tools: the prior is vertical about a known up (--prior,
+      // applied after, overrides it).
+      s.params.prior = facyl::OrientationPrior::Vertical;
+    };
+    up.show = [](const S& s) { return shownVector(s.up); };
+    o.push_back(up);
+    o.push_back(choiceOption<S>(
+      "prior", "P", [](auto& s) -> auto& { return s.params.prior; }, priorChoices(),
+      "orientation prior: uniform | vertical | vertical-strong |\nhorizontal, about --up (" +
+        shownVector(d.up) + " when not given). Default: vertical\nwhen --up is given, else " +
+        facyl::toString(d.params.prior) +
+        " (the tabletop tools know\nthe table: vertical in its frame)"));
+    o.push_back(choiceOption<S>(
+      "voting", "V", [](auto& s) -> auto& { return s.params.voting_mode; }, votingChoices(),
+      "soft-curvature (default; paper eq. 3) | soft-normal | rabbani"));
+
+    Option<S> method;
+    method.name = "method";
+    method.metavar = "M";
+    method.kind = ValueKind::Word;
+    method.help = "facyl (default) | pcl-ransac (pcl::SACSegmentationFromNormals,\n"
+                  "SACMODEL_CYLINDER on the same normals, for comparison)";
+    method.set = [](S& s, const OptionValue& v, const OptionContext& c) {
+      if (v.word == "facyl" || v.word == "pcl-ransac") {
+        s.method = v.word;
+        return;
+      }
+      // The old spelling of --voting.
+      if (!facyl::parseVotingMode(v.word, s.params.voting_mode))
+        throw std::invalid_argument(v.written + " is not facyl or pcl-ransac");
+      if (const OptionValue* voting = c.given("voting"))
+        throw std::invalid_argument(
+          "give the voting mode once: " + c.say.option("voting", voting->word) + " and " +
+          c.say.option("method", v.word));
+      s.method = "facyl";
+    };
+    method.show = [](const S& s) { return s.method; };
+    o.push_back(method);
+
+    o.push_back(integerOption<S>(
+      "neighbours", "K", [](auto& s) -> auto& { return s.neighbours; },
+      "k of the normal and curvature estimation (default {}; old\nspelling --k)"));
+    o.back().alias = "k";
+    o.push_back(integerOption<S>(
+      "orientations", "N", [](auto& s) -> auto& { return s.params.orientations; },
+      "cells per orientation accumulator, N_d (default {})"));
+    o.push_back(integerOption<S>(
+      "accumulators", "K", [](auto& s) -> auto& { return s.params.accumulators; },
+      "independent accumulators per fit (default {})"));
+    Option<S> threshold;
+    threshold.name = "distance-threshold";
+    threshold.metavar = "D";
+    threshold.kind = ValueKind::Number;
+    threshold.help = "inlier distance (default: estimated from the residuals;\npcl-ransac: 1% of "
+                     "the bounding-box diagonal)";
+    threshold.set = [](S& s, const OptionValue& v, const OptionContext&) {
+      if (!(v.number >= 0.0 && v.number <= 1e4))
+        throw std::invalid_argument(v.written + " is not in " + Limits<double>{0, 1e4}.text());
+      s.params.distance_threshold = static_cast<float>(v.number) * metresPerUnit(s.units);
+    };
+    threshold.show = [](const S& s) { return compactNumber(s.params.distance_threshold); };
+    o.push_back(threshold);
+    o.push_back(integerOption<S>(
+      "max-cylinders", "N", [](auto& s) -> auto& { return s.params.max_cylinders; },
+      "cylinders to extract, one after another (default {})", Limits<long long>{1, 100}));
+    o.push_back(integerOption<S>(
+      "point-candidates", "N", [](auto& s) -> auto& { return s.params.point_candidates; },
+      "candidates refined and compared on the points (default {}; 0:\nthe best alone, refined "
+      "on its inliers, as facyl 0.1 did)",
+      Limits<long long>{0, 64}));
+    o.push_back(numberOption<S>(
+      "coarse-scale", "S", [](auto& s) -> auto& { return s.params.coarse_scale; },
+      "at high noise, cues again from neighbours within S radii\n(default {}; 0: never)"));
+    o.push_back(switchOption<S>(
+      "outward-normals", [](auto& s) -> auto& { return s.params.outward_normals; }, true,
+      "inliers' normals must point away from the axis (normals\ntowards a sensor outside the "
+      "cylinder: excludes a cup's inner\nwall; the tabletop tools' default)"));
+    o.push_back(switchOption<S>(
+      "any-normal-sign", [](auto& s) -> auto& { return s.params.outward_normals; }, false,
+      "inliers' normals may point either way (default of a bare fit:\npipes seen from inside, "
+      "normals of unknown orientation)"));
+    o.push_back(integerOption<S>(
+      "seed", "S", [](auto& s) -> auto& { return s.params.seed; },
+      "seed of the accumulator draws and of RANSAC (default {})", Limits<long long>{0, kMaxSeed}));
+    o.push_back(integerOption<S>(
+      "threads", "T", [](auto& s) -> auto& { return s.threads; },
+      "threads for normals (default: all)"));
+    o.back().tool_only = true;
+
+    Option<S> units;
+    units.name = "units";
+    units.metavar = "U";
+    units.kind = ValueKind::Word;
+    units.first = true;
+    units.help = "auto (default: metres; a cloud or radius limits evidently in\nmillimetres are "
+                 "refused) | m (metres, no check) | mm (the\ncloud, the lengths given and the "
+                 "results in millimetres;\nconverted to metres for the fit and back)";
+    units.set = [](S& s, const OptionValue& v, const OptionContext&) {
+      if (v.word == "auto")
+        s.units = Units::Auto;
+      else if (v.word == "m")
+        s.units = Units::Metres;
+      else if (v.word == "mm")
+        s.units = Units::Millimetres;
+      else
+        throw std::invalid_argument(v.written + " is not auto, m or mm");
+      // The default limits, in the cloud's units and back, as limits given would be.
+      const float scale = metresPerUnit(s.units);
+      s.params.radius_min = static_cast<float>(facyl::kDefaultRadiusMin / scale) * scale;
+      s.params.radius_max = static_cast<float>(facyl::kDefaultRadiusMax / scale) * scale;
+    };
+    units.show = [](const S& s) {
+      return s.units == Units::Auto ? "auto" : s.units == Units::Metres ? "m" : "mm";
+    };
+    o.push_back(units);
+
+    // Old spellings: one end of the radius limits, the other 0 or the data's extent.
+    for (const bool lower : {true, false}) {
+      Option<S> end;
+      end.name = lower ? "radius-min" : "radius-max";
+      end.metavar = "R";
+      end.kind = ValueKind::Number;
+      end.hidden = true;
+      end.tool_only = true;
+      end.set = [lower](S& s, const OptionValue& v, const OptionContext& c) {
+        if (!(v.number >= 0.0 && v.number <= 1e4))
+          throw std::invalid_argument(v.written + " is not in " + Limits<double>{0, 1e4}.text());
+        const OptionValue* min = c.given("radius-min");
+        const double r_min = lower ? v.number : min ? min->number : 0.0;
+        const double r_max = lower ? std::numeric_limits<double>::infinity() : v.number;
+        detail::refuseMillimetreRadii(s, r_max, v.written, c.say);
+        detail::setRadii(s, r_min, r_max);
+      };
+      end.show = [lower](const S& s) {
+        return compactNumber(lower ? s.params.radius_min : s.params.radius_max);
+      };
+      o.push_back(end);
+    }
+    return t;
+  }();
+  return table;
+}
+
+/** The help lines of the fit's options. */
 inline const char*
 fitOptionsHelp()
 {
   static const std::string help =
-    std::string(
-      "  --radius-limits A,B  radius interval (default 0.01,0.25: cans to buckets, as in\n"
-      "                       every facyl tool); auto: 0 to twice the extent of the data\n"
-      "                       across each candidate axis (pipes, tanks)\n"
-      "  --up x,y,z           gravity's opposite in the cloud's frame (default: unknown)\n"
-      "  --prior P            orientation prior: uniform | vertical | vertical-strong |\n"
-      "                       horizontal, about --up (0,0,1 when not given). Default: vertical\n"
-      "                       when --up is given, else uniform (the tabletop tools know\n"
-      "                       the table: vertical in its frame)\n"
-      "  --voting V           soft-curvature (default; paper eq. 3) | soft-normal | rabbani\n"
-      "  --method M           facyl (default) | pcl-ransac (pcl::SACSegmentationFromNormals,\n"
-      "                       SACMODEL_CYLINDER on the same normals, for comparison)\n"
-      "  --neighbours K       k of the normal and curvature estimation (default 16; old\n"
-      "                       spelling --k)\n"
-      "  --orientations N     cells per orientation accumulator, N_d (default " +
-      std::to_string(facyl::HoughCylinderParameters{}.orientations) +
-      ")\n"
-      "  --accumulators K     independent accumulators per fit (default " +
-      std::to_string(facyl::HoughCylinderParameters{}.accumulators) +
-      ")\n"
-      "  --distance-threshold D  inlier distance (default: estimated from the residuals;\n"
-      "                       pcl-ransac: 1% of the bounding-box diagonal)\n"
-      "  --max-cylinders N    cylinders to extract, one after another (default 1)\n"
-      "  --point-candidates N candidates refined and compared on the points (default ") +
-    std::to_string(facyl::HoughCylinderParameters{}.point_candidates) +
-    "; 0:\n"
-    "                       the best alone, refined on its inliers, as facyl 0.1 did)\n"
-    "  --coarse-scale S     at high noise, cues again from neighbours within S radii\n"
-    "                       (default " +
-    compactNumber(facyl::HoughCylinderParameters{}.coarse_scale) +
-    "; 0: never)\n"
-    "  --outward-normals    inliers' normals must point away from the axis (normals\n"
-    "                       towards a sensor outside the cylinder: excludes a cup's inner\n"
-    "                       wall; the tabletop tools' default)\n"
-    "  --any-normal-sign    inliers' normals may point either way (default of a bare fit:\n"
-    "                       pipes seen from inside, normals of unknown orientation)\n"
-    "  --seed S             seed of the accumulator draws and of RANSAC (default 0)\n"
-    "  --threads T          threads for normals (default: all)\n"
-    "  --units U            auto (default: metres; a cloud or radius limits evidently in\n"
-    "                       millimetres are refused) | m (metres, no check) | mm (the\n"
-    "                       cloud, the lengths given and the results in millimetres;\n"
-    "                       converted to metres for the fit and back)\n"
+    helpText(fitOptions(), FitSettings{}) +
     "  (old spellings kept for this release: --radius-min R, --radius-max R, --k K,\n"
     "  --method soft-curvature|soft-normal|rabbani)\n";
   return help.c_str();
 }
 
-/** Reads the fit options of \a args into \a s.
- * \throws std::invalid_argument for a malformed, contradictory or out-of-range value. */
+/** Options with a value of the fit (for Arguments). */
+inline std::set<std::string>
+fitValueOptions()
+{
+  return valueOptions(fitOptions());
+}
+
+/** Switches of the fit (for Arguments). */
+inline std::set<std::string>
+fitSwitches()
+{
+  return switches(fitOptions());
+}
+
+/** Old spellings of the fit's options (for Arguments). */
+inline Arguments::Aliases
+fitAliases()
+{
+  return aliases(fitOptions());
+}
+
+/** Reads the fit options of \a args into \a s. \throws std::invalid_argument. */
 inline void
 applyFitOptions(const Arguments& args, FitSettings& s)
 {
-  // --method: facyl or pcl-ransac; a voting mode there is the old spelling of --voting.
-  s.method = args.text("--method", "facyl");
-  std::string voting = args.text("--voting", "soft-curvature");
-  if (s.method != "facyl" && s.method != "pcl-ransac") {
-    facyl::VotingMode unused;
-    if (!facyl::parseVotingMode(s.method, unused))
-      throw std::invalid_argument("option " + args.spelling("--method") + ": '" + s.method +
-                                  "' is not facyl or pcl-ransac");
-    if (args.has("--voting"))
-      throw std::invalid_argument("give the voting mode once: --voting " + voting +
-                                  " and --method " + s.method);
-    voting = s.method;
-    s.method = "facyl";
-  }
-  if (!facyl::parseVotingMode(voting, s.params.voting_mode))
-    throw std::invalid_argument("option " + args.spelling("--voting") + ": '" + voting +
-                                "' is not soft-curvature, soft-normal or rabbani");
-  // One rule with the tabletop tools: the prior is vertical about a known up, uniform without.
-  const std::string prior = args.text("--prior", args.has("--up") ? "vertical" : "uniform");
-  if (!facyl::parseOrientationPrior(prior, s.params.prior))
-    throw std::invalid_argument("option " + args.spelling("--prior") + ": '" + prior +
-                                "' is not uniform, vertical, vertical-strong or horizontal");
-  s.up = args.vector3("--up", Eigen::Vector3f::UnitZ());
-  if (!(s.up.norm() > 0.f))
-    throw std::invalid_argument("option " + args.spelling("--up") + " must not be zero");
-  s.params.orientations = static_cast<std::size_t>(
-    args.integer("--orientations", static_cast<long long>(s.params.orientations),
-                 static_cast<long long>(facyl::kMinOrientations),
-                 static_cast<long long>(facyl::kMaxOrientations)));
-  s.params.accumulators = static_cast<std::size_t>(
-    args.integer("--accumulators", static_cast<long long>(s.params.accumulators), 1,
-                 static_cast<long long>(facyl::kMaxAccumulators)));
-
-  const std::string units = args.text("--units", "auto");
-  if (units == "auto")
-    s.units = Units::Auto;
-  else if (units == "m")
-    s.units = Units::Metres;
-  else if (units == "mm")
-    s.units = Units::Millimetres;
-  else
-    throw std::invalid_argument("option " + args.spelling("--units") + ": '" + units +
-                                "' is not auto, m or mm");
-
-  // Radius limits, in the cloud's units: --radius-limits A,B, or the old --radius-min/-max.
-  if (args.has("--radius-limits") && (args.has("--radius-min") || args.has("--radius-max")))
-    throw std::invalid_argument("give the radius limits once: --radius-limits A,B (--radius-min "
-                                "and --radius-max are its old spellings)");
-  double r_min = 0.01 / metresPerUnit(s.units), r_max = 0.25 / metresPerUnit(s.units);
-  if (args.text("--radius-limits", "") == "auto" || args.has("--radius-min") ||
-      args.has("--radius-max")) // the old --radius-min/--radius-max: 0 and the data's extent
-    r_min = 0.0, r_max = std::numeric_limits<double>::infinity();
-  else if (args.has("--radius-limits")) {
-    const auto r = pairOption(args, "--radius-limits", r_min, r_max);
-    if (!(r.first >= 0.0 && r.second > r.first && r.second <= 1e4))
-      throw std::invalid_argument("option " + args.spelling("--radius-limits") +
-                                  ": expected 0 <= A < B <= 1e4");
-    r_min = r.first, r_max = r.second;
-  }
-  r_min = args.number("--radius-min", r_min, 0.0, 1e4);
-  r_max = args.number("--radius-max", r_max, 0.0, 1e4);
-  s.radius_given =
-    args.has("--radius-limits") || args.has("--radius-min") || args.has("--radius-max");
-  if (s.units == Units::Auto && std::isfinite(r_max) && r_max > 1.0)
-    throw std::invalid_argument(
-      "option " + args.spelling(args.has("--radius-limits") ? "--radius-limits" : "--radius-max") +
-      ": radii up to " +
-      args.text(args.has("--radius-limits") ? "--radius-limits" : "--radius-max", "") +
-      ": facyl works in metres, and radii beyond 1 m look like millimetres. Give the cloud and "
-      "the limits in metres, or --units mm (a cloud in millimetres, converted to metres and the "
-      "results back), or --units m for cylinders that large");
-  const float scale = metresPerUnit(s.units);
-  s.params.radius_min = static_cast<float>(r_min) * scale;
-  s.params.radius_max = static_cast<float>(r_max) * scale;
-  s.params.distance_threshold =
-    static_cast<float>(args.number("--distance-threshold", 0.0, 0.0, 1e4)) * scale;
-  s.params.max_cylinders = static_cast<std::size_t>(args.integer("--max-cylinders", 1, 1, 100));
-  s.neighbours = static_cast<int>(args.integer("--neighbours", 16, 3, 1000));
-  s.params.seed = static_cast<std::uint64_t>(
-    args.integer("--seed", static_cast<long long>(s.params.seed), 0, kMaxSeed));
-  s.threads = static_cast<unsigned>(args.integer("--threads", 0, 0, 256));
-  if (args.has("--outward-normals") && args.has("--any-normal-sign"))
-    throw std::invalid_argument("--outward-normals and --any-normal-sign exclude each other");
-  s.params.outward_normals = args.has("--outward-normals");
-  s.params.point_candidates = static_cast<std::size_t>(
-    args.integer("--point-candidates", static_cast<long long>(s.params.point_candidates), 0, 64));
-  s.params.coarse_scale = static_cast<float>(
-    args.number("--coarse-scale", static_cast<double>(s.params.coarse_scale), 0.0, 2.0));
-  const std::string why = facyl::validate(s.params);
-  if (!why.empty())
-    throw std::invalid_argument(why);
+  applyOptions(fitOptions(), args, s);
 }
 
 /** Above this robust extent (m) a cloud is evidently not in metres: a tabletop scene spans a

@@ -1,7 +1,8 @@
 /*
- * facyl: the one JSON writer of the tools and the Python module (nlohmann-json, fields in the
- * order written). Numbers carry a given number of significant digits and read as printf's %g
- * writes them (0.0362165, 1e-05, 3); not finite: null.
+ * facyl: the one JSON writer of the tools, the Python module and the simulation's ground truth
+ * (nlohmann-json, fields in the order written; the simulation library includes it privately).
+ * Numbers carry a given number of significant digits and read as printf's %g writes them
+ * (0.0362165, 1e-05, 3); not finite: null.
  */
 #pragma once
 
@@ -50,6 +51,63 @@ inline std::string
 dumpJson(const Json& j)
 {
   return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+namespace detail {
+inline void
+appendJson(std::string& out, const Json& j, int digits)
+{
+  switch (j.type()) {
+  case Json::value_t::object: {
+    out += '{';
+    bool first = true;
+    for (const auto& item : j.items()) {
+      out += first ? "" : ",";
+      first = false;
+      out += dumpJson(Json(item.key()));
+      out += ':';
+      appendJson(out, item.value(), digits);
+    }
+    out += '}';
+    break;
+  }
+  case Json::value_t::array: {
+    out += '[';
+    for (std::size_t k = 0; k < j.size(); ++k) {
+      out += k ? "," : "";
+      appendJson(out, j[k], digits);
+    }
+    out += ']';
+    break;
+  }
+  case Json::value_t::number_float: {
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) {
+      out += "null";
+      break;
+    }
+    char text[40];
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    out += text;
+    break;
+  }
+  default:
+    out += dumpJson(j);
+  }
+}
+} // namespace detail
+
+/** \brief \a j as one compact line, as dumpJson writes it, but every floating-point number
+ * as printf's %.<digits>g writes it (what a stream with setprecision(digits) writes; not
+ * finite: null). dumpJson writes the shortest text nlohmann's Grisu2 finds for a number that
+ * jsonNumber rounded, which is the same digits except now and then 17 of them
+ * (0.2154446 as 0.21544460000000001); the simulation's ground truth is written this way. */
+inline std::string
+dumpJsonWithDigits(const Json& j, int digits)
+{
+  std::string out;
+  detail::appendJson(out, j, digits);
+  return out;
 }
 
 } // namespace facyl_cli

@@ -124,12 +124,24 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
   // results back to the cloud's frame, so that the answer does not depend on the frame the
   // cloud is stored in.
   const PointCloudConstPtr given = input_;
-  const Eigen::Vector3f given_up = up_;
-  input_ = sensorFrameCopy(*given, pose);
-  up_ = pose.linear().transpose() * up_;
-  const bool found = recognizeInSensorFrame(objects, t0);
-  input_ = given;
-  up_ = given_up;
+  bool found = false;
+  {
+    // The input and up direction are the caller's again however the recognition ends (an
+    // exception included).
+    struct Restore {
+      TabletopCylinderRecognizer& rec;
+      const PointCloudConstPtr input;
+      const Eigen::Vector3f up;
+      ~Restore()
+      {
+        rec.input_ = input;
+        rec.up_ = up;
+      }
+    } restore{*this, given, up_};
+    input_ = sensorFrameCopy(*given, pose);
+    up_ = pose.linear().transpose() * up_;
+    found = recognizeInSensorFrame(objects, t0);
+  }
   segmentation_.setInputCloud(given);
   std::vector<TabletopCluster> none;
   segmentation_.transformResults(pose, none);
@@ -163,7 +175,7 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   segmentation_.setCamera(camera_);
   segmentation_.setUpDirection(up_);
   // The cloud is in the sensor's frame, its far points gone (recognize() saw to it).
-  const bool segmented = segmentation_.run(clusters, false);
+  const bool segmented = segmentation_.segmentInSensorFrame(clusters);
   timing_.segmentation = ms(t0, Clock::now());
   timing_.segmentation_steps = segmentation_.getTiming();
   if (!segmented) {

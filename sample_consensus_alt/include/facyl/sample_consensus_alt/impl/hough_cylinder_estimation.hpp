@@ -257,18 +257,17 @@ HoughCylinderEstimation<PointT, PointNT>::gatherCues(CylinderCues& cues,
 }
 
 namespace detail {
-/** Curvatures of \a cues at facyl's own scale (NormalCurvatureEstimation's k = 16: normals of
- * the 16 nearest points, then the spread of those normals), whatever scale the given normals
+/** Curvatures of \a cues at facyl's own scale (kDefaultNeighbours, 16: normals of the 16
+ * nearest points, then the spread of those normals), whatever scale the given normals
  * have: normals smoothed over k = 50 neighbours bend c_max on a small cylinder. The given
  * normals stay the normals of the vote and of the inlier test. Columns without a usable
  * neighbourhood vote without curvature (weight 0). */
 inline void
 estimateOwnCurvatures(CylinderCues& cues)
 {
-  constexpr int kCueNeighbours = 16;
   const Eigen::Index n = cues.points.cols();
-  const PointCues own =
-    estimatePointCues(cues.points, std::numeric_limits<float>::max(), kCueNeighbours, cues.normals);
+  const PointCues own = estimatePointCues(cues.points, std::numeric_limits<float>::max(),
+                                          kDefaultNeighbours, cues.normals);
   cues.curvature_directions.setZero(3, n);
   cues.weights.setZero(n);
   for (Eigen::Index s = 0; s < n; ++s) {

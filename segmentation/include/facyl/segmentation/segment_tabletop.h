@@ -1,0 +1,311 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * The tabletop segmentation as a plain core: one function over the x, y, z of a frame in the
+ * sensor's frame, its camera and its settings, returning supports and objects as values; its
+ * scratch buffers in a workspace that the caller owns and reuses between frames.
+ * TabletopSegmentation (tabletop_segmentation.h) is the PCL front over it.
+ */
+#pragma once
+
+#include <facyl/segmentation/object_segmentation.h>
+#include <facyl/segmentation/plane_search.h>
+#include <facyl/segmentation/support_planes.h>
+#include <facyl/segmentation/tabletop_geometry.h>
+
+#include <pcl/PCLHeader.h>
+#include <pcl/PointIndices.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_struct_traits.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace facyl {
+
+/** \brief Settings of TabletopSegmentation (lengths in cloud units, metres for sensors). */
+struct TabletopSegmentationParameters {
+  /** Half-width of a support's inlier band (m), >= 0. 0 (default): measured on each support
+   * from its own points, as band_factor x the robust scale of their distances from the plane
+   * at each range from the sensor (see DepthBand): the noise and bias of the sensor at hand,
+   * growing with range. > 0: this band at every range (the behaviour of earlier versions,
+   * 0.015 there). */
+  float plane_distance{0.f};
+  float band_factor{3.f}; ///< measured bands: half-width in robust sigmas, in [1, 10]
+  /** Organized: regions of the plane search grow between neighbours whose normals differ by
+   * less than this (rad, > 0); a seed setting, the support's own normal tolerance is measured
+   * (see PlaneRegionSettings). */
+  float plane_angle{0.05f};
+  /** A plane needs this many points (full resolution) to be found; supports must also be
+   * min_support_area large. */
+  std::size_t min_plane_points{1000};
+  /** Objects are the points between min_height and max_height above their support, and above
+   * its band (the points clearly off the support at their range; see plane_distance):
+   * min_height (m, default 0) only raises the band's lower end. min < max. */
+  float min_height{0.f};
+  float max_height{0.5f};
+  /** How the object points are split into objects:
+   * - EdgeAware (default): organized clouds are cut at depth discontinuities and concave
+   *   creases, then fragments, enclosed parts and parts seen on both sides of an occluder are
+   *   joined (segmentObjectsOrganized); unorganized clouds are first projected into a depth
+   *   image from the sensor origin (the camera given with setCamera, else a pinhole looking at
+   *   the objects), each point then taking its pixel's segment;
+   * - Euclidean: connected components within cluster_tolerance (the paper's clustering). */
+  enum class Clustering { Euclidean, EdgeAware } clustering{Clustering::EdgeAware};
+  ObjectSegmentationParameters objects; ///< settings of the EdgeAware clustering
+  float cluster_tolerance{0.02f};       ///< Euclidean cluster tolerance, > 0
+  std::size_t min_cluster_size{300};
+  std::size_t max_cluster_size{200000};
+  /** A cluster is an object on a support if at least this share of its points lies over the
+   * support's convex hull, in (0, 1] (1: every point, as pcl::ExtractPolygonalPrismData). */
+  float min_hull_share{0.25f};
+  /** Which planes support objects:
+   * - ObjectsStanding (default): planes of at least min_support_area are candidates (with an
+   *   up direction, only those within max_support_tilt of it); families of parallel candidates
+   *   (a table, the floor, a shelf) compete by the object points standing on them; each
+   *   cluster belongs to the nearest candidate of the winning family under it, and the table
+   *   is the one with the most object points standing on it;
+   * - LargestPlane: the plane with the most points is the table (the paper's choice). */
+  enum class Support { LargestPlane, ObjectsStanding } support{Support::ObjectsStanding};
+  float max_support_tilt{0.35f}; ///< rad, with an up direction: support normal vs up
+  /** Supports are at least this large (m^2, the convex hull of their points; a stool or a
+   * chair-arm tablet shows 0.05 m^2): smaller planes are faces of objects, and their points
+   * stay object points. */
+  float min_support_area{0.04f};
+  /** A plane inside the object band of a larger parallel support (a shelf, a box top) is a
+   * support only when the region found on it is at least this large (m^2): smaller ones are
+   * the tops of objects standing on the larger support. Planes of other orientations this large
+   * (walls, a floor seen from a low camera) are structure: their points are never object
+   * points (smaller ones may be the faces of boxes). */
+  float min_shelf_area{0.1f};
+  /** A cluster stands on a support when it reaches down to within this height of the
+   * support's band (m): the lowest visible points of an object are above its contact. */
+  float contact_height{0.03f};
+  /** Organized: the plane search works on blocks of step x step pixels, in [0, 16]; 0
+   * (default): the image width / 160 (4 at VGA), so that the search sees the same angular
+   * grid at every resolution. */
+  int plane_step{0};
+  /** Speed for accuracy on large frames (0, the default: off). Organized frames wider than 1.5
+   * times this many pixels are segmented on a lattice of every s-th pixel and row, s =
+   * round(width / lattice_width) (640: a 1280 x 720 frame at 640 x 360, about as a VGA frame;
+   * see latticeStep), and each object and support then takes the pixels of its lattice pixels'
+   * s x s blocks that continue its surface. It trades a few objects for time: measured in
+   * docs/speed.md, "The whole segmentation on a lattice". 0 or in [160, 8192]. */
+  int lattice_width{0};
+  std::size_t plane_samples{20000}; ///< unorganized: points sampled for the plane search, >= 100
+  std::size_t max_planes{6};        ///< support candidates examined, in [1, 8]
+};
+
+/** \brief Checks \a params. \return an empty string, or what is wrong. */
+std::string validate(const TabletopSegmentationParameters& params);
+
+/** \brief The distance threshold (m, scaled by depth^2 inside PCL) with which
+ * pcl::OrganizedMultiPlaneSegmentation grows the seed regions of the plane search when
+ * plane_distance is 0: it only makes seeds; each support's band is measured on it afterwards. */
+constexpr float kSeedDistance = 0.015f;
+
+/** \brief Wall-clock time per step of a segmentation (ms). */
+struct SegmentationTiming {
+  double planes{0.0};  ///< the plane grid, its seeds and their regions (the candidates)
+  double points{0.0};  ///< every point sorted onto and above the candidates (one pass)
+  double objects{0.0}; ///< the families of supports tried, the objects clustered and placed
+  double total{0.0};
+};
+
+/** \brief One object above a support. */
+struct TabletopCluster {
+  pcl::PointIndices indices;    ///< into the input cloud, ascending
+  PixelBox box{-1, -1, -1, -1}; ///< pixel box (organized input, or projection with a camera)
+  Eigen::Vector3f centroid{Eigen::Vector3f::Zero()};
+  int support{0}; ///< index into TabletopSegmentation::getSupports()
+};
+
+/** \brief A plane that objects stand on (a table, a shelf, the floor). */
+struct SupportPlane {
+  Eigen::Vector4f plane{Eigen::Vector4f::Zero()}; ///< unit normal towards the sensor
+  /** z = the plane's normal (up), origin = centre of its points; maps plane coordinates to
+   * the cloud's. */
+  Eigen::Affine3f frame{Eigen::Affine3f::Identity()};
+  pcl::PointIndices inliers; ///< points within the band (full resolution)
+  /** Distance from the plane that its points keep, by range from the sensor: the support's
+   * measured noise and bias (or the fixed plane_distance). */
+  DepthBand band;
+  std::vector<Eigen::Vector2f> polygon; ///< convex hull of the inliers, plane coordinates
+  std::size_t objects{0};               ///< clusters assigned to it
+  std::size_t standing_points{0};       ///< points of the clusters standing on it
+};
+
+/** \brief The points a segmentation reads: the x, y and z of point i are the floats
+ * xyz[i * stride], xyz[i * stride + 1], xyz[i * stride + 2]. It refers to memory it does not
+ * own (a PCL cloud's points, see pointFrame), which must outlive it. */
+struct PointFrame {
+  const float* xyz{nullptr};
+  /** Floats from one point to the next, >= 3; >= 4 (the fourth float of each point readable)
+   * lets the pixel sort read four points at a time. */
+  std::size_t stride{4};
+  std::size_t size{0};                  ///< points
+  std::uint32_t width{0}, height{1};    ///< as pcl::PointCloud's: organized when height > 1
+  const pcl::Indices* indices{nullptr}; ///< the points to segment; nullptr: every point
+  Eigen::Vector3f viewpoint{Eigen::Vector3f::Zero()}; ///< the sensor origin
+  pcl::PCLHeader header;                              ///< given to the outputs' indices
+
+  bool isOrganized() const
+  {
+    return height > 1;
+  }
+  Eigen::Map<const Eigen::Vector3f> point(std::size_t i) const
+  {
+    return Eigen::Map<const Eigen::Vector3f>(xyz + i * stride);
+  }
+  /** \brief pcl::isFinite of point \a i: x, y and z finite. */
+  bool finite(std::size_t i) const
+  {
+    const float* p = xyz + i * stride;
+    return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+  }
+};
+
+/** \brief The PointFrame of \a cloud (sensor origin, header, organization) with \a indices
+ * (nullptr: every point). PCL's point types start with x, y, z (PCL_ADD_POINT4D): the frame
+ * reads the cloud's own memory. Other types are copied into \a buffer (four floats a point),
+ * which must then outlive the frame. */
+template <typename PointT>
+PointFrame
+pointFrame(const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
+           std::vector<float>& buffer)
+{
+  PointFrame f;
+  f.size = cloud.size();
+  f.width = cloud.width;
+  f.height = cloud.height;
+  f.indices = indices;
+  f.viewpoint = cloud.sensor_origin_.template head<3>();
+  f.header = cloud.header;
+  if constexpr (pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
+                pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
+                pcl::traits::offset<PointT, pcl::fields::z>::value == 8 &&
+                sizeof(PointT) % sizeof(float) == 0 && sizeof(PointT) >= 4 * sizeof(float)) {
+    f.xyz = reinterpret_cast<const float*>(cloud.points.data());
+    f.stride = sizeof(PointT) / sizeof(float);
+  }
+  else {
+    buffer.resize(4 * cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      float* q = buffer.data() + 4 * i;
+      q[0] = cloud[i].x, q[1] = cloud[i].y, q[2] = cloud[i].z, q[3] = 1.f;
+    }
+    f.xyz = buffer.data();
+    f.stride = 4;
+  }
+  return f;
+}
+
+namespace detail {
+/** A std::allocator whose value-less construct() leaves the value uninitialised: a vector of
+ * such grows to a frame's size without writing every element first. */
+template <typename T> struct UninitialisedAllocator : std::allocator<T> {
+  template <typename U> struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <typename U> UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value)
+  {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args> void construct(U* p, Args&&... args)
+  {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+} // namespace detail
+
+/** \brief The scratch buffers of segmentTabletop, owned by its caller and reused from frame to
+ * frame (of any size): a VGA frame's buffers run to megabytes, and fresh ones cost more in page
+ * faults and fills than the work done on them (docs/speed.md, "First frames"). What they hold
+ * between calls has no meaning: a workspace used before gives the same results as a new one,
+ * and a copy of a workspace is a new one (copying scratch would only cost time). Not to be
+ * used by two calls at a time. */
+struct TabletopWorkspace {
+  TabletopWorkspace() = default;
+  TabletopWorkspace(const TabletopWorkspace&) {}
+  TabletopWorkspace& operator=(const TabletopWorkspace&)
+  {
+    return *this;
+  }
+  TabletopWorkspace(TabletopWorkspace&&) = default;
+  TabletopWorkspace& operator=(TabletopWorkspace&&) = default;
+
+  /** The pixel sort's lists of each candidate's points: a slice per candidate that could take
+   * every point, so the sort tests no growth per point; left uninitialised (a frame touches
+   * only the pages it writes). */
+  std::vector<pcl::index_t, detail::UninitialisedAllocator<pcl::index_t>> on_planes;
+  std::vector<PointOverPlanes> above;  ///< the pixel sort's points above some candidate
+  std::vector<std::uint8_t> has_depth; ///< organized frames: per pixel, finite
+  /** The Euclidean clustering of organized frames: a copy of the frame with only the object
+   * points finite, and the pixels last written (the only ones cleared for the next call). */
+  pcl::PointCloud<pcl::PointXYZ> masked;
+  pcl::Indices masked_written;
+  pcl::PointCloud<pcl::Label> labels;
+  /** The points of the lattice (lattice_width), four floats each; left uninitialised. */
+  std::vector<float, detail::UninitialisedAllocator<float>> lattice;
+};
+
+/** \brief The supports and objects of a frame. */
+struct TabletopSegments {
+  std::vector<TabletopCluster> clusters; ///< largest first
+  /** The supports that hold objects, and the table (there unless the frame showed no
+   * support at all). */
+  std::vector<SupportPlane> supports;
+  std::size_t table{0};      ///< index into supports
+  bool table_found{false};   ///< some object stands on the table
+  float focal{0.f};          ///< pixels (organized frames: the camera's, or estimated); else 0
+  SegmentationTiming timing; ///< its steps, and their total
+};
+
+/** \brief Supports, objects above them and object clusters of \a frame (paper III-A; the steps:
+ * TabletopSegmentation's description).
+ * \param frame   in the sensor's frame (depth along the line of sight; its viewpoint the sensor
+ *                origin, any rotation undone: see sensorFrameCopy), every finite coordinate
+ *                within kMaxCoordinate (tabletop_segmentation.h).
+ * \param camera  the sensor's intrinsics (PinholeCamera::valid(), cameraUsable), or an
+ *                invalid one: unknown.
+ * \param up      gravity's opposite in the sensor's frame, or zero: unknown.
+ * \param params  valid settings (validate).
+ * \param workspace  scratch buffers (see TabletopWorkspace).
+ * \throws std::invalid_argument on invalid \a params, an unusable valid \a camera, a non-finite
+ *         \a up, or a frame without points memory or with a stride below 3. */
+TabletopSegments segmentTabletop(const PointFrame& frame, const PinholeCamera& camera,
+                                 const Eigen::Vector3f& up,
+                                 const TabletopSegmentationParameters& params,
+                                 TabletopWorkspace& workspace);
+
+/** \brief The lattice step of \a params.lattice_width for a frame: s = round(width /
+ * lattice_width) for organized frames searched as images (at least 16 plane-grid cells wide
+ * and high) that are wider than 1.5 lattice_width and come without indices; else 1 (every
+ * pixel). */
+int latticeStep(const PointFrame& frame, const TabletopSegmentationParameters& params);
+
+/** \brief \a params for the lattice of \a step (> 1): a lattice point stands for step^2
+ * pixels, so counts of points (min_plane_points, cluster sizes, objects.min_fragment) scale
+ * by 1 / step^2 (at least 1; the largest cluster at least the smallest) and a given
+ * plane_step by 1 / step (at least 1); lengths stay. */
+TabletopSegmentationParameters latticeParameters(const TabletopSegmentationParameters& params,
+                                                 int step);
+
+/** \brief \a camera for the lattice of \a step of its image (latticeOf): focal lengths and
+ * principal point divided by \a step, the image \a width x \a height lattice pixels. An
+ * invalid camera stays as it is. */
+PinholeCamera latticeCamera(const PinholeCamera& camera, int step, std::uint32_t width,
+                            std::uint32_t height);
+
+} // namespace facyl

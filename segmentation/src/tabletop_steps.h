@@ -1,0 +1,184 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * The steps of segmentTabletop (segment_tabletop.h), internal to the library: each takes what
+ * it reads (the run's Setup, what earlier steps found) and returns what it found.
+ *   tabletop_planes.cpp    the support candidates: plane grid or point sample, seeds, regions
+ *   tabletop_supports.cpp  the pixel sort, the families of candidates and their trials, the
+ *                          supports' hulls, each cluster's support
+ *   tabletop_objects.cpp   the object points split into clusters (object_segmentation.h for
+ *                          the edge-aware split of an image), the frame without a support
+ *   tabletop_lattice.cpp   the run on a lattice of a large frame, and back to full resolution
+ *   segment_tabletop.cpp   the run of one frame: the steps in order, the family chosen
+ */
+#pragma once
+
+#include <facyl/segmentation/segment_tabletop.h>
+
+#include <optional>
+#include <vector>
+
+namespace facyl {
+namespace tabletop {
+
+/** What every step reads of a run: the frame, its settings, its camera and up direction, and
+ * how the frame is searched. Holds references: they outlive the run. */
+struct Setup {
+  const PointFrame& frame;
+  const TabletopSegmentationParameters& params;
+  const PinholeCamera& camera;
+  Eigen::Vector3f up;
+  int plane_step; ///< the block size of the plane search on an image (see plane_step)
+  bool as_image;  ///< searched as an image (see searchedAsImage), else as a point set
+};
+
+/** The block size of the plane search on organized frames: plane_step, or width / 160. */
+int planeStep(const PointFrame& frame, const TabletopSegmentationParameters& params);
+
+/** True when \a frame is searched as an image: organized and at least 16 plane-grid cells wide
+ * and high (its normals use a window of several cells); narrower organized frames (a LiDAR's
+ * few rings, a strip) are point sets. */
+bool searchedAsImage(const PointFrame& frame, const TabletopSegmentationParameters& params);
+
+Setup makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
+                const PinholeCamera& camera, const Eigen::Vector3f& up);
+
+/** Calls \a f with each index of the points to segment (the frame's indices, else all). */
+template <typename F>
+void
+forEachPoint(const PointFrame& frame, F f)
+{
+  if (frame.indices) {
+    for (const auto i : *frame.indices)
+      f(i);
+    return;
+  }
+  for (std::size_t i = 0; i < frame.size; ++i)
+    f(static_cast<pcl::index_t>(i));
+}
+
+/** What the plane search learns of the frame, for the steps after it. */
+struct FrameCues {
+  float focal{0.f}; ///< pixels, images: the camera's, or estimated
+  Eigen::Vector3f image_down{Eigen::Vector3f::Zero()}; ///< images; zero: unknown
+  /** The sensor's noise by range, as measured on the largest candidate: the depth gaps of the
+   * object segmentation are never below it. */
+  std::optional<DepthBand> noise;
+  /** Images: per pixel, finite (recorded by the plane grid's pass over the image). */
+  const std::vector<std::uint8_t>* has_depth{nullptr};
+
+  const DepthBand* noiseBand() const
+  {
+    return noise ? &*noise : nullptr;
+  }
+};
+
+// ------------------------------------------------------------------ tabletop_planes.cpp
+
+/** A candidate plane: coefficients, band and the points of the region found on it. */
+struct Candidate {
+  Eigen::Vector4f plane{Eigen::Vector4f::Zero()};
+  DepthBand band;
+  pcl::Indices points;    ///< frame indices, one per cell of the region (grid or sample)
+  std::size_t support{0}; ///< full-resolution points it stands for
+};
+
+/** The support candidates of the frame, largest first: seeds of the plane grid (images) or of
+ * a point sample grown into planes (refinePlaneRegion), then keepSupportCandidates. Sets \a
+ * cues: focal, image_down and has_depth (in \a workspace) on images, the noise. */
+std::vector<Candidate> findCandidates(const Setup& setup, FrameCues& cues,
+                                      TabletopWorkspace& workspace);
+
+/** Of a candidate's \a region, the points that can be vertices of its convex hull: on an
+ * image, each row's first and last (rowExtremes); all of them in a point set. */
+pcl::Indices hullCandidates(const Setup& setup, const pcl::Indices& region);
+
+/** Area of the convex hull of the points that found \a c, in \a frame's plane. */
+float regionArea(const Setup& setup, const Candidate& c, const Eigen::Affine3f& frame);
+
+// ------------------------------------------------------------------ tabletop_supports.cpp
+
+/** Per candidate, its hulls (see supportHull) and region area: computed once for all the
+ * trials of its family. */
+struct CandidateHulls {
+  bool known{false};
+  std::vector<Eigen::Vector2f> polygon, extent;
+  float region{0.f};
+};
+
+/** The candidates of a frame and the pixel sort's result, which every trial reads. */
+struct SortedFrame {
+  std::vector<Candidate> candidates;
+  /** Per candidate: plane, band, frame and inliers (the final trial moves its family's
+   * inliers out). */
+  std::vector<SupportPlane> all;
+  std::vector<CandidateHulls> hulls;
+  /** The points above some candidate (the workspace's list). */
+  const std::vector<PointOverPlanes>* above{nullptr};
+};
+
+/** One pass over the points (the pixel sort): \a candidates with their inliers, frames and
+ * the points above some candidate (\a workspace.above). */
+SortedFrame classifyPoints(const Setup& setup, std::vector<Candidate> candidates,
+                           TabletopWorkspace& workspace);
+
+/** The families of parallel candidates, those an upright camera would see facing up first,
+ * then by their number of points. */
+std::vector<std::vector<std::size_t>> rankFamilies(const Setup& setup, const FrameCues& cues,
+                                                   const SortedFrame& sorted);
+
+/** The supports and objects of one family of parallel candidates. */
+struct Trial {
+  std::vector<SupportPlane> supports;
+  std::vector<TabletopCluster> clusters;
+  std::size_t table{0};
+  std::size_t standing{0};         ///< object points standing on the supports
+  std::size_t standing_objects{0}; ///< objects standing on them
+};
+
+/** The supports of \a family (large enough, see min_support_area) and the objects on them, on
+ * every \a stride-th pixel and row of an image (1: all; larger: only the standing points are
+ * counted, to compare families). \a final: the result (the family's inliers are moved out of
+ * \a sorted). */
+Trial tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
+                const std::vector<std::size_t>& family, int stride, bool final,
+                TabletopWorkspace& workspace);
+
+// ------------------------------------------------------------------- tabletop_objects.cpp
+
+/** The object points \a objects split into clusters (see Clustering). */
+std::vector<pcl::Indices> cluster(const Setup& setup, const FrameCues& cues,
+                                  const pcl::Indices& objects, TabletopWorkspace& workspace);
+
+/** cluster() on a grid of every \a stride-th pixel and row of an image (\a objects on that
+ * grid), without joining parts seen around occluders: the clusters hold those pixels only
+ * (enough to count the objects standing on a family of supports). */
+std::vector<pcl::Indices> clusterCoarse(const Setup& setup, const FrameCues& cues,
+                                        const pcl::Indices& objects, int stride,
+                                        TabletopWorkspace& workspace);
+
+/** No support in view (or none that objects stand on): the compact segments of the frame (of
+ * its points not flagged in \a taken) are objects too, with support -1; appended to \a
+ * clusters. */
+void segmentWithoutSupport(const Setup& setup, const FrameCues& cues,
+                           const std::vector<std::uint8_t>* taken,
+                           std::vector<TabletopCluster>& clusters, TabletopWorkspace& workspace);
+
+/** The cluster of \a indices (sorted here if they are not): header, centroid and box. */
+TabletopCluster makeCluster(const Setup& setup, pcl::Indices indices, int support);
+
+// ------------------------------------------------------------------- tabletop_lattice.cpp
+
+/** segmentFrame on the lattice of every \a step-th pixel and row of \a setup's frame, its
+ * clusters and supports then brought to full resolution. */
+TabletopSegments segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace);
+
+// ------------------------------------------------------------------- segment_tabletop.cpp
+
+/** The run on every point of \a setup's frame; \a cues: what its plane search learnt. */
+TabletopSegments segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace);
+
+/** Largest first, like pcl::EuclideanClusterExtraction (stable). */
+void sortLargestFirst(std::vector<TabletopCluster>& clusters);
+
+} // namespace tabletop
+} // namespace facyl
