@@ -252,11 +252,11 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
   EXPECT_EQ(info.input.size, 227);
   EXPECT_FALSE(info.softmax);
   EXPECT_FALSE(info.has_fusion);
-  EXPECT_EQ(
-    facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info),
-    "");
+  EXPECT_EQ(facyl::parseClassifierModelInfo(
+              "channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15\n", info),
+            "");
   EXPECT_TRUE(info.has_fusion);
-  EXPECT_EQ(info.fusion[8], 9.f);
+  EXPECT_EQ(info.fusion[14], 15.f);
   EXPECT_EQ(facyl::parseClassifierModelInfo("channels depthrgb\nsize 64\n", info), "");
   EXPECT_EQ(info.input.channels, facyl::ClassifierChannels::DepthRgb);
   EXPECT_NE(facyl::parseClassifierModelInfo("size 64\n", info), "");
@@ -287,7 +287,7 @@ TEST(CylinderEvidence, EvidenceFeaturesAndProbability)
   EXPECT_EQ(f[1], 0.9f);
   EXPECT_EQ(f[2], 0.7f);
   EXPECT_EQ(f[3], 1.f);           // unknown curvature ratio
-  EXPECT_EQ(f[7], 8.f);           // unknown normal agreement: the worst
+  EXPECT_EQ(f[7], 4.f);           // unknown normal agreement: the worst
   EXPECT_EQ(f[8], 1.f);           // unknown normal concentration: the worst
   EXPECT_EQ(f[9], 0.f);           // unknown profile range: no evidence against
   EXPECT_NEAR(f[14], 0.f, 1e-6f); // logit(0.5)
@@ -526,6 +526,15 @@ TEST(CylinderClassifier, RecognizerReportsACalibratedProbabilityPerObject)
   }
   EXPECT_GE(cylinders, 3u);
   EXPECT_GT(with.getTiming().classification, 0.0);
-  for (const auto& o : b)
-    EXPECT_TRUE(std::isnan(o.evidence.p_cylinder));
+  // Without a classifier: the evidence model's probability for each fitted object (NaN for
+  // the others), and the same decision rule.
+  for (const auto& o : b) {
+    EXPECT_EQ(std::isnan(o.evidence.p_cylinder), !o.evidence.fitted);
+    EXPECT_TRUE(std::isnan(o.evidence.p_network));
+    if (o.evidence.fitted) {
+      EXPECT_FLOAT_EQ(o.evidence.p_cylinder,
+                      facyl::geometricProbability(o.evidence, without.getParameters().decision));
+      EXPECT_EQ(o.is_cylinder, facyl::acceptCylinder(o.evidence, without.getParameters().decision));
+    }
+  }
 }

@@ -268,8 +268,12 @@ def test_detect_on_a_rendered_frame():
     for o in out["objects"]:
         assert 0.0 <= o["p_cylinder"] <= 1.0
         assert o["n_points"] == len(o["indices"])
+    # Without a network p_cylinder is the evidence model's alone: a probability for every
+    # fitted object, None for the others.
     none = facyl.detect(scene["points"], scene["colors"], model="none")
-    assert all(o["p_cylinder"] is None for o in none["objects"])
+    for o in none["objects"]:
+        assert (o["p_cylinder"] is None) == (o["cylinder"] is None)
+        assert o["p_network"] is None
     # (N, 3) with a camera: the same objects as an unorganized cloud.
     flat = scene["points"].reshape(-1, 3)
     keep = np.isfinite(flat).all(axis=1)
@@ -323,7 +327,7 @@ def test_bundled_scene_matches_facyl_detect():
     pcd = o3d.io.read_point_cloud(os.path.join(DATA, "default_scene.pcd"), remove_nan_points=False)
     pts = np.asarray(pcd.points).reshape(480, 640, 3)
     out = facyl.detect(pts)
-    assert sum(o["is_cylinder"] for o in out["objects"]) == 4
+    assert sum(o["is_cylinder"] for o in out["objects"]) == 5
 
 
 # ----------------------------------------------------------------------------- bad input

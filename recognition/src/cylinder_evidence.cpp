@@ -60,7 +60,7 @@ evidenceFeatures(float p_network, const CylinderEvidence& e)
           known(e.angular_coverage, 0.f),
           std::clamp(known(e.taper, 0.f), 0.f, 1.f),
           known(e.arc_gap, 0.f),
-          std::clamp(known(s.normal_agreement, 8.f), 0.f, 8.f),
+          std::clamp(known(s.normal_agreement, 4.f), 0.f, 4.f),
           known(s.normal_concentration, 1.f),
           std::clamp(known(s.profile_range, 0.f), 0.f, 1.f),
           std::clamp(known(s.axis_bend, 0.f), 0.f, 1.f),
@@ -375,7 +375,7 @@ CylinderEvidence
 localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
               const Eigen::Matrix3Xf& normals, const std::vector<std::uint8_t>& alive,
               const ExplainSettings& settings, float radial_margin, float axial_margin,
-              float margin, std::vector<Explained>* explained, const Eigen::VectorXf& k_min)
+              float margin, std::vector<Explained>* explained, const Eigen::VectorXf& scatter)
 {
   const std::vector<Explained> why = explainedPoints(model, points, normals, settings);
   const float reach =
@@ -417,7 +417,7 @@ localEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   e.arc_gap = arcGap(model, points(Eigen::all, on_surface));
   if (normals.cols() == points.cols()) {
     e.taper = taperAlongAxis(model, points, normals, alive);
-    e.shape = shapeEvidence(model, points, normals, k_min, in_region, settings.distance);
+    e.shape = shapeEvidence(model, points, normals, scatter, in_region, settings.distance);
   }
   if (explained)
     *explained = why;

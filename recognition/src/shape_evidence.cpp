@@ -72,7 +72,7 @@ largestCircularWindowShare(std::vector<float> angles, float width)
 
 ShapeEvidence
 shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-              const Eigen::Matrix3Xf& normals, const Eigen::VectorXf& k_min,
+              const Eigen::Matrix3Xf& normals, const Eigen::VectorXf& scatter,
               const std::vector<std::uint8_t>& mask, float distance)
 {
   ShapeEvidence e{kNaN, kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
@@ -90,7 +90,7 @@ shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   std::array<int, kBendSlices> centre_count{};
   centre_sum.fill(Eigen::Vector3f::Zero());
   std::vector<float> deviation, azimuth, noise;
-  const bool with_k_min = k_min.size() == points.cols();
+  const bool with_scatter = scatter.size() == points.cols();
   std::size_t used = 0, inner = 0, beyond = 0;
   const auto slice = [&](float t, int slices) {
     return std::clamp(static_cast<int>(std::floor(t / h * slices)), 0, slices - 1);
@@ -120,8 +120,8 @@ shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     // of an open container faces the axis), where its normal points, where its slice's
     // centre is.
     deviation.push_back(std::acos(std::min(1.f, std::abs(cos_radial))));
-    if (with_k_min && std::isfinite(k_min[i]))
-      noise.push_back(k_min[i]);
+    if (with_scatter && std::isfinite(scatter[i]))
+      noise.push_back(scatter[i]);
     azimuth.push_back(std::atan2(l.across.dot(e2), l.across.dot(e1)));
     const int s = slice(l.t, kBendSlices);
     const float sign = cos_radial >= 0.f ? 1.f : -1.f;

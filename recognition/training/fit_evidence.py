@@ -87,7 +87,7 @@ def features_of(obj):
     return [1.0, known("surface_ratio", 0.0), known("inlier_ratio", 0.0),
             known("curvature_ratio", 1.0), known("angular_coverage", 0.0),
             clamp(known("taper", 0.0), 0.0, 1.0), known("arc_gap", 0.0),
-            clamp(known("normal_agreement", 8.0), 0.0, 8.0), known("normal_concentration", 1.0),
+            clamp(known("normal_agreement", 4.0), 0.0, 4.0), known("normal_concentration", 1.0),
             clamp(known("profile_range", 0.0), 0.0, 1.0), clamp(known("axis_bend", 0.0), 0.0, 1.0),
             known("inner_share", 0.0), known("outside_share", 0.0),
             known("inner_share", 0.0) * clamp(1.0 - known("aspect", 1.0), 0.0, 1.0), 0.0]
@@ -287,7 +287,7 @@ def fit_logistic(x, y, weight, l2=0.1):
 # axis and points beyond the surface against. A weight that comes out the other way (the
 # features overlap) is set to 0 and the rest refitted. The arc gap is a gate only: it is known
 # for the parts of the cylinder-first recovery alone.
-SIGNS = [0, 1, 0, -1, 1, -1, None, -1, -1, -1, -1, None, -1, -1, 1]
+SIGNS = [0, 1, 1, -1, 1, -1, None, -1, -1, -1, -1, None, -1, -1, 1]
 
 
 def fit_signed(x, y, weight):

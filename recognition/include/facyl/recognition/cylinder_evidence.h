@@ -29,8 +29,8 @@ constexpr std::size_t kEvidenceFeatures = 15;
  * evidenceFeatures fitted by recognition/training/fit_evidence.py on simulated and real labelled
  * objects (docs/classifier.md, "The evidence model"); the network's weight is 0. */
 constexpr std::array<float, kEvidenceFeatures> kGeometryWeights = {
-  2.43258f,  1.80012f,  -2.43618f, -4.45941f, 1.72003f, -15.0715f, 0.f, -0.0823083f,
-  -4.37786f, -8.71453f, -8.42685f, 0.f,       0.f,      -7.27018f, 0.f};
+  1.89986f, 0.740473f, 0.f,       -4.81554f, 1.0968f, -12.5418f, 0.f, 0.f,
+  -4.6012f, -9.17987f, -10.2173f, 0.f,       0.f,     -9.05837f, 0.f};
 
 /** \brief The decision rule's settings. */
 struct CylinderDecision {
@@ -112,7 +112,7 @@ bool passesGates(const CylinderEvidence& evidence, const CylinderDecision& decis
 
 /** \brief What the evidence model sees of a fitted object: 1, surface ratio, inlier ratio,
  * curvature ratio (1 when unknown), angular coverage, taper clamped to [0, 1] (0 when unknown),
- * arc gap (0 when unknown), normal agreement clamped to [0, 8] (8 when unknown),
+ * arc gap (0 when unknown), normal agreement clamped to [0, 4] (4 when unknown),
  * normal concentration (1 when unknown), profile range and axis bend clamped to [0, 1] (0 when
  * unknown), inner share and outside share (0 when unknown), the inner share of a shallow
  * container (inner share x clamp(1 - aspect, 0, 1): a bowl's inside; a cup is deeper than its
@@ -234,7 +234,7 @@ CylinderEvidence localEvidence(const CylinderModel& model, const Eigen::Matrix3X
                                const ExplainSettings& settings, float radial_margin,
                                float axial_margin, float margin,
                                std::vector<Explained>* explained = nullptr,
-                               const Eigen::VectorXf& k_min = Eigen::VectorXf());
+                               const Eigen::VectorXf& scatter = Eigen::VectorXf());
 
 /** \brief Share of \a points (3 x n) inside the volume of \a model: within \a radial_factor x
  * radius of its axis and between base and top grown by \a axial_margin (m). The inside of an

@@ -20,11 +20,12 @@ namespace facyl {
 /** \brief The shape evidence of one fit (see shapeEvidence); NaN where unknown. */
 struct ShapeEvidence {
   /** Median angle between a side point's normal, across the axis, and the radial line through
-   * it, in units of the normals' own noise (the square root of the median k_min of the side
-   * points: how much neighbouring normals scatter along the least curved direction). About 1
-   * on a cylinder whatever the sensor: its normals turn with the radial line and only the
-   * noise separates them; 3 and more on a box, whose flat faces, fitted by a cylinder across
-   * their edge, keep one normal each while the radial line turns under them. */
+   * it, in units of how much neighbouring normals scatter (the square root of the side points'
+   * median k_max + k_min: noise, and the turn of the surface within a neighbourhood). About
+   * 0.5 on a cylinder whatever the sensor and the radius: its normals turn with the radial line
+   * and only the noise and the estimate's smoothing separate them; 2 and more on a box, whose
+   * flat faces, fitted by a cylinder across their edge, keep one normal each while the radial
+   * line turns under them. */
   float normal_agreement;
   /** Largest share of the side points whose normals, across the axis, lie within 10 degrees of
    * one direction: a cylinder's normals turn evenly over the arc it shows (a half-visible can:
@@ -52,14 +53,14 @@ struct ShapeEvidence {
 };
 
 /** \brief The shape evidence of \a model on the columns of \a points (unit \a normals and the
- * smaller principal curvature \a k_min alongside, as NormalCurvatureEstimation gives them)
+ * scatter of the neighbouring normals, k_max + k_min of NormalCurvatureEstimation, alongside)
  * flagged in \a mask (all when empty). Side points are within \a distance (the fit's inlier
  * distance, > 0) of the surface, within its axial extent, with a normal within 60 degrees of
  * perpendicular to the axis. Fields are NaN when too few points say anything: fewer than 10
- * side points (agreement, concentration; agreement also without k_min), too few slices
+ * side points (agreement, concentration; agreement also without the scatter), too few slices
  * (profile, bend), no point (shares). */
 ShapeEvidence shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-                            const Eigen::Matrix3Xf& normals, const Eigen::VectorXf& k_min,
+                            const Eigen::Matrix3Xf& normals, const Eigen::VectorXf& scatter,
                             const std::vector<std::uint8_t>& mask, float distance);
 
 /** \brief Largest share of \a angles (rad, any range: taken modulo 2 pi) within a window of

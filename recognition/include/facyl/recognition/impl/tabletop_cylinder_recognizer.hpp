@@ -27,7 +27,7 @@ template <typename PointT> struct TabletopCylinderRecognizer<PointT>::FitInput {
   pcl::PointCloud<NormalCurvature>::Ptr cues; ///< their normals and curvatures
   Eigen::Matrix3Xf columns;                   ///< points with a normal, as columns
   Eigen::Matrix3Xf normals;                   ///< their normals
-  Eigen::VectorXf k_min;                      ///< their smaller principal curvatures
+  Eigen::VectorXf scatter;                    ///< their neighbours' normal scatter (k_max + k_min)
   pcl::Indices column_of;                     ///< subset position -> column, -1 without
 };
 
@@ -557,7 +557,7 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
     std::vector<Explained> why;
     CylinderEvidence e = localEvidence(fit.model, input.columns, input.normals, alive_columns,
                                        explainSettings(fit.model), radial_margin, axial_margin,
-                                       margin, &why, input.k_min);
+                                       margin, &why, input.scatter);
     e.curvature_ratio = fit.evidence.curvature_ratio;
     std::vector<Eigen::Index> part, rest;
     for (std::size_t k = 0; k < alive.size(); ++k)
@@ -758,7 +758,7 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
   const auto n = static_cast<Eigen::Index>(in.points->size());
   in.columns.resize(3, n);
   in.normals.resize(3, n);
-  in.k_min.resize(n);
+  in.scatter.resize(n);
   in.column_of.assign(in.points->size(), -1);
   Eigen::Index m = 0;
   for (std::size_t k = 0; k < in.points->size(); ++k) {
@@ -767,12 +767,12 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
       continue;
     in.columns.col(m) = (*in.points)[k].getVector3fMap();
     in.normals.col(m) = Eigen::Vector3f(c.normal_x, c.normal_y, c.normal_z);
-    in.k_min[m] = c.pc2;
+    in.scatter[m] = c.pc1 + c.pc2;
     in.column_of[k] = static_cast<pcl::index_t>(m++);
   }
   in.columns.conservativeResize(3, m);
   in.normals.conservativeResize(3, m);
-  in.k_min.conservativeResize(m);
+  in.scatter.conservativeResize(m);
   return in;
 }
 
@@ -813,7 +813,7 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
         alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
   }
   e.taper = taperAlongAxis(f.model, input.columns, input.normals, alive_columns);
-  e.shape = shapeEvidence(f.model, input.columns, input.normals, input.k_min, alive_columns,
+  e.shape = shapeEvidence(f.model, input.columns, input.normals, input.scatter, alive_columns,
                           f.model.distance_threshold);
   // The surface ratio: lateral inliers, plus the points on the caps and on the inner wall.
   std::vector<std::uint8_t> counted(static_cast<std::size_t>(input.columns.cols()), 0);
