@@ -4,6 +4,7 @@
  */
 #include <facyl/tools/cli.h>
 #include <facyl/tools/detect_json.h>
+#include <facyl/tools/overlay_canvas.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/track_json.h>
@@ -73,61 +74,6 @@ printHelp(const char* self)
     self, facyl_cli::recognizerOptionsHelp(), facyl_cli::commonHelp());
 }
 
-// ---- drawing on an RGB buffer ----
-struct Canvas {
-  int width{0}, height{0};
-  std::vector<unsigned char> rgb;
-  void put(int u, int v, const std::array<unsigned char, 3>& c)
-  {
-    if (u < 0 || v < 0 || u >= width || v >= height)
-      return;
-    std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::size_t>(v) * width + u));
-  }
-  void line(Eigen::Vector2f a, Eigen::Vector2f b, const std::array<unsigned char, 3>& c,
-            int thick = 1)
-  {
-    if (!a.allFinite() || !b.allFinite() || (a - b).norm() > 4.f * (width + height))
-      return;
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).lpNorm<Eigen::Infinity>())));
-    for (int s = 0; s <= steps; ++s) {
-      const Eigen::Vector2f p = a + (b - a) * (static_cast<float>(s) / steps);
-      for (int dv = 0; dv < thick; ++dv)
-        for (int du = 0; du < thick; ++du)
-          put(static_cast<int>(std::lround(p.x())) + du, static_cast<int>(std::lround(p.y())) + dv,
-              c);
-    }
-  }
-};
-
-void
-drawCylinder(Canvas& canvas, const facyl::PinholeCamera& cam, const facyl::CylinderModel& m,
-             const std::array<unsigned char, 3>& colour)
-{
-  const Eigen::Vector3f a = m.axis.normalized();
-  Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
-  auto project = [&](const Eigen::Vector3f& p) {
-    return p.z() > 0.f ? cam.project(p) : Eigen::Vector2f::Constant(NAN);
-  };
-  for (const Eigen::Vector3f& c : {m.base, m.top}) {
-    Eigen::Vector2f prev;
-    for (int k = 0; k <= 48; ++k) {
-      const float t = 2.f * static_cast<float>(M_PI) * k / 48.f;
-      const Eigen::Vector2f q = project(c + m.radius * (std::cos(t) * e1 + std::sin(t) * e2));
-      if (k)
-        canvas.line(prev, q, colour);
-      prev = q;
-    }
-  }
-  // Silhouette generators: perpendicular to both the axis and the line of sight.
-  const Eigen::Vector3f centre = 0.5f * (m.base + m.top);
-  Eigen::Vector3f side = a.cross(centre);
-  if (side.norm() < 1e-6f)
-    return;
-  side = side.normalized() * m.radius;
-  for (float s : {-1.f, 1.f})
-    canvas.line(project(m.base + s * side), project(m.top + s * side), colour, 2);
-}
-
 /** The name of each scene's outputs (overlay, clusters): its file name's stem, or, when
  * several scenes share a stem, "<stem>-<k>" with k its position among the scenes (from 1). */
 std::vector<std::string>
@@ -195,7 +141,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
             const std::vector<facyl::RecognizedObject>& objects, std::string& why)
 {
   why.clear();
-  Canvas canvas;
+  facyl_cli::Canvas canvas;
   if (cloud.isOrganized()) {
     canvas.width = static_cast<int>(cloud.width);
     canvas.height = static_cast<int>(cloud.height);
@@ -230,7 +176,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
       canvas.line(p11, p01, c, 2), canvas.line(p01, p00, c, 2);
     }
     if (o.is_cylinder && camera.valid())
-      drawCylinder(canvas, camera, o.cylinder, yellow);
+      facyl_cli::drawCylinderOutline(canvas, camera, o.cylinder, yellow);
   }
   std::error_code ec;
   std::filesystem::remove(path, ec); // so that a stale image does not pass for this one
