@@ -3,6 +3,7 @@
  * One JSON object per scene on stdout.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/depth_colours.h>
 #include <facyl/tools/detect_json.h>
 #include <facyl/tools/overlay_canvas.h>
 #include <facyl/tools/pcd_input.h>
@@ -43,9 +44,11 @@ printHelp(const char* self)
     "Output:\n"
     "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
     "  --overlay OUT.png      RGB image with boxes (green: cylinder, red: not) and fitted\n"
-    "                         outlines; with several scenes a folder (<stem>.png;\n"
-    "                         <stem>-<k>.png when scenes share a name, k from 1). A path not\n"
-    "                         ending in .png, or one that is an input, is refused\n"
+    "                         outlines; a cloud without colour is coloured by depth (near\n"
+    "                         red, middle grey, far blue). With several scenes a folder\n"
+    "                         (<stem>.png; <stem>-<k>.png when scenes share a name, k from\n"
+    "                         1). A path not ending in .png, or one that is an input, is\n"
+    "                         refused\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png);\n"
     "                         refused when DIR holds an input (a later *.pcd there would\n"
     "                         read the clusters as scenes) or a name it would write is one\n"
@@ -132,8 +135,9 @@ drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
   return camera;
 }
 
-/** The overlay image: the RGB frame (or the points projected with the camera) with a box per
- * object (green: cylinder, red: not) and the fitted cylinders' outlines.
+/** The overlay image: the RGB frame (or the points projected with the camera; a cloud without
+ * colour coloured by depth) with a box per object (green: cylinder, red: not) and the fitted
+ * cylinders' outlines.
  * \return false when the image could not be written (\a why says so); true with \a why set
  * when there is no overlay to draw (a warning), true with \a why empty when it was written. */
 bool
@@ -141,13 +145,20 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
             const std::vector<facyl::RecognizedObject>& objects, std::string& why)
 {
   why.clear();
+  // A cloud without colour is drawn by its depth: black points on black show nothing.
+  Cloud by_depth;
+  if (!facyl_cli::hasColour(cloud)) {
+    by_depth = cloud;
+    facyl_cli::colourByDepth(by_depth);
+  }
+  const Cloud& drawn = by_depth.empty() ? cloud : by_depth;
   facyl_cli::Canvas canvas;
-  if (cloud.isOrganized()) {
-    canvas.width = static_cast<int>(cloud.width);
-    canvas.height = static_cast<int>(cloud.height);
-    canvas.rgb.resize(3 * cloud.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const auto& p = cloud[i];
+  if (drawn.isOrganized()) {
+    canvas.width = static_cast<int>(drawn.width);
+    canvas.height = static_cast<int>(drawn.height);
+    canvas.rgb.resize(3 * drawn.size());
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+      const auto& p = drawn[i];
       canvas.rgb[3 * i] = p.r, canvas.rgb[3 * i + 1] = p.g, canvas.rgb[3 * i + 2] = p.b;
     }
   }
@@ -155,7 +166,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
     canvas.width = camera.width;
     canvas.height = camera.height;
     canvas.rgb.assign(3 * static_cast<std::size_t>(camera.width) * camera.height, 0);
-    for (const auto& p : cloud)
+    for (const auto& p : drawn)
       if (pcl::isFinite(p) && p.z > 0.f) {
         const Eigen::Vector2f q = camera.project(p.getVector3fMap());
         canvas.put(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())),

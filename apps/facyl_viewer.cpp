@@ -1,10 +1,10 @@
 /*
  * facyl_viewer: a pcl_viewer-style 3-D viewer of scenes and their cylinders
- * (pcl::visualization::PCLVisualizer). The cloud in its colours, the table outline, accepted
- * cylinders as finite green meshes from base to top, rejected objects as red boxes, a label
- * per object; optionally PCL's SACMODEL_CYLINDER on the same clusters in a second viewport,
- * or one object's orientation accumulators for the three voting modes. --screenshot renders
- * and exits (under xvfb-run without a screen).
+ * (pcl::visualization::PCLVisualizer). The cloud in its colours (by depth without colour),
+ * the table outline, accepted cylinders as finite green meshes from base to top, rejected
+ * objects as red boxes, a label per object; optionally PCL's SACMODEL_CYLINDER on the same
+ * clusters in a second viewport, or one object's orientation accumulators for the three voting
+ * modes. --screenshot renders and exits (under xvfb-run without a screen).
  */
 #include "viewer/scene_drawing.h"
 #include "viewer/stream_view.h"
@@ -90,7 +90,8 @@ printHelp(const char* self)
     "The cloud, the table and the cylinders are drawn in the cloud's own frame, seen from its\n"
     "sensor (the VIEWPOINT; a pose that puts the points behind the sensor, as PCL's grabber\n"
     "frames store, is taken as the identity rotation, as the recognizer does). A frame\n"
-    "without any support is shown with its objects and no table outline.\n"
+    "without any support is shown with its objects and no table outline. A cloud without\n"
+    "colour (x y z only) is coloured by depth: near red, middle grey, far blue.\n"
     "The recognizer's options (--detect; as in facyl_detect):\n%s"
     "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
@@ -138,7 +139,8 @@ struct Settings {
   long long frames{0}; ///< --frames; 0: all
 };
 
-/** The file as an XYZRGBA cloud (grey without colour). \throws std::runtime_error. */
+/** The file as an XYZRGBA cloud (black without colour: drawnCloud colours it by depth).
+ * \throws std::runtime_error. */
 Cloud::Ptr
 loadCloud(const std::string& file)
 {
@@ -149,9 +151,6 @@ loadCloud(const std::string& file)
     throw std::runtime_error(why);
   Cloud::Ptr cloud(new Cloud);
   pcl::fromPCLPointCloud2(blob, *cloud);
-  if (!facyl_cli::hasField(blob, "rgb") && !facyl_cli::hasField(blob, "rgba"))
-    for (auto& p : *cloud)
-      p.r = p.g = p.b = 160, p.a = 255;
   cloud->sensor_origin_ = viewpoint.origin;
   cloud->sensor_orientation_ = viewpoint.orientation;
   if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))

@@ -3,6 +3,8 @@
  */
 #include "scene_drawing.h"
 
+#include <facyl/tools/depth_colours.h>
+
 #include <facyl/segmentation/tabletop_geometry.h>
 #include <facyl/segmentation/tabletop_segmentation.h>
 
@@ -160,6 +162,8 @@ Cloud::ConstPtr
 drawnCloud(const Cloud& cloud)
 {
   Cloud::Ptr drawn(new Cloud(cloud));
+  if (!facyl_cli::hasColour(cloud))
+    facyl_cli::colourByDepth(*drawn); // in the sensor's pose, before it is dropped
   drawn->sensor_origin_ = Eigen::Vector4f::Zero();
   drawn->sensor_orientation_ = Eigen::Quaternionf::Identity();
   return drawn;

@@ -57,10 +57,12 @@ void drawTable(pcl::visualization::PCLVisualizer& viewer,
  * with a Kinect's field of view. */
 void sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int viewport);
 
-/** The cloud as drawn: its points in its own frame. PCLVisualizer would move a cloud by its
- * sensor pose (sensor_origin_, sensor_orientation_), while the recognizer's table, cylinders
- * and boxes are in the cloud's frame: drawn with the pose, a grabber frame (VIEWPOINT
- * 0 0 0 0 1 0 0) ends up turned away from everything found on it. */
+/** The cloud as drawn: its points in its own frame, in their colours, or coloured by depth
+ * when they have none (facyl_cli::colourByDepth: near red, far blue; black points on the dark
+ * background show nothing). PCLVisualizer would move a cloud by its sensor pose
+ * (sensor_origin_, sensor_orientation_), while the recognizer's table, cylinders and boxes are
+ * in the cloud's frame: drawn with the pose, a grabber frame (VIEWPOINT 0 0 0 0 1 0 0) ends up
+ * turned away from everything found on it. */
 Cloud::ConstPtr drawnCloud(const Cloud& cloud);
 
 } // namespace facyl_viewer
