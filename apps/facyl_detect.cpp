@@ -5,7 +5,7 @@
 #include <facyl/tools/cli.h>
 #include <facyl/tools/depth_colours.h>
 #include <facyl/tools/detect_json.h>
-#include <facyl/tools/overlay_canvas.h>
+#include <facyl/tools/detect_overlay.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/track_json.h>
@@ -66,6 +66,9 @@ printHelp(const char* self)
     "                         become the track's decision and filtered estimate (in this\n"
     "                         frame), \"is_cylinder_frame\" and \"cylinder_frame\" the frame's\n"
     "                         own; each line adds \"stream\" and \"tracks\" (every live track).\n"
+    "                         --overlay shows the same: boxes and solid outlines by the\n"
+    "                         track, the frame's own cylinder dashed magenta, the track's id\n"
+    "                         (\"#7\") over each box.\n"
     "                         A frame that fails (its line has \"error\") does not end the\n"
     "                         stream; frames of a new scene start new tracks. docs/tracking.md\n"
     "  --track-confirm-hits N frames a new track must be seen in to be confirmed (default 2)\n"
@@ -136,13 +139,13 @@ drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
 }
 
 /** The overlay image: the RGB frame (or the points projected with the camera; a cloud without
- * colour coloured by depth) with a box per object (green: cylinder, red: not) and the fitted
- * cylinders' outlines.
+ * colour coloured by depth) with the objects \a shown (detect_overlay.h: a box per object,
+ * green: cylinder, red: not; the cylinders' outlines; with --track the tracks' ids).
  * \return false when the image could not be written (\a why says so); true with \a why set
  * when there is no overlay to draw (a warning), true with \a why empty when it was written. */
 bool
 drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCamera& camera,
-            const std::vector<facyl::RecognizedObject>& objects, std::string& why)
+            const std::vector<facyl_cli::OverlayObject>& shown, std::string& why)
 {
   why.clear();
   // A cloud without colour is drawn by its depth: black points on black show nothing.
@@ -177,18 +180,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
     why = "no overlay: an unorganized cloud needs --camera fx,fy,cx,cy";
     return true;
   }
-  const std::array<unsigned char, 3> green{0, 230, 0}, red{230, 0, 0}, yellow{255, 230, 0};
-  for (const auto& o : objects) {
-    const auto& b = o.cluster.box;
-    if (b[0] >= 0) {
-      const auto& c = o.is_cylinder ? green : red;
-      const Eigen::Vector2f p00(b[0], b[1]), p10(b[2], b[1]), p11(b[2], b[3]), p01(b[0], b[3]);
-      canvas.line(p00, p10, c, 2), canvas.line(p10, p11, c, 2);
-      canvas.line(p11, p01, c, 2), canvas.line(p01, p00, c, 2);
-    }
-    if (o.is_cylinder && camera.valid())
-      facyl_cli::drawCylinderOutline(canvas, camera, o.cylinder, yellow);
-  }
+  facyl_cli::drawOverlayObjects(canvas, camera, shown);
   std::error_code ec;
   std::filesystem::remove(path, ec); // so that a stale image does not pass for this one
   pcl::io::saveRgbPNGFile(path, canvas.rgb.data(), canvas.width, canvas.height);
@@ -310,7 +302,9 @@ processScene(const std::string& file, const std::string& name, const Settings& s
     const std::string path =
       s.many ? (std::filesystem::path(s.overlay) / (name + ".png")).string() : s.overlay;
     std::string why;
-    if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects, why))
+    const auto shown = stream ? facyl_cli::trackedOverlayObjects(objects, stream->tracker)
+                              : facyl_cli::overlayObjects(objects);
+    if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), shown, why))
       error = why;
     else if (!why.empty())
       warning += (warning.empty() ? "" : "; ") + why;

@@ -1,8 +1,11 @@
 /*
  * The tools' drawing (apps/common): colours by depth for clouds without colour
- * (depth_colours.h).
+ * (depth_colours.h), the overlays' canvas (overlay_canvas.h) and what facyl_detect's overlay
+ * draws of an object (detect_overlay.h).
  */
 #include <facyl/tools/depth_colours.h>
+#include <facyl/tools/detect_overlay.h>
+#include <facyl/tools/overlay_canvas.h>
 
 #include <pcl/point_types.h>
 
@@ -106,6 +109,89 @@ TEST(DepthColours, OneColouredPointIsColour)
   auto cloud = blackRay(Eigen::Vector3f::UnitZ());
   cloud[7].g = 1;
   EXPECT_TRUE(facyl_cli::hasColour(cloud));
+}
+
+using Colour = std::array<unsigned char, 3>;
+
+facyl_cli::Canvas
+blankCanvas(int width, int height, unsigned char grey)
+{
+  facyl_cli::Canvas canvas;
+  canvas.width = width;
+  canvas.height = height;
+  canvas.rgb.assign(3 * static_cast<std::size_t>(width) * height, grey);
+  return canvas;
+}
+
+Colour
+pixel(const facyl_cli::Canvas& canvas, int u, int v)
+{
+  const auto* p = &canvas.rgb[3 * (static_cast<std::size_t>(v) * canvas.width + u)];
+  return {p[0], p[1], p[2]};
+}
+
+TEST(OverlayCanvas, DashedLinesAlternateAlongAPolyline)
+{
+  auto canvas = blankCanvas(40, 3, 0);
+  const Colour white{255, 255, 255}, black{0, 0, 0};
+  // Two segments of one dashed polyline, 4 pixels on and 4 off: the pattern runs on.
+  const float travelled = canvas.line({0.f, 1.f}, {10.f, 1.f}, white, 1, 4);
+  EXPECT_FLOAT_EQ(travelled, 10.f);
+  canvas.line({10.f, 1.f}, {39.f, 1.f}, white, 1, 4, travelled);
+  for (int u = 0; u < 39; ++u)
+    EXPECT_EQ(pixel(canvas, u, 1), u % 8 < 4 ? white : black) << u;
+  // Solid (dash 0) draws every pixel, as it always did.
+  auto solid = blankCanvas(40, 3, 0);
+  solid.line({0.f, 1.f}, {39.f, 1.f}, white);
+  for (int u = 0; u < 40; ++u)
+    EXPECT_EQ(pixel(solid, u, 1), white) << u;
+}
+
+TEST(OverlayCanvas, LabelsAreGlyphsOnBlack)
+{
+  const Colour green{0, 230, 0}, black{0, 0, 0};
+  EXPECT_EQ(facyl_cli::labelSize("#12", 2), Eigen::Vector2i(38, 18));
+  auto canvas = blankCanvas(50, 30, 128);
+  facyl_cli::drawLabel(canvas, 3, 4, "#1", green, 2);
+  // '#' starts one font pixel in; its top row is .#.#. ; '1' (second glyph) .. #..
+  const auto font = [&](int glyph, int col, int row) {
+    return pixel(canvas, 3 + (6 * glyph + 1) * 2 + 2 * col, 4 + 2 + 2 * row);
+  };
+  EXPECT_EQ(font(0, 0, 0), black);
+  EXPECT_EQ(font(0, 1, 0), green);
+  EXPECT_EQ(font(0, 3, 0), green);
+  EXPECT_EQ(font(0, 0, 2), green); // the crossbar: #####
+  EXPECT_EQ(font(1, 2, 0), green);
+  EXPECT_EQ(font(1, 0, 0), black);
+  EXPECT_EQ(pixel(canvas, 3, 4), black);                   // the backing's corner
+  EXPECT_EQ(pixel(canvas, 3 + 26 - 1, 4 + 18 - 1), black); // and the opposite one
+  EXPECT_EQ(pixel(canvas, 3 + 26, 4), (Colour{128, 128, 128}));
+  EXPECT_EQ(facyl_cli::labelGlyph('x'), (std::array<std::uint8_t, 7>{})); // a gap
+}
+
+TEST(DetectOverlay, TrackedObjectsShowTheirIdInTheTracksColour)
+{
+  const Colour green{0, 230, 0}, red{230, 0, 0}, grey{128, 128, 128};
+  auto canvas = blankCanvas(200, 120, 128); // scale 1: 120 rows
+  facyl_cli::OverlayObject cylinder, other, untracked;
+  cylinder.box = {20, 40, 60, 100};
+  cylinder.is_cylinder = true;
+  cylinder.track_id = 7;
+  other.box = {100, 2, 150, 50}; // no room above: the label goes inside
+  other.track_id = 12;
+  untracked.box = {160, 60, 190, 90};
+  facyl_cli::drawOverlayObjects(canvas, facyl::PinholeCamera{}, {cylinder, other, untracked});
+  EXPECT_EQ(pixel(canvas, 20, 70), green); // the boxes in the decision's colour
+  EXPECT_EQ(pixel(canvas, 100, 30), red);
+  const Eigen::Vector2i size = facyl_cli::labelSize("#7", 1);
+  // "#7" above the cylinder's box: black backing, '#' top row .#.#.
+  EXPECT_EQ(pixel(canvas, 20, 40 - size.y() - 1), (Colour{0, 0, 0}));
+  EXPECT_EQ(pixel(canvas, 20 + 1 + 1, 40 - size.y()), green);
+  // "#12" inside the other box's top (2 pixels below its top edge).
+  EXPECT_EQ(pixel(canvas, 100 + 1 + 1, 2 + 2 + 1), red);
+  // Nothing over the untracked box.
+  for (int v = 40; v < 60; ++v)
+    EXPECT_EQ(pixel(canvas, 170, v), grey) << v;
 }
 
 } // namespace

@@ -11,9 +11,16 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/conversions.h>
 
+#include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkRendererCollection.h>
+#include <vtkSmartPointer.h>
 
 #include <algorithm>
 #include <cmath>
@@ -98,6 +105,82 @@ drawCylinder(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderMod
                                           viewport);
   viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY, 0.85, id,
                                           viewport);
+}
+
+namespace {
+
+/** Shape \a id drawn in its own colour whatever the light. */
+void
+unlit(pcl::visualization::PCLVisualizer& viewer, const std::string& id)
+{
+  const auto shapes = viewer.getShapeActorMap();
+  const auto it = shapes->find(id);
+  if (it == shapes->end())
+    return;
+  if (auto* actor = vtkActor::SafeDownCast(it->second))
+    actor->GetProperty()->LightingOff();
+}
+
+} // namespace
+
+void
+drawCylinderOutline(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderModel& m,
+                    const std::string& id, int viewport, double r, double g, double b, double width)
+{
+  const pcl::PolygonMesh mesh = cylinderMesh(m, kMeshSegments);
+  pcl::PointCloud<pcl::PointXYZ> corners;
+  pcl::fromPCLPointCloud2(mesh.cloud, corners); // the two rings, then the two centres
+  vtkNew<vtkPoints> points;
+  for (const auto& p : corners)
+    points->InsertNextPoint(p.x, p.y, p.z);
+  vtkNew<vtkCellArray> lines;
+  const auto segment = [&lines](vtkIdType i, vtkIdType j) {
+    const vtkIdType ends[2] = {i, j};
+    lines->InsertNextCell(2, ends);
+  };
+  const vtkIdType n = kMeshSegments;
+  for (vtkIdType k = 0; k < n; ++k) {
+    segment(k, (k + 1) % n);         // base ring
+    segment(n + k, n + (k + 1) % n); // top ring
+  }
+  for (vtkIdType k = 0; k < n; k += n / 4)
+    segment(k, n + k); // four generators
+  vtkSmartPointer<vtkPolyData> polydata = vtkSmartPointer<vtkPolyData>::New();
+  polydata->SetPoints(points);
+  polydata->SetLines(lines);
+  viewer.addModelFromPolyData(polydata, id, viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, r, g, b, id,
+                                     viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, width, id,
+                                     viewport);
+  unlit(viewer, id);
+}
+
+void
+drawBox(pcl::visualization::PCLVisualizer& viewer, const Eigen::Vector3f& box_min,
+        const Eigen::Vector3f& box_max, const std::string& id, int viewport, double r, double g,
+        double b, double width)
+{
+  viewer.addCube(box_min.x(), box_max.x(), box_min.y(), box_max.y(), box_min.z(), box_max.z(), r, g,
+                 b, id, viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
+                                     pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME,
+                                     id, viewport);
+  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, width, id,
+                                     viewport);
+  unlit(viewer, id);
+}
+
+void
+drawLabel(pcl::visualization::PCLVisualizer& viewer, const std::string& text,
+          const Eigen::Vector3f& at, const Eigen::Vector3f& eye, const std::string& id,
+          int viewport, double r, double g, double b)
+{
+  // A quarter of the way to the eye: where the sensor sees it at, in front of the object.
+  const Eigen::Vector3f shown = eye + 0.75f * (at - eye);
+  const float distance = std::max(0.1f, (shown - eye).norm());
+  viewer.addText3D(text, pcl::PointXYZ(shown.x(), shown.y(), shown.z()), kLabelHeight * distance, r,
+                   g, b, id, viewport);
 }
 
 void

@@ -43,6 +43,30 @@ pcl::PolygonMesh cylinderMesh(const facyl::CylinderModel& m, int segments);
 void drawCylinder(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderModel& m,
                   const std::string& id, int viewport, double r, double g, double b);
 
+/** The outline of \a m (its base and top circles and four generators) as lines \a id of colour (r,
+ * g, b), \a width pixels wide, unlit: beside a mesh, another estimate of the same cylinder. */
+void drawCylinderOutline(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderModel& m,
+                         const std::string& id, int viewport, double r, double g, double b,
+                         double width = 2.0);
+
+/** The wireframe box from \a box_min to \a box_max as shape \a id, \a width pixels wide and
+ * unlit (every edge in its colour; lit, the edges that face away were drawn black). */
+void drawBox(pcl::visualization::PCLVisualizer& viewer, const Eigen::Vector3f& box_min,
+             const Eigen::Vector3f& box_max, const std::string& id, int viewport, double r,
+             double g, double b, double width);
+
+/** \a text at \a at as the sensor at \a eye sees it, facing the camera: a quarter of the way
+ * from \a at to the eye (in front of the object it names, which would hide it), its height
+ * kLabelHeight times its distance from the eye (as readable on a far object as on a near
+ * one). */
+void drawLabel(pcl::visualization::PCLVisualizer& viewer, const std::string& text,
+               const Eigen::Vector3f& at, const Eigen::Vector3f& eye, const std::string& id,
+               int viewport, double r, double g, double b);
+
+/** Height of a label (drawLabel) per metre of distance from the sensor: about 12 pixels at a
+ * Kinect's field of view in a window 480 pixels high. */
+constexpr float kLabelHeight = 0.018f;
+
 /** The table \a outline (nothing with fewer than 3 corners) as the blue polygon
  * \a tag + "table". */
 void drawTable(pcl::visualization::PCLVisualizer& viewer,

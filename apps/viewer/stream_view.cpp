@@ -7,6 +7,7 @@
 
 #include <facyl/tools/frame_stream.h>
 #include <facyl/tools/json_writer.h>
+#include <facyl/tools/track_json.h>
 
 #include <facyl/tracking/cylinder_tracker.h>
 
@@ -39,9 +40,57 @@ trackColour(int id)
   return c;
 }
 
-/** One frame of --stream: the cloud, the table, every confirmed track in its colour with its
- * id (cylinders as meshes, faint when the frame did not see them; other objects as the box of
- * their points), tentative ones as thin boxes. */
+/** Track \a t as drawn over its frame, in its colour, with its id: a confirmed cylinder as the
+ * mesh of its filtered cylinder (faint when the frame did not see it; its label right of its
+ * top) and, when this frame's own fit of its object is a cylinder, that fit's white outline
+ * beside it; other objects seen as the box of their points (thin while tentative); a
+ * confirmed track not seen as its label at its place. \a sensor: the frame's sensor pose. */
+void
+drawTrack(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderTrack& t,
+          const facyl::CylinderTracker& tracker, const Cloud& cloud,
+          const std::vector<facyl::RecognizedObject>& objects, const Eigen::Affine3f& sensor,
+          const Layers& layers)
+{
+  const auto c = trackColour(t.id);
+  const std::string id = "t" + std::to_string(t.id);
+  const bool seen = t.status == facyl::TrackStatus::Seen;
+  const facyl::RecognizedObject* object =
+    seen && t.object >= 0 && static_cast<std::size_t>(t.object) < objects.size()
+      ? &objects[static_cast<std::size_t>(t.object)]
+      : nullptr;
+  const std::string status = seen ? "" : " " + facyl::toString(t.status);
+  Eigen::Vector3f label_at = tracker.centroidInFrame(t);
+  char label[160];
+  if (tracker.isCylinder(t)) {
+    const facyl::CylinderModel m = tracker.cylinderInFrame(t);
+    if (layers.cylinders) {
+      drawCylinder(viewer, m, id + "_cyl", 0, c[0], c[1], c[2]);
+      viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY,
+                                              seen ? 0.85 : 0.3, id + "_cyl", 0);
+      if (object && object->is_cylinder)
+        drawCylinderOutline(viewer, object->cylinder, id + "_frame", 0, 1.0, 1.0, 1.0);
+    }
+    std::snprintf(label, sizeof label, "#%d r=%.1fmm h=%.1fmm p=%.2f%s", t.id, m.radius * 1e3f,
+                  m.height * 1e3f, t.pCylinder(), status.c_str());
+    label_at = m.top + 1.2f * m.radius * sensor.linear().col(0); // not over the mesh's colour
+  }
+  else if (object) {
+    Eigen::Vector3f box_min, box_max;
+    boxOf(cloud, object->cluster.indices.indices, box_min, box_max);
+    if (layers.boxes)
+      drawBox(viewer, box_min, box_max, id + "_box", 0, c[0], c[1], c[2], t.confirmed ? 2 : 1);
+    std::snprintf(label, sizeof label, "#%d%s", t.id, t.confirmed ? "" : " (new)");
+    label_at = box_min;
+  }
+  else if (t.confirmed)
+    std::snprintf(label, sizeof label, "#%d%s", t.id, status.c_str());
+  else
+    return;
+  if (layers.labels)
+    drawLabel(viewer, label, label_at, sensor.translation(), id + "_label", 0, c[0], c[1], c[2]);
+}
+
+/** One frame of --stream: the cloud, the table, and every track (drawTrack). */
 void
 drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cloud,
             const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
@@ -56,75 +105,40 @@ drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cl
   if (layers.table) {
     drawTable(viewer, tableOutline(rec), "s_", 0);
   }
-  for (const auto& t : tracker.getTracks()) {
-    const auto c = trackColour(t.id);
-    const std::string id = "t" + std::to_string(t.id);
-    const bool seen = t.status == facyl::TrackStatus::Seen;
-    Eigen::Vector3f label_at = tracker.centroidInFrame(t);
-    std::string label;
-    char buf[160];
-    if (tracker.isCylinder(t)) {
-      const facyl::CylinderModel m = tracker.cylinderInFrame(t);
-      if (layers.cylinders) {
-        drawCylinder(viewer, m, id + "_cyl", 0, c[0], c[1], c[2]);
-        viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY,
-                                                seen ? 0.85 : 0.3, id + "_cyl", 0);
-      }
-      std::snprintf(buf, sizeof buf, "#%d r=%.1fmm h=%.1fmm p=%.2f%s", t.id, m.radius * 1e3f,
-                    m.height * 1e3f, t.pCylinder(),
-                    seen ? "" : (" " + facyl::toString(t.status)).c_str());
-      label_at = m.top;
-    }
-    else if (seen && t.object >= 0 && static_cast<std::size_t>(t.object) < objects.size()) {
-      Eigen::Vector3f box_min, box_max;
-      boxOf(*cloud, objects[static_cast<std::size_t>(t.object)].cluster.indices.indices, box_min,
-            box_max);
-      if (layers.boxes) {
-        viewer.addCube(box_min.x(), box_max.x(), box_min.y(), box_max.y(), box_min.z(), box_max.z(),
-                       c[0], c[1], c[2], id + "_box");
-        viewer.setShapeRenderingProperties(
-          pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
-          pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME, id + "_box");
-        viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH,
-                                           t.confirmed ? 2 : 1, id + "_box");
-      }
-      std::snprintf(buf, sizeof buf, "#%d%s", t.id, t.confirmed ? "" : " (new)");
-      label_at = box_min;
-    }
-    else
-      continue;
-    label = buf;
-    if (layers.labels)
-      viewer.addText3D(label, pcl::PointXYZ(label_at.x(), label_at.y(), label_at.z()), 0.008, c[0],
-                       c[1], c[2], id + "_label");
-  }
+  const Eigen::Affine3f sensor = facyl::plausibleSensorPose(*cloud);
+  for (const auto& t : tracker.getTracks())
+    drawTrack(viewer, t, tracker, *cloud, objects, sensor, layers);
   viewer.addText(title, 10, 10, 14, 0.8, 0.8, 0.8, "title");
 }
 
-/** The frame's tracks as one JSON line: {"frame", "file", "objects", "tracks": [{"track_id",
- * "confirmed", "is_cylinder", "status", "object"}]}, or {"frame", "file", "error"}. */
+/** The frame's JSON line: "frame" (its number in the stream), then what facyl_detect --track
+ * prints for it (track_json.h: the objects with their tracks, "stream" and "tracks" with their
+ * geometry). */
 std::string
-streamLine(std::size_t frame, const std::string& file, const facyl::CylinderTracker* tracker,
-           std::size_t objects, const std::string& error = {})
+streamLine(std::size_t frame, const std::string& file, const Cloud& cloud,
+           const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
+           const std::vector<facyl::RecognizedObject>& objects,
+           const facyl::CylinderTracker& tracker)
+{
+  Json scene = facyl_cli::trackedSceneJson(file, cloud, rec, objects, rec.getTiming(), tracker);
+  Json out;
+  out["frame"] = frame;
+  for (auto& [key, value] : scene.items())
+    out[key] = std::move(value);
+  return facyl_cli::dumpJson(out);
+}
+
+/** The JSON line of a frame that could not be tracked (after tracker.skipFrame()): "frame",
+ * "file", "error", and the stream's fields as facyl_detect --track prints them. */
+std::string
+errorLine(std::size_t frame, const std::string& file, const std::string& error,
+          const facyl::CylinderTracker& tracker)
 {
   Json out;
   out["frame"] = frame;
   out["file"] = file;
-  if (!error.empty()) {
-    out["error"] = error;
-    return facyl_cli::dumpJson(out);
-  }
-  out["objects"] = objects;
-  out["tracks"] = Json::array();
-  for (const auto& t : tracker->getTracks()) {
-    Json j;
-    j["track_id"] = t.id;
-    j["confirmed"] = t.confirmed;
-    j["is_cylinder"] = tracker->isCylinder(t);
-    j["status"] = facyl::toString(t.status);
-    j["object"] = t.object >= 0 ? Json(t.object) : Json(nullptr);
-    out["tracks"].push_back(std::move(j));
-  }
+  out["error"] = error;
+  facyl_cli::addStreamFields(out, tracker, nullptr);
   return facyl_cli::dumpJson(out);
 }
 
@@ -177,8 +191,8 @@ runStream(const StreamSettings& s)
     for (const auto& why : frame.skipped) { // unreadable: nothing known, the tracks are kept
       std::fprintf(stderr, "facyl_viewer: %s\n", why.c_str());
       tracker.skipFrame();
-      std::cout << streamLine(number++, why.substr(0, why.find(": ")), nullptr, 0,
-                              "PCL's reader could not read it")
+      std::cout << errorLine(number++, why.substr(0, why.find(": ")),
+                             "PCL's reader could not read it", tracker)
                 << std::endl;
     }
     const Cloud::ConstPtr& cloud = frame.cloud;
@@ -194,12 +208,12 @@ runStream(const StreamSettings& s)
       tracker.skipFrame();
       std::fprintf(stderr, "facyl_viewer: %s: %s (the tracks are kept)\n", frame.name.c_str(),
                    error.c_str());
-      std::cout << streamLine(number++, frame.name, nullptr, 0, error) << std::endl;
+      std::cout << errorLine(number++, frame.name, error, tracker) << std::endl;
       ++processed;
       continue;
     }
     tracker.update(rec, objects);
-    std::cout << streamLine(number++, frame.name, &tracker, objects.size()) << std::endl;
+    std::cout << streamLine(number++, frame.name, *cloud, rec, objects, tracker) << std::endl;
     title = frame.name + "  (frame " + std::to_string(frame.index) + ", " +
             std::to_string(tracker.getTracks().size()) + " tracks)";
     drawTracked(viewer, cloud, rec, objects, tracker, title, layers);
