@@ -3,7 +3,9 @@
  * One JSON object per scene on stdout.
  */
 #include <facyl/tools/cli.h>
+#include <facyl/tools/depth_colours.h>
 #include <facyl/tools/detect_json.h>
+#include <facyl/tools/detect_overlay.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/recognizer_options.h>
 #include <facyl/tools/track_json.h>
@@ -43,9 +45,11 @@ printHelp(const char* self)
     "Output:\n"
     "  --camera fx,fy,cx,cy   intrinsics for boxes of unorganized clouds (and their overlay)\n"
     "  --overlay OUT.png      RGB image with boxes (green: cylinder, red: not) and fitted\n"
-    "                         outlines; with several scenes a folder (<stem>.png;\n"
-    "                         <stem>-<k>.png when scenes share a name, k from 1). A path not\n"
-    "                         ending in .png, or one that is an input, is refused\n"
+    "                         outlines; a cloud without colour is coloured by depth (near\n"
+    "                         red, middle grey, far blue). With several scenes a folder\n"
+    "                         (<stem>.png; <stem>-<k>.png when scenes share a name, k from\n"
+    "                         1). A path not ending in .png, or one that is an input, is\n"
+    "                         refused\n"
     "  --save-clusters DIR    each object's cloud (<stem>_obj<k>.pcd) and RGB crop (.png);\n"
     "                         refused when DIR holds an input (a later *.pcd there would\n"
     "                         read the clusters as scenes) or a name it would write is one\n"
@@ -63,6 +67,9 @@ printHelp(const char* self)
     "                         become the track's decision and filtered estimate (in this\n"
     "                         frame), \"is_cylinder_frame\" and \"cylinder_frame\" the frame's\n"
     "                         own; each line adds \"stream\" and \"tracks\" (every live track).\n"
+    "                         --overlay shows the same: boxes and solid outlines by the\n"
+    "                         track, the frame's own cylinder dashed magenta, the track's id\n"
+    "                         (\"#7\") over each box.\n"
     "                         A frame that fails (its line has \"error\") does not end the\n"
     "                         stream; frames of a new scene start new tracks. docs/tracking.md\n"
     "%s%s"
@@ -72,61 +79,6 @@ printHelp(const char* self)
     self, facyl_cli::recognizerOptionsHelp(),
     facyl_cli::helpText(facyl_cli::trackerOptions(), facyl::CylinderTrackerParameters{}).c_str(),
     facyl_cli::commonHelp());
-}
-
-// ---- drawing on an RGB buffer ----
-struct Canvas {
-  int width{0}, height{0};
-  std::vector<unsigned char> rgb;
-  void put(int u, int v, const std::array<unsigned char, 3>& c)
-  {
-    if (u < 0 || v < 0 || u >= width || v >= height)
-      return;
-    std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::size_t>(v) * width + u));
-  }
-  void line(Eigen::Vector2f a, Eigen::Vector2f b, const std::array<unsigned char, 3>& c,
-            int thick = 1)
-  {
-    if (!a.allFinite() || !b.allFinite() || (a - b).norm() > 4.f * (width + height))
-      return;
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).lpNorm<Eigen::Infinity>())));
-    for (int s = 0; s <= steps; ++s) {
-      const Eigen::Vector2f p = a + (b - a) * (static_cast<float>(s) / steps);
-      for (int dv = 0; dv < thick; ++dv)
-        for (int du = 0; du < thick; ++du)
-          put(static_cast<int>(std::lround(p.x())) + du, static_cast<int>(std::lround(p.y())) + dv,
-              c);
-    }
-  }
-};
-
-void
-drawCylinder(Canvas& canvas, const facyl::PinholeCamera& cam, const facyl::CylinderModel& m,
-             const std::array<unsigned char, 3>& colour)
-{
-  const Eigen::Vector3f a = m.axis.normalized();
-  Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
-  auto project = [&](const Eigen::Vector3f& p) {
-    return p.z() > 0.f ? cam.project(p) : Eigen::Vector2f::Constant(NAN);
-  };
-  for (const Eigen::Vector3f& c : {m.base, m.top}) {
-    Eigen::Vector2f prev;
-    for (int k = 0; k <= 48; ++k) {
-      const float t = 2.f * static_cast<float>(M_PI) * k / 48.f;
-      const Eigen::Vector2f q = project(c + m.radius * (std::cos(t) * e1 + std::sin(t) * e2));
-      if (k)
-        canvas.line(prev, q, colour);
-      prev = q;
-    }
-  }
-  // Silhouette generators: perpendicular to both the axis and the line of sight.
-  const Eigen::Vector3f centre = 0.5f * (m.base + m.top);
-  Eigen::Vector3f side = a.cross(centre);
-  if (side.norm() < 1e-6f)
-    return;
-  side = side.normalized() * m.radius;
-  for (float s : {-1.f, 1.f})
-    canvas.line(project(m.base + s * side), project(m.top + s * side), colour, 2);
 }
 
 /** The name of each scene's outputs (overlay, clusters): its file name's stem, or, when
@@ -187,22 +139,30 @@ drawingCamera(const Cloud& cloud, const facyl::PinholeCamera& given)
   return camera;
 }
 
-/** The overlay image: the RGB frame (or the points projected with the camera) with a box per
- * object (green: cylinder, red: not) and the fitted cylinders' outlines.
+/** The overlay image: the RGB frame (or the points projected with the camera; a cloud without
+ * colour coloured by depth) with the objects \a shown (detect_overlay.h: a box per object,
+ * green: cylinder, red: not; the cylinders' outlines; with --track the tracks' ids).
  * \return false when the image could not be written (\a why says so); true with \a why set
  * when there is no overlay to draw (a warning), true with \a why empty when it was written. */
 bool
 drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCamera& camera,
-            const std::vector<facyl::RecognizedObject>& objects, std::string& why)
+            const std::vector<facyl_cli::OverlayObject>& shown, std::string& why)
 {
   why.clear();
-  Canvas canvas;
-  if (cloud.isOrganized()) {
-    canvas.width = static_cast<int>(cloud.width);
-    canvas.height = static_cast<int>(cloud.height);
-    canvas.rgb.resize(3 * cloud.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const auto& p = cloud[i];
+  // A cloud without colour is drawn by its depth: black points on black show nothing.
+  Cloud by_depth;
+  if (!facyl_cli::hasColour(cloud)) {
+    by_depth = cloud;
+    facyl_cli::colourByDepth(by_depth);
+  }
+  const Cloud& drawn = by_depth.empty() ? cloud : by_depth;
+  facyl_cli::Canvas canvas;
+  if (drawn.isOrganized()) {
+    canvas.width = static_cast<int>(drawn.width);
+    canvas.height = static_cast<int>(drawn.height);
+    canvas.rgb.resize(3 * drawn.size());
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+      const auto& p = drawn[i];
       canvas.rgb[3 * i] = p.r, canvas.rgb[3 * i + 1] = p.g, canvas.rgb[3 * i + 2] = p.b;
     }
   }
@@ -210,7 +170,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
     canvas.width = camera.width;
     canvas.height = camera.height;
     canvas.rgb.assign(3 * static_cast<std::size_t>(camera.width) * camera.height, 0);
-    for (const auto& p : cloud)
+    for (const auto& p : drawn)
       if (pcl::isFinite(p) && p.z > 0.f) {
         const Eigen::Vector2f q = camera.project(p.getVector3fMap());
         canvas.put(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())),
@@ -221,18 +181,7 @@ drawOverlay(const std::string& path, const Cloud& cloud, const facyl::PinholeCam
     why = "no overlay: an unorganized cloud needs --camera fx,fy,cx,cy";
     return true;
   }
-  const std::array<unsigned char, 3> green{0, 230, 0}, red{230, 0, 0}, yellow{255, 230, 0};
-  for (const auto& o : objects) {
-    const auto& b = o.cluster.box;
-    if (b[0] >= 0) {
-      const auto& c = o.is_cylinder ? green : red;
-      const Eigen::Vector2f p00(b[0], b[1]), p10(b[2], b[1]), p11(b[2], b[3]), p01(b[0], b[3]);
-      canvas.line(p00, p10, c, 2), canvas.line(p10, p11, c, 2);
-      canvas.line(p11, p01, c, 2), canvas.line(p01, p00, c, 2);
-    }
-    if (o.is_cylinder && camera.valid())
-      drawCylinder(canvas, camera, o.cylinder, yellow);
-  }
+  facyl_cli::drawOverlayObjects(canvas, camera, shown);
   std::error_code ec;
   std::filesystem::remove(path, ec); // so that a stale image does not pass for this one
   pcl::io::saveRgbPNGFile(path, canvas.rgb.data(), canvas.width, canvas.height);
@@ -354,7 +303,9 @@ processScene(const std::string& file, const std::string& name, const Settings& s
     const std::string path =
       s.many ? (std::filesystem::path(s.overlay) / (name + ".png")).string() : s.overlay;
     std::string why;
-    if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), objects, why))
+    const auto shown = stream ? facyl_cli::trackedOverlayObjects(objects, stream->tracker)
+                              : facyl_cli::overlayObjects(objects);
+    if (!drawOverlay(path, *cloud, drawingCamera(*cloud, s.camera), shown, why))
       error = why;
     else if (!why.empty())
       warning += (warning.empty() ? "" : "; ") + why;

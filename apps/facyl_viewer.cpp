@@ -1,14 +1,16 @@
 /*
  * facyl_viewer: a pcl_viewer-style 3-D viewer of scenes and their cylinders
- * (pcl::visualization::PCLVisualizer). The cloud in its colours, the table outline, accepted
- * cylinders as finite green meshes from base to top, rejected objects as red boxes, a label
- * per object; optionally PCL's SACMODEL_CYLINDER on the same clusters in a second viewport,
- * or one object's orientation accumulators for the three voting modes. --screenshot renders
- * and exits (under xvfb-run without a screen).
+ * (pcl::visualization::PCLVisualizer). The cloud in its colours (by depth without colour),
+ * the table outline, accepted cylinders as finite green meshes from base to top, rejected
+ * objects as red boxes, a label per object; optionally PCL's SACMODEL_CYLINDER on the same
+ * clusters in a second viewport, or one object's orientation accumulators for the three voting
+ * modes. --screenshot renders and exits (under xvfb-run without a screen).
  */
+#include "viewer/scene_drawing.h"
+#include "viewer/stream_view.h"
+
 #include <facyl/tools/cli.h>
 #include <facyl/tools/cylinder_fit.h>
-#include <facyl/tools/frame_stream.h>
 #include <facyl/tools/json_writer.h>
 #include <facyl/tools/pcd_input.h>
 #include <facyl/tools/pcl_baseline.h>
@@ -19,9 +21,7 @@
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 #include <facyl/sample_consensus_alt/orientation_accumulator.h>
-#include <facyl/tracking/cylinder_tracker.h>
 
-#include <pcl/PolygonMesh.h>
 #include <pcl/common/common.h>
 #include <pcl/common/io.h>
 #include <pcl/common/point_tests.h>
@@ -29,24 +29,25 @@
 #include <pcl/conversions.h>
 #include <pcl/visualization/pcl_visualizer.h>
 
-#include <vtkCamera.h>
-#include <vtkRenderer.h>
-#include <vtkRendererCollection.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 
 namespace {
 
-using Cloud = pcl::PointCloud<pcl::PointXYZRGBA>;
+using facyl_viewer::boxOf;
+using facyl_viewer::Cloud;
+using facyl_viewer::drawCylinder;
+using facyl_viewer::drawnCloud;
+using facyl_viewer::drawTable;
+using facyl_viewer::Layers;
+using facyl_viewer::sensorCamera;
+using facyl_viewer::tableOutline;
 
 constexpr int kDefaultWidth = 1024, kDefaultHeight = 768;
-constexpr int kMeshSegments = 36;
 constexpr float kPclMinInlierRatio = 0.5f; // PCL's fit is drawn as a cylinder from this on
 
 void
@@ -62,8 +63,11 @@ printHelp(const char* self)
     "                        or openni2 / openni2:DEVICE (pcl::io::OpenNI2Grabber, when PCL\n"
     "                        has OpenNI2 and a device is present). Each track is drawn in its\n"
     "                        own colour with its id (\"#7\"): confirmed cylinders as meshes\n"
-    "                        (faint while hidden or missed), other objects as boxes. One JSON\n"
-    "                        line per frame on standard output: its tracks and their ids.\n"
+    "                        of the filtered cylinder (faint while hidden or missed), with\n"
+    "                        this frame's own fit as a white outline beside it; other objects\n"
+    "                        as boxes. One JSON line per frame on standard output: \"frame\"\n"
+    "                        and what facyl_detect --track prints for it (the objects with\n"
+    "                        their track ids and cylinders, \"stream\", \"tracks\").\n"
     "                        Unreadable frames are skipped with a message; the tracks are kept\n"
     "  --rate FPS            --stream of PCD frames: play at FPS frames per second (frames\n"
     "                        that arrive while one is processed are dropped, as from a\n"
@@ -89,7 +93,8 @@ printHelp(const char* self)
     "The cloud, the table and the cylinders are drawn in the cloud's own frame, seen from its\n"
     "sensor (the VIEWPOINT; a pose that puts the points behind the sensor, as PCL's grabber\n"
     "frames store, is taken as the identity rotation, as the recognizer does). A frame\n"
-    "without any support is shown with its objects and no table outline.\n"
+    "without any support is shown with its objects and no table outline. A cloud without\n"
+    "colour (x y z only) is coloured by depth: near red, middle grey, far blue.\n"
     "The recognizer's options (--detect; as in facyl_detect):\n%s"
     "Keys (besides pcl_viewer's: r reset camera, j screenshot, h help): n / p next /\n"
     "previous file, o next object (prints its numbers), t table, c cylinders, b boxes,\n"
@@ -137,7 +142,8 @@ struct Settings {
   long long frames{0}; ///< --frames; 0: all
 };
 
-/** The file as an XYZRGBA cloud (grey without colour). \throws std::runtime_error. */
+/** The file as an XYZRGBA cloud (black without colour: drawnCloud colours it by depth).
+ * \throws std::runtime_error. */
 Cloud::Ptr
 loadCloud(const std::string& file)
 {
@@ -148,45 +154,11 @@ loadCloud(const std::string& file)
     throw std::runtime_error(why);
   Cloud::Ptr cloud(new Cloud);
   pcl::fromPCLPointCloud2(blob, *cloud);
-  if (!facyl_cli::hasField(blob, "rgb") && !facyl_cli::hasField(blob, "rgba"))
-    for (auto& p : *cloud)
-      p.r = p.g = p.b = 160, p.a = 255;
   cloud->sensor_origin_ = viewpoint.origin;
   cloud->sensor_orientation_ = viewpoint.orientation;
   if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))
     throw std::runtime_error("the cloud has no finite point");
   return cloud;
-}
-
-void
-boxOf(const Cloud& cloud, const pcl::Indices& indices, ViewObject& o)
-{
-  o.box_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-  o.box_max = -o.box_min;
-  for (const auto i : indices) {
-    const Eigen::Vector3f p = cloud[static_cast<std::size_t>(i)].getVector3fMap();
-    o.box_min = o.box_min.cwiseMin(p);
-    o.box_max = o.box_max.cwiseMax(p);
-  }
-}
-
-std::vector<Eigen::Vector3f>
-tableOutline(const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec)
-{
-  std::vector<Eigen::Vector3f> outline;
-  const auto& supports = rec.getSupports();
-  const auto& t = rec.getTableCoefficients().values;
-  if (supports.empty() || t.size() != 4)
-    return outline;
-  // The support whose plane is the table's.
-  const Eigen::Vector4f table(t[0], t[1], t[2], t[3]);
-  const auto best =
-    std::min_element(supports.begin(), supports.end(), [&](const auto& a, const auto& b) {
-      return (a.plane - table).norm() < (b.plane - table).norm();
-    });
-  for (const auto& q : best->polygon)
-    outline.push_back(best->frame * Eigen::Vector3f(q.x(), q.y(), 0.f));
-  return outline;
 }
 
 /** --detect: the recognizer's objects. */
@@ -211,7 +183,7 @@ detectObjects(const Settings& s, Scene& scene)
     o.centroid = r.cluster.centroid;
     o.p_cylinder = r.evidence.p_cylinder;
     o.indices = r.cluster.indices.indices;
-    boxOf(*scene.cloud, o.indices, o);
+    boxOf(*scene.cloud, o.indices, o.box_min, o.box_max);
     scene.objects.push_back(std::move(o));
   }
 }
@@ -319,42 +291,6 @@ detectionFor(const std::vector<Json>& lines, const std::string& file, std::size_
 
 // ----------------------------------------------------------------------------- drawing
 
-/** A closed finite cylinder from \a m.base to \a m.top, \a segments around. */
-pcl::PolygonMesh
-cylinderMesh(const facyl::CylinderModel& m, int segments)
-{
-  Eigen::Vector3f a = m.top - m.base;
-  if (!(a.norm() > 1e-6f))
-    a = m.axis * std::max(m.height, 1e-3f);
-  const Eigen::Vector3f axis = a.normalized();
-  Eigen::Vector3f u = axis.unitOrthogonal(), v = axis.cross(u);
-  pcl::PointCloud<pcl::PointXYZ> vertices;
-  for (int ring = 0; ring < 2; ++ring)
-    for (int k = 0; k < segments; ++k) {
-      const float t =
-        2.f * static_cast<float>(M_PI) * static_cast<float>(k) / static_cast<float>(segments);
-      const Eigen::Vector3f p = m.base + (ring ? a : Eigen::Vector3f::Zero()) +
-                                m.radius * (std::cos(t) * u + std::sin(t) * v);
-      vertices.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    }
-  vertices.push_back(pcl::PointXYZ(m.base.x(), m.base.y(), m.base.z()));
-  const Eigen::Vector3f top = m.base + a;
-  vertices.push_back(pcl::PointXYZ(top.x(), top.y(), top.z()));
-  pcl::PolygonMesh mesh;
-  pcl::toPCLPointCloud2(vertices, mesh.cloud);
-  const pcl::index_t n = segments;
-  for (pcl::index_t k = 0; k < n; ++k) {
-    const pcl::index_t k1 = (k + 1) % n;
-    for (pcl::Indices face : {pcl::Indices{k, k1, n + k1, n + k}, pcl::Indices{2 * n, k1, k},
-                              pcl::Indices{2 * n + 1, n + k, n + k1}}) {
-      pcl::Vertices v;
-      v.vertices = std::move(face); // side, bottom, lid
-      mesh.polygons.push_back(std::move(v));
-    }
-  }
-  return mesh;
-}
-
 std::string
 labelOf(const ViewObject& o, std::size_t id)
 {
@@ -367,23 +303,6 @@ labelOf(const ViewObject& o, std::size_t id)
   else
     std::snprintf(buf, sizeof buf, "#%zu not a cylinder%s", id, p.c_str());
   return buf;
-}
-
-/** Which layers are shown. */
-struct Layers {
-  bool table{true}, cylinders{true}, boxes{true}, labels{true};
-};
-
-void
-drawCylinder(pcl::visualization::PCLVisualizer& viewer, const facyl::CylinderModel& m,
-             const std::string& id, int viewport, double r, double g, double b)
-{
-  // Meshes live with the clouds in PCLVisualizer: their properties are point-cloud ones.
-  viewer.addPolygonMesh(cylinderMesh(m, kMeshSegments), id, viewport);
-  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_COLOR, r, g, b, id,
-                                          viewport);
-  viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY, 0.85, id,
-                                          viewport);
 }
 
 void
@@ -410,84 +329,6 @@ drawObjects(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const
                        viewport);
     }
   }
-}
-
-void
-drawTable(pcl::visualization::PCLVisualizer& viewer, const Scene& scene, const std::string& tag,
-          int viewport)
-{
-  if (scene.table_outline.size() < 3)
-    return;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr polygon(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto& p : scene.table_outline)
-    polygon->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  viewer.addPolygon<pcl::PointXYZ>(polygon, 0.2, 0.5, 1.0, tag + "table", viewport);
-  viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH, 3,
-                                     tag + "table", viewport);
-}
-
-/** The camera at the cloud's sensor, looking along its z (image y down), as pcl_viewer does.
- * The pose is the one the recognizer uses (facyl::plausibleSensorPose): PCL's grabber frames
- * store a 180-degree turn about x with the points in the camera's frame, and the camera must
- * then look along +z to see them. An organized frame is seen with its own intrinsics
- * (estimated from its points and pixels: field of view from fy, the principal point as the
- * window centre), so that a screenshot of its size lies on the frame's image; other clouds
- * with a Kinect's field of view. */
-void
-sensorCamera(pcl::visualization::PCLVisualizer& viewer, const Cloud& cloud, int viewport)
-{
-  const Eigen::Affine3f pose = facyl::plausibleSensorPose(cloud);
-  const Eigen::Vector3f o = pose.translation();
-  const Eigen::Matrix3f r = pose.linear();
-  const Eigen::Vector3f look = o + r.col(2), up = -r.col(1);
-  viewer.setCameraPosition(o.x(), o.y(), o.z(), look.x(), look.y(), look.z(), up.x(), up.y(),
-                           up.z(), viewport);
-  double fov = 49.0 * M_PI / 180.0; // a Kinect's vertical field of view
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  if (cloud.isOrganized() && cloud.height > 1) {
-    const Eigen::Affine3f to_sensor = pose.inverse();
-    const std::size_t step = std::max<std::size_t>(1, cloud.size() / 4000);
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(cloud.size() / step + 1));
-    Eigen::Matrix2Xf px(2, pts.cols());
-    Eigen::Index n = 0;
-    for (std::size_t i = 0; i < cloud.size(); i += step)
-      if (pcl::isFinite(cloud[i])) {
-        pts.col(n) = to_sensor * cloud[i].getVector3fMap();
-        px.col(n++) =
-          Eigen::Vector2f(static_cast<float>(i % cloud.width), static_cast<float>(i / cloud.width));
-      }
-    facyl::PinholeCamera camera;
-    const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
-    if (facyl::estimatePinhole(pts.leftCols(n), px.leftCols(n), w, h, camera) && camera.fy > 0.f) {
-      fov = 2.0 * std::atan(0.5 * h / camera.fy);
-      // VTK moves the optical axis to -WindowCenter in normalized device coordinates.
-      centre =
-        Eigen::Vector2d(1.0 - 2.0 * (camera.cx + 0.5) / w, 2.0 * (camera.cy + 0.5) / h - 1.0);
-    }
-  }
-  viewer.setCameraFieldOfView(fov, viewport);
-  viewer.setCameraClipDistances(0.01, 50.0, viewport);
-  auto renderers = viewer.getRendererCollection();
-  renderers->InitTraversal();
-  int i = 0;
-  while (vtkRenderer* renderer = renderers->GetNextItem()) {
-    if (viewport == 0 || viewport == i)
-      renderer->GetActiveCamera()->SetWindowCenter(centre.x(), centre.y());
-    ++i;
-  }
-}
-
-/** The cloud as drawn: its points in its own frame. PCLVisualizer would move a cloud by its
- * sensor pose (sensor_origin_, sensor_orientation_), while the recognizer's table, cylinders
- * and boxes are in the cloud's frame: drawn with the pose, a grabber frame (VIEWPOINT
- * 0 0 0 0 1 0 0) ends up turned away from everything found on it. */
-Cloud::ConstPtr
-drawnCloud(const Cloud& cloud)
-{
-  Cloud::Ptr drawn(new Cloud(cloud));
-  drawn->sensor_origin_ = Eigen::Vector4f::Zero();
-  drawn->sensor_orientation_ = Eigen::Quaternionf::Identity();
-  return drawn;
 }
 
 // ------------------------------------------------------------------------ PCL comparison
@@ -696,7 +537,7 @@ private:
     }
     viewer_.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud", left);
     if (layers_.table)
-      drawTable(viewer_, scene_, "f_", left);
+      drawTable(viewer_, scene_.table_outline, "f_", left);
     drawObjects(viewer_, scene_, layers_, "f_", left);
     sensorCamera(viewer_, *scene_.cloud, left);
     if (s_.compare_pcl) {
@@ -760,222 +601,6 @@ private:
   mutable std::vector<Json> lines_;
   mutable bool lines_loaded_{false};
 };
-
-// ------------------------------------------------------------------------------- streams
-
-/** A colour of its own for each track id (golden-ratio hues). */
-std::array<double, 3>
-trackColour(int id)
-{
-  const double h = std::fmod(0.13 + 0.618034 * id, 1.0) * 6.0;
-  const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
-  const int sector = static_cast<int>(h);
-  const std::array<std::array<double, 3>, 6> rgb{
-    {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}}};
-  auto c = rgb[static_cast<std::size_t>(sector % 6)];
-  for (auto& v : c)
-    v = 0.25 + 0.75 * v;
-  return c;
-}
-
-/** One frame of --stream: the cloud, the table, every confirmed track in its colour with its
- * id (cylinders as meshes, faint when the frame did not see them; other objects as the box of
- * their points), tentative ones as thin boxes. */
-void
-drawTracked(pcl::visualization::PCLVisualizer& viewer, const Cloud::ConstPtr& cloud,
-            const facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA>& rec,
-            const std::vector<facyl::RecognizedObject>& objects,
-            const facyl::CylinderTracker& tracker, const std::string& title, const Layers& layers)
-{
-  viewer.removeAllPointClouds();
-  viewer.removeAllShapes();
-  const Cloud::ConstPtr drawn = drawnCloud(*cloud);
-  pcl::visualization::PointCloudColorHandlerRGBField<pcl::PointXYZRGBA> rgb(drawn);
-  viewer.addPointCloud<pcl::PointXYZRGBA>(drawn, rgb, "cloud");
-  if (layers.table) {
-    Scene scene;
-    scene.table_outline = tableOutline(rec);
-    drawTable(viewer, scene, "s_", 0);
-  }
-  for (const auto& t : tracker.getTracks()) {
-    const auto c = trackColour(t.id);
-    const std::string id = "t" + std::to_string(t.id);
-    const bool seen = t.status == facyl::TrackStatus::Seen;
-    Eigen::Vector3f label_at = tracker.centroidInFrame(t);
-    std::string label;
-    char buf[160];
-    if (tracker.isCylinder(t)) {
-      const facyl::CylinderModel m = tracker.cylinderInFrame(t);
-      if (layers.cylinders) {
-        drawCylinder(viewer, m, id + "_cyl", 0, c[0], c[1], c[2]);
-        viewer.setPointCloudRenderingProperties(pcl::visualization::PCL_VISUALIZER_OPACITY,
-                                                seen ? 0.85 : 0.3, id + "_cyl", 0);
-      }
-      std::snprintf(buf, sizeof buf, "#%d r=%.1fmm h=%.1fmm p=%.2f%s", t.id, m.radius * 1e3f,
-                    m.height * 1e3f, t.pCylinder(),
-                    seen ? "" : (" " + facyl::toString(t.status)).c_str());
-      label_at = m.top;
-    }
-    else if (seen && t.object >= 0 && static_cast<std::size_t>(t.object) < objects.size()) {
-      ViewObject o;
-      boxOf(*cloud, objects[static_cast<std::size_t>(t.object)].cluster.indices.indices, o);
-      if (layers.boxes) {
-        viewer.addCube(o.box_min.x(), o.box_max.x(), o.box_min.y(), o.box_max.y(), o.box_min.z(),
-                       o.box_max.z(), c[0], c[1], c[2], id + "_box");
-        viewer.setShapeRenderingProperties(
-          pcl::visualization::PCL_VISUALIZER_REPRESENTATION,
-          pcl::visualization::PCL_VISUALIZER_REPRESENTATION_WIREFRAME, id + "_box");
-        viewer.setShapeRenderingProperties(pcl::visualization::PCL_VISUALIZER_LINE_WIDTH,
-                                           t.confirmed ? 2 : 1, id + "_box");
-      }
-      std::snprintf(buf, sizeof buf, "#%d%s", t.id, t.confirmed ? "" : " (new)");
-      label_at = o.box_min;
-    }
-    else
-      continue;
-    label = buf;
-    if (layers.labels)
-      viewer.addText3D(label, pcl::PointXYZ(label_at.x(), label_at.y(), label_at.z()), 0.008, c[0],
-                       c[1], c[2], id + "_label");
-  }
-  viewer.addText(title, 10, 10, 14, 0.8, 0.8, 0.8, "title");
-}
-
-/** The frame's tracks as one JSON line: {"frame", "file", "objects", "tracks": [{"track_id",
- * "confirmed", "is_cylinder", "status", "object"}]}, or {"frame", "file", "error"}. */
-std::string
-streamLine(std::size_t frame, const std::string& file, const facyl::CylinderTracker* tracker,
-           std::size_t objects, const std::string& error = {})
-{
-  Json out;
-  out["frame"] = frame;
-  out["file"] = file;
-  if (!error.empty()) {
-    out["error"] = error;
-    return facyl_cli::dumpJson(out);
-  }
-  out["objects"] = objects;
-  out["tracks"] = Json::array();
-  for (const auto& t : tracker->getTracks()) {
-    Json j;
-    j["track_id"] = t.id;
-    j["confirmed"] = t.confirmed;
-    j["is_cylinder"] = tracker->isCylinder(t);
-    j["status"] = facyl::toString(t.status);
-    j["object"] = t.object >= 0 ? Json(t.object) : Json(nullptr);
-    out["tracks"].push_back(std::move(j));
-  }
-  return facyl_cli::dumpJson(out);
-}
-
-/** --stream: frames from a grabber, recognized and tracked, drawn as they come. */
-int
-runStream(const Settings& s)
-{
-  facyl_cli::FrameStream stream(s.stream, s.rate, s.loop);
-  for (const auto& r : stream.rejected())
-    std::fprintf(stderr, "facyl_viewer: %s: left out of the stream\n", r.c_str());
-  pcl::visualization::PCLVisualizer viewer("facyl_viewer: " + stream.description());
-  viewer.setSize(s.width, s.height);
-  viewer.setBackgroundColor(0.05, 0.05, 0.08);
-  viewer.setShowFPS(false);
-  Layers layers;
-  bool redraw = false;
-  viewer.registerKeyboardCallback([&](const pcl::visualization::KeyboardEvent& e) {
-    if (!e.keyDown())
-      return;
-    const std::string key = e.getKeySym();
-    bool* layer = key == "t"   ? &layers.table
-                  : key == "c" ? &layers.cylinders
-                  : key == "b" ? &layers.boxes
-                  : key == "l" ? &layers.labels
-                               : nullptr;
-    if (layer) {
-      *layer = !*layer;
-      redraw = true;
-    }
-  });
-  facyl::TabletopCylinderRecognizer<pcl::PointXYZRGBA> rec;
-  rec.setParameters(s.params);
-  rec.setUpDirection(s.up);
-  rec.setClassifier(s.classifier);
-  facyl::CylinderTracker tracker;
-  std::vector<facyl::RecognizedObject> objects;
-  Cloud::ConstPtr shown;
-  std::string title;
-  std::size_t processed = 0, number = 0;
-  while (!viewer.wasStopped() && !(s.frames > 0 && static_cast<long long>(processed) >= s.frames)) {
-    facyl_cli::StreamFrame frame;
-    if (!stream.next(frame, 0.05)) {
-      if (stream.timedOut()) { // a live source between frames
-        viewer.spinOnce(20);
-        continue;
-      }
-      break; // the end of the frames
-    }
-    for (const auto& why : frame.skipped) { // unreadable: nothing known, the tracks are kept
-      std::fprintf(stderr, "facyl_viewer: %s\n", why.c_str());
-      tracker.skipFrame();
-      std::cout << streamLine(number++, why.substr(0, why.find(": ")), nullptr, 0,
-                              "PCL's reader could not read it")
-                << std::endl;
-    }
-    const Cloud::ConstPtr& cloud = frame.cloud;
-    std::string error;
-    if (std::none_of(cloud->begin(), cloud->end(), [](const auto& p) { return pcl::isFinite(p); }))
-      error = "the cloud has no finite point";
-    else {
-      rec.setInputCloud(cloud);
-      if (!rec.recognize(objects))
-        error = "recognition failed (see the message above)";
-    }
-    if (!error.empty()) {
-      tracker.skipFrame();
-      std::fprintf(stderr, "facyl_viewer: %s: %s (the tracks are kept)\n", frame.name.c_str(),
-                   error.c_str());
-      std::cout << streamLine(number++, frame.name, nullptr, 0, error) << std::endl;
-      ++processed;
-      continue;
-    }
-    tracker.update(rec, objects);
-    std::cout << streamLine(number++, frame.name, &tracker, objects.size()) << std::endl;
-    title = frame.name + "  (frame " + std::to_string(frame.index) + ", " +
-            std::to_string(tracker.getTracks().size()) + " tracks)";
-    drawTracked(viewer, cloud, rec, objects, tracker, title, layers);
-    if (!shown)
-      sensorCamera(viewer, *cloud, 0); // the sensor's view once; the user may move it then
-    shown = cloud;
-    ++processed;
-    viewer.spinOnce(1, true);
-  }
-  if (stream.dropped() > 0)
-    std::fprintf(stderr,
-                 "facyl_viewer: %zu frames arrived while one was processed and were "
-                 "dropped\n",
-                 stream.dropped());
-  if (!shown) {
-    std::fprintf(stderr, "facyl_viewer: --stream %s: no frame could be shown\n", s.stream.c_str());
-    return 1;
-  }
-  if (!s.screenshot.empty()) {
-    viewer.spinOnce(1, true);
-    viewer.saveScreenshot(s.screenshot);
-    Json line;
-    line["stream"] = s.stream;
-    line["frames"] = processed;
-    line["screenshot"] = s.screenshot;
-    std::printf("%s\n", facyl_cli::dumpJson(line).c_str());
-    return 0;
-  }
-  while (!viewer.wasStopped()) { // the last frame stays on screen
-    if (redraw) {
-      drawTracked(viewer, shown, rec, objects, tracker, title, layers);
-      redraw = false;
-    }
-    viewer.spinOnce(50);
-  }
-  return 0;
-}
 
 Settings
 parseSettings(int argc, char** argv)
@@ -1068,7 +693,18 @@ main(int argc, char** argv)
   pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
   if (!s.stream.empty()) {
     try {
-      return runStream(s);
+      facyl_viewer::StreamSettings stream;
+      stream.source = s.stream;
+      stream.rate = s.rate;
+      stream.loop = s.loop;
+      stream.frames = s.frames;
+      stream.params = s.params;
+      stream.up = s.up;
+      stream.classifier = s.classifier;
+      stream.screenshot = s.screenshot;
+      stream.width = s.width;
+      stream.height = s.height;
+      return facyl_viewer::runStream(stream);
     }
     catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "facyl_viewer: %s\n", e.what());

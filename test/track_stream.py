@@ -4,8 +4,10 @@ ground truth; facyl_detect --track runs it as one stream with bad input in the m
 that is not a PCD, an empty cloud, a frame of another size, a frame without any support) and a
 new scene at the end: every object has an integer track_id, the cylinders confirmed early keep
 their ids to the end, failed frames say why and keep the tracks, the new scene starts new
-tracks; facyl_viewer --stream plays the folder through pcl::PCDGrabber under xvfb-run (when
-built and xvfb-run is there) with the same track ids.
+tracks; --overlay draws what the lines say (issue 41): each box in the colour of the track's
+decision with the track's id over it, this frame's own cylinder dashed magenta; facyl_viewer
+--stream plays the folder through pcl::PCDGrabber under xvfb-run (when built and xvfb-run is
+there) with the same track ids, and its JSON lines are facyl_detect --track's (plus "frame").
 
     track_stream.py FACYL_SYNTH FACYL_DETECT DATA_DIR [FACYL_VIEWER]
 """
@@ -15,6 +17,9 @@ import shutil
 import subprocess
 import sys
 import tempfile
+
+import numpy as np
+import cv2  # python3-opencv
 
 synth, detect, data = sys.argv[1], sys.argv[2], sys.argv[3]
 viewer = sys.argv[4] if len(sys.argv) > 4 else ""
@@ -100,6 +105,58 @@ try:
         check("a new scene starts new tracks",
               last["stream"]["new_scene"] and
               not ({o["track_id"] for o in last["objects"]} & previous), last["stream"])
+    # ---- the overlays of the stream: what the lines say
+    overlays = os.path.join(tmp, "overlays")
+    os.mkdir(overlays)
+    frames = [frame(k) for k in range(8)]
+    r = run([detect, "--track", "--overlay", overlays] + frames)
+    lines = [json.loads(l) for l in r.stdout.splitlines() if l.strip()]
+    check("facyl_detect --track --overlay: an overlay per frame", r.returncode == 0 and
+          len(lines) == 8 and all(os.path.exists(os.path.join(overlays, f"s_f{k:04d}.png"))
+                                  for k in range(8)), (r.returncode, r.stderr[-400:]))
+    colours = {True: (0, 230, 0), False: (230, 0, 0)}  # RGB
+    boxes = labelled = frame_fits = dashed = 0
+    disagree = agree_drawn = 0
+    for k, line in enumerate(lines):
+        img = cv2.imread(os.path.join(overlays, f"s_f{k:04d}.png"))[..., ::-1].astype(int)
+        is_colour = lambda c: (np.abs(img - np.array(c)).max(axis=2) == 0)
+        h, w = img.shape[:2]
+        scale = max(1, h // 240)
+        for o in line["objects"]:
+            u0, v0, u1, v1 = o["bbox"]
+            if u0 < 0 or o["track_id"] is None:
+                continue
+            boxes += 1
+            # The box's four sides, away from the corners (another box may cover one): more
+            # in the colour of the track's decision than in that of the frame's.
+            def edge(c):
+                m, du, dv = is_colour(colours[c]), (u1 - u0) // 4, (v1 - v0) // 4
+                return sum(side.sum() for side in (
+                    m[v0 + dv:v1 - dv, u0:u0 + 2], m[v0 + dv:v1 - dv, u1:u1 + 2],
+                    m[v0:v0 + 2, u0 + du:u1 - du], m[v1:v1 + 2, u0 + du:u1 - du]))
+            if o["is_cylinder"] != o["is_cylinder_frame"]:
+                disagree += 1
+                agree_drawn += edge(o["is_cylinder"]) > edge(o["is_cylinder_frame"])
+            # "#id" over the box's top-left corner: box-coloured glyphs on black.
+            lw, lh = (6 * len(f"#{o['track_id']}") + 1) * scale, 9 * scale
+            top = v0 - lh - 1 if v0 - lh - 1 >= 0 else v0 + 2
+            left = min(max(u0, 0), max(0, w - lw))
+            label = img[top:top + lh, left:left + lw]
+            ink = is_colour(colours[o["is_cylinder"]])[top:top + lh, left:left + lw].mean()
+            black = (label.max(axis=2) == 0).mean()
+            labelled += 0.15 < ink < 0.6 and black > 0.3
+        fits = sum(1 for o in line["objects"] if o["is_cylinder_frame"] and o["cylinder_frame"])
+        frame_fits += fits
+        dashed += fits > 0 and is_colour((255, 0, 255)).sum() > 30
+    check("each tracked object's box has its track's id over it",
+          boxes > 10 and labelled >= 0.9 * boxes, f"{labelled} of {boxes} boxes labelled")
+    check("boxes take the track's decision where the frame's differs",
+          disagree > 0 and agree_drawn == disagree, f"{agree_drawn} of {disagree}")
+    check("the frame's own cylinders are drawn dashed magenta",
+          frame_fits > 0 and dashed == sum(1 for l in lines if any(
+              o["is_cylinder_frame"] and o["cylinder_frame"] for o in l["objects"])),
+          f"{dashed} frames with magenta, {frame_fits} frame fits")
+
     r = run([detect, "--track-max-misses", "3", frame(0)])
     check("--track-max-misses without --track is refused", r.returncode == 2, r.stderr)
     r = run([detect, "--track", "--track-confirm-hits", "0", frame(0)])
@@ -121,9 +178,19 @@ try:
               [f"f{k}.pcd" for k in range(6)] and "f2_notes.pcd" in r.stderr and
               os.path.getsize(shot) > 1000, (r.returncode, r.stderr[-400:]))
         if len(vl) == 6:
-            ids = lambda l: {t["track_id"] for t in l["tracks"] if t["confirmed"]}
+            ids = lambda l: {t["track_id"] for t in l["tracks"] if t["state"]["confirmed"]}
             check("the viewer's tracks keep their ids", len(ids(vl[1])) >= 3 and
                   len(ids(vl[1]) - ids(vl[5])) <= 1, (ids(vl[1]), ids(vl[5])))
+            # Its lines carry what facyl_detect --track prints: objects with their geometry,
+            # "stream", "tracks" with centroids and cylinders.
+            r = run([detect, "--track", "--model", "none"] +
+                    [os.path.join(folder, f"f{k}.pcd") for k in range(6)])
+            dl = [json.loads(l) for l in r.stdout.splitlines() if l.strip()]
+            strip = lambda l: {k: v for k, v in l.items() if k not in ("frame", "timing_ms")}
+            same = len(dl) == 6 and all(strip(a) == strip(b) for a, b in zip(vl, dl))
+            check("the viewer's JSON lines are facyl_detect --track's (and \"frame\")",
+                  same and [l["frame"] for l in vl] == list(range(6)),
+                  [sorted(set(strip(a)) ^ set(strip(b))) for a, b in zip(vl, dl)] or r.stderr)
         r = run(["xvfb-run", "-a", viewer, "--stream", os.path.join(tmp, "missing"),
                  "--screenshot", shot])
         check("--stream of a missing folder: a clear message, exit 2",

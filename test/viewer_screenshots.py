@@ -56,9 +56,9 @@ def red(img):
 
 
 def blue(img):
-    """The table outline (0.2, 0.5, 1.0)."""
+    """The table outline (0.2, 0.5, 1.0), not the blues of a cloud coloured by depth."""
     b, g, r = (img[..., i].astype(int) for i in range(3))
-    return (b > 200) & (r < 110) & (g > 80) & (g < 180)
+    return (b > 240) & (r < 90) & (g > 100) & (g < 160)
 
 
 def write_pcd_frame(path, points):

@@ -8,9 +8,12 @@
 Open3D reads the file (PCD, PLY, ...); facyl fits (Open3D's points go to facyl as they are,
 NaN rows of organized frames included: inliers index the file's points); each cylinder is
 drawn as a green wireframe from its base to its top (no surface that would hide the red
-inliers on it or the points inside) over the finite points (grey; inliers red). The view is
-the sensor's: from the origin along +z, image y down, as RGB-D frames and PCL's tools have
-it. Open3D has no cylinder detection of its own.
+inliers on it or the points inside) over the finite points (grey; inliers red). The
+screenshot is framed on the fitted cylinders: each whole, with as much again around it, in
+the middle, seen from the sensor (the origin, image y down, as RGB-D frames and PCL's tools
+have it; from in front along +z when the cloud is not in a sensor's frame); without a
+cylinder, on the points. The window starts looking at the same place. Open3D has no cylinder
+detection of its own.
 --screenshot renders off-screen (under xvfb-run without a screen); its path must end in
 .png and must not be the input (exit 2, nothing written).
 """
@@ -56,21 +59,66 @@ def cylinder_lines(c, segments=36, generators=24, rings=6):
     return wire
 
 
-def sensor_camera(vis, points, width, height):
-    """Puts Open3D's camera where an RGB-D sensor is: at the origin looking along +z, image y
-    down, with a field of view that holds 96 % of the points. False when the cloud is not in
-    a sensor's frame (most points not in front of the origin)."""
-    ahead = points[points[:, 2] > 1e-6]
-    if len(ahead) < 0.5 * len(points):
-        return False
-    tx, ty = np.abs(ahead[:, 0] / ahead[:, 2]), np.abs(ahead[:, 1] / ahead[:, 2])
-    half = max(np.percentile(tx, 98) / width, np.percentile(ty, 98) / height) * 1.05
-    f = 0.5 / max(half, 1e-6)
+def framed(points, cylinders, context=2.0):
+    """What the picture must hold: each fitted cylinder whole (the corners of its wireframe) and
+    as much again around it (its extent scaled by `context` about its centre: the points around
+    it); without a cylinder, the finite points between the 2nd and 98th percentile of each
+    coordinate (a sample of at most about 20000)."""
+    if not cylinders:
+        lo, hi = np.percentile(points, 2, axis=0), np.percentile(points, 98, axis=0)
+        inside = points[((points >= lo) & (points <= hi)).all(axis=1)]
+        return inside[::max(1, len(inside) // 20000)]
+    corners = []
+    for c in cylinders:
+        wire = np.asarray(cylinder_lines(c).points)
+        centre = wire.mean(axis=0)
+        corners.append(centre + context * (wire - centre))
+    return np.concatenate(corners)
+
+
+def camera_axes(look):
+    """The camera's axes (rows x, y, z) in the cloud's frame for a camera looking along `look`,
+    image y down (towards +y, as RGB-D frames have it)."""
+    z = look / np.linalg.norm(look)
+    x = np.cross([0.0, 1.0, 0.0], z)
+    if np.linalg.norm(x) < 1e-6:  # looking along y
+        x = np.cross(z, np.cross([1.0, 0.0, 0.0], z))
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z])
+
+
+def frame_camera(vis, points, targets, width, height, margin=0.05):
+    """Puts Open3D's camera where it sees all of `targets` (N x 3) in the middle of the picture,
+    image y down: at the sensor (the origin) when the cloud is in a sensor's frame (most points
+    in front of the origin, along +z), else in front of them along +z. The field of view holds
+    every target with `margin` (a share of the picture) to spare. False when Open3D refuses
+    the camera (the caller then sets a plain view)."""
+    centre = 0.5 * (targets.min(axis=0) + targets.max(axis=0))
+    if (points[:, 2] > 1e-6).mean() >= 0.5:
+        eye = np.zeros(3)
+    else:
+        eye = centre - np.array([0.0, 0.0, 3.0 * np.linalg.norm(targets - centre, axis=1).max()])
+    look = centre - eye
+    for turn in range(4):  # aim at the middle of what the camera sees of the targets
+        axes = camera_axes(look)
+        q = (targets - eye) @ axes.T
+        q = q[q[:, 2] > 1e-6]
+        if len(q) == 0:
+            return False
+        u, v = q[:, 0] / q[:, 2], q[:, 1] / q[:, 2]
+        if turn < 3:
+            look = axes.T @ np.array([0.5 * (u.min() + u.max()), 0.5 * (v.min() + v.max()), 1.0])
+    tx, ty = np.abs(u).max(), np.abs(v).max()
+    f = (1.0 - 2.0 * margin) * 0.5 * min(width / max(tx, 1e-6), height / max(ty, 1e-6))
+    # Open3D takes fields of view from 5 to 90 degrees.
     f = min(max(f, 0.5 * height / np.tan(np.radians(44))), 0.5 * height / np.tan(np.radians(3)))
     param = vis.get_view_control().convert_to_pinhole_camera_parameters()
     param.intrinsic = o3d.camera.PinholeCameraIntrinsic(width, height, f, f, width / 2 - 0.5,
                                                         height / 2 - 0.5)
-    param.extrinsic = np.eye(4)
+    extrinsic = np.eye(4)
+    extrinsic[:3, :3] = axes
+    extrinsic[:3, 3] = -axes @ eye
+    param.extrinsic = extrinsic
     return vis.get_view_control().convert_from_pinhole_camera_parameters(param)
 
 
@@ -136,6 +184,7 @@ def main():
     shown = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points[finite]))
     shown.colors = o3d.utility.Vector3dVector(colors[finite])
     geometries = [shown] + [cylinder_lines(c) for c in cylinders]
+    targets = framed(points[finite], cylinders)
     if args.screenshot:
         vis = o3d.visualization.Visualizer()
         if not vis.create_window(visible=False, width=width, height=height):
@@ -143,9 +192,9 @@ def main():
                      "xvfb-run -a)")
         for g in geometries:
             vis.add_geometry(g)
-        if not sensor_camera(vis, points[finite], width, height):
+        if not frame_camera(vis, points[finite], targets, width, height):
             view = vis.get_view_control()
-            view.set_lookat(np.median(points[finite], axis=0))
+            view.set_lookat(targets.mean(axis=0))
             view.set_front([0.0, 0.0, -1.0])
             view.set_up([0.0, -1.0, 0.0])
         vis.get_render_option().point_size = 2.0
@@ -156,7 +205,7 @@ def main():
         vis.destroy_window()
         print(f"fit_open3d: wrote {args.screenshot}")
     else:
-        o3d.visualization.draw_geometries(geometries, lookat=np.median(points[finite], axis=0),
+        o3d.visualization.draw_geometries(geometries, lookat=targets.mean(axis=0),
                                           front=[0.0, 0.0, -1.0], up=[0.0, -1.0, 0.0], zoom=0.6)
 
 

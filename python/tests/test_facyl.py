@@ -503,6 +503,45 @@ def test_open3d_example_screenshot_of_the_tutorial_scene():
     assert green.sum() > 200, f"{green.sum()} green pixels"
 
 
+def test_open3d_example_frames_the_fitted_object():
+    """fit_open3d.py --screenshot frames the fitted cylinder (issue 41: the view was the whole
+    cloud's, with the mug low and off-centre, and cut off the bottom of the object): on PCL's
+    tutorial scene, at two shapes of picture, the mug (its red inliers and green wireframe) is
+    whole, 3 % or more from every edge, in the middle, a third or more of the picture high, with
+    the scene's grey points around it."""
+    pytest.importorskip("open3d", reason="python3-open3d is not installed")
+    cv2 = pytest.importorskip("cv2")
+    example = os.environ.get("FACYL_EXAMPLE")
+    if not example or not os.path.exists(TUTORIAL):
+        pytest.skip("FACYL_EXAMPLE or the real tutorial scene (FACYL_REAL_DATA) not given")
+    if not shutil.which("xvfb-run"):
+        pytest.skip("xvfb-run is not installed")
+    for w, h in ((640, 480), (360, 480)):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "shot.png")
+            r = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1600x1200x24", sys.executable,
+                                example, TUTORIAL, "--screenshot", out, "--size", f"{w},{h}"],
+                               capture_output=True, text=True, env=dict(os.environ), timeout=300)
+            assert r.returncode == 0, r.stderr[-500:]
+            img = cv2.imread(out)
+        assert img is not None and img.shape[:2] == (h, w)
+        b, g, r_ = (img[..., i].astype(int) for i in range(3))
+        mug = ((r_ > 180) & (g < 80) & (b < 80)) | ((g > 150) & (r_ < 100) & (b < 120))
+        grey = (abs(r_ - g) < 12) & (abs(g - b) < 12) & (r_ > 120) & (r_ < 190)
+        ys, xs = np.nonzero(mug)
+        u0, u1, v0, v1 = xs.min(), xs.max(), ys.min(), ys.max()
+        size = f"{w}x{h}: the mug at u {u0}..{u1}, v {v0}..{v1}"
+        assert u0 >= 0.03 * w and u1 <= 0.97 * w and v0 >= 0.03 * h and v1 <= 0.97 * h, size
+        assert abs(0.5 * (u0 + u1) - 0.5 * w) <= 0.1 * w, size
+        assert abs(0.5 * (v0 + v1) - 0.5 * h) <= 0.1 * h, size
+        assert v1 - v0 >= h / 3, size
+        around = np.zeros(mug.shape, bool)
+        du, dv = (u1 - u0) // 2, (v1 - v0) // 2
+        around[max(0, v0 - dv):v1 + dv, max(0, u0 - du):u1 + du] = True
+        around[v0:v1, u0:u1] = False
+        assert grey[around].mean() > 0.3, f"{size}: {grey[around].mean():.2f} grey around it"
+
+
 def test_open3d_example():
     pytest.importorskip("open3d", reason="python3-open3d is not installed: example skipped")
     example = os.environ.get("FACYL_EXAMPLE")
