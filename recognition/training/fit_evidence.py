@@ -322,6 +322,45 @@ def decide(rows, w, network):
     return out
 
 
+def probabilities(rows, w, network):
+    return [1 / (1 + math.exp(-float(design([r], network)[0] @ w))) for r in rows]
+
+
+def reliability(pairs, bins=10):
+    """Calibration of left-out probabilities: per bin of p, (mean p, share positive, count),
+    and the expected calibration error."""
+    table, ece, total = [], 0.0, len(pairs)
+    for b in range(bins):
+        lo, hi = b / bins, (b + 1) / bins
+        inb = [(p, y) for p, y in pairs if lo <= p < hi or (b == bins - 1 and p == 1.0)]
+        if not inb:
+            continue
+        mp = sum(p for p, _ in inb) / len(inb)
+        my = sum(y for _, y in inb) / len(inb)
+        table.append((mp, my, len(inb)))
+        ece += len(inb) / total * abs(mp - my)
+    return table, ece
+
+
+def plot_reliability(curves, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(4.6, 4.2))
+    ax.plot([0, 1], [0, 1], color="0.7", lw=1)
+    for name, (table, ece) in curves.items():
+        line, = ax.plot([t[0] for t in table], [t[1] for t in table], "-", lw=1,
+                        label="%s sources (ECE %.3f)" % (name, ece))
+        ax.scatter([t[0] for t in table], [t[1] for t in table], s=[4 + 2 * t[2] ** 0.5 * 3 for t in table],
+                   color=line.get_color(), zorder=3)
+    ax.set_xlabel("p_cylinder (left out)")
+    ax.set_ylabel("share that are cylinders")
+    ax.set_title("Reliability, left out (marker area ~ objects)")
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 # --------------------------------------------------------------------------- scores
 
 def prf(tp, fp, fn):
@@ -407,6 +446,8 @@ def main():
                     "written (to refit without running the recognizer again)")
     ap.add_argument("--list", action="store_true", help="list the real objects each left-out "
                     "model decides wrongly")
+    ap.add_argument("--plot", help="PNG of the reliability curve of the left-out probabilities "
+                    "(simulated and real sources apart)")
     args = ap.parse_args()
     sys.path.insert(0, os.path.join(os.path.abspath(args.build), "python"))
     import facyl
@@ -436,8 +477,13 @@ def main():
     sources = sorted({r["source"] for r in rows} | {f[0] for f in frames})
 
     table = {}
+    left_out = {"simulated": [], "real": []}  # (p, is a cylinder) of the fits each model decides
     for s in sources:
         w = train([r for r in rows if r["source"] != s], network)
+        judged = [r for r in rows if r["source"] == s and r["gates"] and
+                  label_kind(r["label"]) is not None]
+        left_out["simulated" if s.startswith("sim") else "real"] += zip(
+            probabilities(judged, w, network), [label_kind(r["label"]) for r in judged])
         if s.startswith("rgbd-"):
             mine = [f for f in frames if f[0] == s]
             calls_of = lambda frame, objs: decide([prepare(obj_row(s, frame, o, "")) for o in objs], w, network)
@@ -460,6 +506,12 @@ def main():
         table[s] = {"tp": tp, "fp": fp, "fn": fn, "precision": p, "recall": r, "f1": f,
                     "segmentation_recall": seg}
     w_all = train(rows, network)
+    curves = {k: reliability(v) for k, v in left_out.items() if v}
+    for k, (t, ece) in curves.items():
+        print("reliability, %s sources left out: ECE %.3f; bins (mean p, share cylinders, n): %s" % (
+            k, ece, " ".join("(%.2f %.2f %d)" % b for b in t)))
+    if args.plot:
+        plot_reliability(curves, args.plot)
 
     print("Leave-one-source-out (model %s; each source scored by the evidence model fitted "
           "without it):" % args.model)
