@@ -51,7 +51,7 @@ def fit_cylinders(
     points: Any,  # (N, 3) float array or open3d.utility.Vector3dVector
     normals: Optional[Any] = None,
     *,
-    radius_limits: Union[Tuple[float, float], str, None] = None,  # None: (0.01, 0.25); "auto"
+    radius_limits: Union[Tuple[float, float], str, None] = None,  # None: "auto"; (min, max)
     prior: Optional[str] = None,  # None: "vertical" with up, else "uniform"
     up: Optional[Sequence[float]] = None,
     voting: str = "soft-curvature",

@@ -922,10 +922,9 @@ points (unless normals (N, 3) are given), orientation votes weighted by curvatur
 for position and radius, least-squares refinement.
 
 points, normals: numpy arrays (N, 3) or Open3D Vector3dVector (pcd.points, pcd.normals).
-radius_limits: (min, max), default None: )" +
-         value("radius-limits") + R"( m as in every facyl tool (cans to
-buckets); "auto": 0 to twice the extent of the data across each candidate axis (pipes,
-tanks). up: gravity's opposite in the cloud's frame (default None: unknown). prior:
+radius_limits: (min, max), or "auto" (default None: "auto"): 0 to twice the extent of the
+data across each candidate axis, HoughCylinderEstimation's own (pipes, tanks, cans; detect()
+keeps (0.01, 0.25)). up: gravity's opposite in the cloud's frame (default None: unknown). prior:
 orientation prior "uniform", "vertical", "vertical-strong" or "horizontal" about up ()" +
          pythonValue(ValueKind::Vector3, facyl_cli::shownVector(d.up)) +
          R"(

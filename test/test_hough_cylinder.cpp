@@ -192,6 +192,38 @@ TEST(HoughCylinderEstimation, CleanCylinderIsExact)
   }
 }
 
+TEST(HoughCylinderEstimation, UpOrientsTheCylinders)
+{
+  // With an up direction the axis points up and the base (point_on_axis) is the lower end, as
+  // the recognizer's cylinders; a lying one points towards the sensor. Zero: the fit's sign.
+  auto p = randomCylinder(3, 0.f, 0.f);
+  const auto sim = facyl::simulateCylinder(p);
+  for (const Eigen::Vector3f up : {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f),
+                                   Eigen::Vector3f(sim.truth.axis)}) {
+    Hough hough;
+    hough.setUpDirection(up);
+    hough.setOrientationPrior(facyl::OrientationPrior::Uniform);
+    const auto o = fitOnce(sim.cloud.makeShared(), sim.truth, hough);
+    ASSERT_TRUE(o.found);
+    if (std::abs(o.model.axis.dot(up)) > 0.1f) {
+      EXPECT_GT(o.model.axis.dot(up), 0.f);
+      EXPECT_LT(o.model.base.dot(up), o.model.top.dot(up));
+    }
+    EXPECT_TRUE(o.model.point_on_axis.isApprox(o.model.base));
+    EXPECT_EQ(hough.getUpDirection(), up.normalized());
+  }
+  facyl::CylinderModel lying;
+  lying.axis = Eigen::Vector3f::UnitX();
+  lying.base = lying.point_on_axis = Eigen::Vector3f(0.1f, 0.f, 1.f);
+  lying.top = Eigen::Vector3f(-0.1f, 0.f, 1.f);
+  facyl::orientCylinder(lying, Eigen::Vector3f::UnitY(), Eigen::Vector3f(-1.f, 0.f, 0.f));
+  EXPECT_EQ(lying.axis, -Eigen::Vector3f::UnitX()); // towards the viewpoint
+  EXPECT_EQ(lying.point_on_axis, Eigen::Vector3f(-0.1f, 0.f, 1.f));
+  Hough none;
+  none.setUpDirection(Eigen::Vector3f::Zero());
+  EXPECT_EQ(none.getUpDirection(), Eigen::Vector3f::Zero());
+}
+
 TEST(HoughCylinderEstimation, SoftCurvatureIsRobustToLids)
 {
   // Random axes, radius 0.02-0.3 m, 1% noise, lids at 300% and 500% of the lateral points.

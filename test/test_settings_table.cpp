@@ -486,11 +486,16 @@ TEST(SettingsTable, DefaultsAreValidAndShared)
   std::string rule;
   EXPECT_EQ(facyl_cli::validate(FitSettings{}, &rule), "");
   EXPECT_EQ(facyl::validate(facyl::TabletopRecognizerParameters{}, &rule), "");
-  // One home for k and for the radius limits of the tools and of the recognizer.
+  // One home for k; a bare fit's radius limits are the estimator's own (issue 41: the tools'
+  // 0.01-0.25 m refused pipes and the paper's 0.3 m cylinder), the recognizer's the tabletop's.
   EXPECT_EQ(FitSettings{}.neighbours, facyl::kDefaultNeighbours);
   EXPECT_EQ(facyl::TabletopRecognizerParameters{}.neighbours, facyl::kDefaultNeighbours);
-  EXPECT_EQ(FitSettings{}.params.radius_min, facyl::tabletopHoughDefaults().radius_min);
-  EXPECT_EQ(FitSettings{}.params.radius_max, facyl::tabletopHoughDefaults().radius_max);
+  EXPECT_EQ(FitSettings{}.params.radius_min, facyl::HoughCylinderParameters{}.radius_min);
+  EXPECT_EQ(FitSettings{}.params.radius_max, facyl::HoughCylinderParameters{}.radius_max);
+  EXPECT_EQ(facyl::TabletopRecognizerParameters{}.hough.radius_min,
+            facyl::tabletopHoughDefaults().radius_min);
+  EXPECT_EQ(facyl::TabletopRecognizerParameters{}.hough.radius_max,
+            facyl::tabletopHoughDefaults().radius_max);
 }
 
 } // namespace

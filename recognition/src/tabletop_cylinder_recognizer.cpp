@@ -41,22 +41,6 @@ validate(const TabletopRecognizerParameters& p, std::string* rule)
   return {};
 }
 
-void
-orientCylinder(CylinderModel& model, const Eigen::Vector3f& up, const Eigen::Vector3f& viewpoint)
-{
-  const Eigen::Vector3f a = model.axis.normalized();
-  const Eigen::Vector3f centre = 0.5f * (model.base + model.top);
-  // Up decides unless the axis lies across it (a lying can), then the side of the viewer.
-  float side = a.dot(up.normalized());
-  if (!(std::abs(side) > 0.1f))
-    side = a.dot(viewpoint - centre);
-  if (!(side < 0.f))
-    return;
-  model.axis = -a;
-  std::swap(model.base, model.top);
-  model.point_on_axis = model.base;
-}
-
 pcl::Indices
 evenSubsample(const pcl::Indices& indices, std::size_t max_count)
 {

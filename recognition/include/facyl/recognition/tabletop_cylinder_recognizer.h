@@ -281,13 +281,8 @@ private:
   std::vector<std::unique_ptr<Fitter>> fitters_; ///< one per thread of the fits
 };
 
-/** \brief The convention of the recognizer's cylinders: the axis runs from the base (
- * point_on_axis, the end nearest the support) to the top, pointing to the side of \a up (the
- * support's normal; without a support, an upright camera's up: against the image rows); when
- * the axis lies across \a up (within about 6 degrees of perpendicular: a lying can), it points
- * to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
-void orientCylinder(CylinderModel& model, const Eigen::Vector3f& up,
-                    const Eigen::Vector3f& viewpoint);
+/* The recognizer's cylinders follow orientCylinder (cylinder_model.h) with \a up the support's
+ * normal (without a support, an upright camera's up: against the image rows). */
 
 /** \brief Evenly spaced subsample of \a indices of at most \a max_count elements (all of them
  * when there are fewer). */

@@ -207,8 +207,9 @@ constexpr std::size_t kMinOrientations = 10;
 constexpr std::size_t kMaxOrientations = 100000;
 /** \brief Most accumulators per fit (HoughCylinderParameters::accumulators). */
 constexpr std::size_t kMaxAccumulators = 64;
-/** \brief The radius limits (m) of the tabletop recognizer (tabletopHoughDefaults) and of the
- * tools' bare fit (facyl_fit, Python's fit_cylinders): cans to buckets. */
+/** \brief The radius limits (m) of the tabletop recognizer (tabletopHoughDefaults): cans to
+ * buckets. A bare fit (this estimator, facyl_fit, Python's fit_cylinders) has none by default
+ * (radius_min 0, radius_max infinity: the data's extent), as PCL's segmentation. */
 constexpr double kDefaultRadiusMin = 0.01;
 constexpr double kDefaultRadiusMax = 0.25;
 

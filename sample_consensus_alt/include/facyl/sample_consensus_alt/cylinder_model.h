@@ -37,6 +37,13 @@ struct CylinderModel {
   float signedDistance(const Eigen::Vector3f& p) const;
 };
 
+/** \brief facyl's convention for a cylinder whose surroundings are known: the axis runs from
+ * the base (point_on_axis) to the top and points to the side of \a up (gravity's opposite, a
+ * support's normal); when it lies across \a up (within about 6 degrees of perpendicular: a lying
+ * can), to the side of \a viewpoint. Flips \a model (axis, base and top) when needed. */
+void orientCylinder(CylinderModel& model, const Eigen::Vector3f& up,
+                    const Eigen::Vector3f& viewpoint);
+
 /** \brief Angle (rad, in [0, pi/2]) between two axes, which have no sign. */
 float axisAngle(const Eigen::Vector3f& a, const Eigen::Vector3f& b);
 

@@ -91,6 +91,18 @@ enum class HoughFailure {
  *         pc2 (facyl::NormalCurvature), those are the curvatures used by SoftCurvature voting;
  *         otherwise they are estimated from the points (see above).
  */
+/** \brief A frame whose z axis is \a up (normalized; x any unit vector orthogonal to it): the
+ * reference frame HoughCylinderEstimation::setUpDirection sets. */
+inline Eigen::Matrix3f
+frameAboutUp(const Eigen::Vector3f& up)
+{
+  const Eigen::Vector3f z = up.normalized();
+  const Eigen::Vector3f x = z.unitOrthogonal();
+  Eigen::Matrix3f frame;
+  frame << x, z.cross(x), z;
+  return frame;
+}
+
 template <typename PointT, typename PointNT>
 class HoughCylinderEstimation : public pcl::PCLBase<PointT> {
 public:
@@ -346,8 +358,16 @@ public:
     frame_ = frame;
     drawn_.clear();
   }
-  /** \brief Sets the reference frame from its "up" axis only (e.g. a table normal). */
+  /** \brief Gravity's opposite (e.g. a table normal): the reference frame from this "up" axis,
+   * and the cylinders found follow orientCylinder (cylinder_model.h): the axis points up and the
+   * base (point_on_axis, the coefficients' point) is the lower end; a lying one points towards
+   * the cloud's sensor_origin_. Zero: unknown (the default), the axis's sign is the fit's. */
   void setUpDirection(const Eigen::Vector3f& up);
+  /** \brief The up direction (zero: unknown). */
+  const Eigen::Vector3f& getUpDirection() const
+  {
+    return up_;
+  }
   /** \brief Frame of the prior. */
   const Eigen::Matrix3f& getReferenceFrame() const
   {
@@ -453,6 +473,7 @@ private:
   GaussianMixture mixture_; ///< with explicit_mixture_: replaces params_.prior
   bool explicit_mixture_{false};
   Eigen::Matrix3f frame_{Eigen::Matrix3f::Identity()};
+  Eigen::Vector3f up_{Eigen::Vector3f::Zero()}; ///< unit, or zero: unknown
   std::vector<OrientationAccumulator> user_accumulators_;
   std::vector<OrientationAccumulator> drawn_;
 };

@@ -27,7 +27,8 @@ namespace facyl_cli {
  * included) and the "up" of the prior's frame. */
 struct HoughSettings {
   facyl::HoughCylinderParameters params;
-  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()};
+  Eigen::Vector3f up{Eigen::Vector3f::UnitZ()}; ///< the prior's "up"
+  bool up_given{false}; ///< up is known (--up): the cylinders are oriented by it
 };
 
 /** The voting modes, in the help's order. */
@@ -73,7 +74,10 @@ houghFit(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
 {
   facyl::HoughCylinderEstimation<pcl::PointXYZ, facyl::NormalCurvature> hough;
   hough.setParameters(s.params);
-  hough.setUpDirection(s.up);
+  if (s.up_given)
+    hough.setUpDirection(s.up); // the prior's frame and the cylinders' orientation
+  else
+    hough.setReferenceFrame(facyl::frameAboutUp(s.up)); // the prior's frame only
   hough.setInputCloud(cloud);
   hough.setInputNormals(cues);
   std::vector<facyl::CylinderModel> models;

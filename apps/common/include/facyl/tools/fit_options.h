@@ -52,13 +52,10 @@ struct FitSettings : HoughSettings {
   int neighbours{facyl::kDefaultNeighbours}; ///< k of the normal and curvature estimation
   int threads{0};                            ///< 0: all cores
   Units units{Units::Auto};
-  bool radius_given{false}; ///< radius limits were given (not the tools' default)
-
-  FitSettings()
-  {
-    params.radius_min = static_cast<float>(facyl::kDefaultRadiusMin);
-    params.radius_max = static_cast<float>(facyl::kDefaultRadiusMax);
-  }
+  bool radius_given{false}; ///< radius limits were given (not the default: auto)
+  // The radius limits default to the estimator's own (HoughCylinderParameters: auto, 0 to
+  // twice the data's extent across each candidate axis), as PCL's segmentation has none: a bare
+  // fit knows nothing of the objects. The tabletop recognizer keeps cans to buckets.
 };
 
 /** Checks \a s: the fit's own settings, then its estimator's (facyl::validate).
@@ -126,8 +123,9 @@ fitOptions()
     radii.metavar = "A,B";
     radii.kind = ValueKind::Pair;
     radii.words = {"auto"};
-    radii.help = "radius interval (default {}: cans to buckets, as in\nevery facyl tool); auto: 0 "
-                 "to twice the extent of the data\nacross each candidate axis (pipes, tanks)";
+    radii.help = "radius interval, or auto (default): 0 to twice the\nextent of the data across "
+                 "each candidate axis (pipes,\ntanks, cans: HoughCylinderEstimation's own; the "
+                 "tabletop\ntools keep 0.01,0.25)";
     radii.set = [](S& s, const OptionValue& v, const OptionContext& c) {
       double r_min = 0.0, r_max = std::numeric_limits<double>::infinity(); // auto
       if (v.word.empty()) {
@@ -138,18 +136,24 @@ fitOptions()
       detail::refuseMillimetreRadii(s, r_max, v.written, c.say);
       detail::setRadii(s, r_min, r_max);
     };
-    radii.show = [](const S& s) { return shownPair(s.params.radius_min, s.params.radius_max); };
+    radii.show = [](const S& s) {
+      return s.params.radius_min == 0.f && std::isinf(s.params.radius_max)
+               ? std::string("auto")
+               : shownPair(s.params.radius_min, s.params.radius_max);
+    };
     o.push_back(radii);
 
     Option<S> up;
     up.name = "up";
     up.metavar = "x,y,z";
     up.kind = ValueKind::Vector3;
-    up.help = "gravity's opposite in the cloud's frame (default: unknown)";
+    up.help = "gravity's opposite in the cloud's frame (default: unknown);\ngiven, each cylinder's "
+              "axis points up and its base is\nthe lower end";
     up.set = [](S& s, const OptionValue& v, const OptionContext&) {
       if (!(v.vector.norm() > 0.f))
         throw std::invalid_argument("must not be zero");
       s.up = v.vector;
+      s.up_given = true;
       // One rule with the tabletop tools: the prior is vertical about a known up (--prior,
       // applied after, overrides it).
       s.params.prior = facyl::OrientationPrior::Vertical;
@@ -256,10 +260,6 @@ fitOptions()
         s.units = Units::Millimetres;
       else
         throw std::invalid_argument(v.written + " is not auto, m or mm");
-      // The default limits, in the cloud's units and back, as limits given would be.
-      const float scale = metresPerUnit(s.units);
-      s.params.radius_min = static_cast<float>(facyl::kDefaultRadiusMin / scale) * scale;
-      s.params.radius_max = static_cast<float>(facyl::kDefaultRadiusMax / scale) * scale;
     };
     units.show = [](const S& s) {
       return s.units == Units::Auto ? "auto" : s.units == Units::Metres ? "m" : "mm";

@@ -24,11 +24,13 @@ template <typename PointT, typename PointNT>
 void
 HoughCylinderEstimation<PointT, PointNT>::setUpDirection(const Eigen::Vector3f& up)
 {
-  const Eigen::Vector3f z = up.normalized();
-  const Eigen::Vector3f x = z.unitOrthogonal();
-  Eigen::Matrix3f frame;
-  frame << x, z.cross(x), z;
-  setReferenceFrame(frame);
+  if (!(up.norm() > 0.f) || !up.allFinite()) {
+    up_ = Eigen::Vector3f::Zero();
+    setReferenceFrame(Eigen::Matrix3f::Identity());
+    return;
+  }
+  up_ = up.normalized();
+  setReferenceFrame(frameAboutUp(up));
 }
 
 template <typename PointT, typename PointNT>
@@ -305,10 +307,13 @@ HoughCylinderEstimation<PointT, PointNT>::segment(std::vector<CylinderModel>& cy
     cylinders.clear();
     return fail(HoughFailure::InternalError, e.what());
   }
+  const Eigen::Vector3f viewpoint = this->input_->sensor_origin_.template head<3>();
   for (auto& c : cylinders) {
     for (auto& i : c.inliers)
       i = column_to_index[static_cast<std::size_t>(i)];
     std::sort(c.inliers.begin(), c.inliers.end());
+    if (up_.norm() > 0.f)
+      orientCylinder(c, up_, viewpoint);
   }
   if (cylinders.empty())
     return explainNoCylinder(cues, total_points);
