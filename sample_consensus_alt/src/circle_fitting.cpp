@@ -209,23 +209,32 @@ refineCylinder(const Eigen::Matrix3Xf& points, Eigen::Vector3f& point_on_axis,
   Eigen::Vector3d p0 = point_on_axis.cast<double>();
   p0 += (centroid - p0).dot(a) * a;
   double r = radius;
+  const Eigen::Matrix3Xd pts = points.cast<double>();
   for (int it = 0; it < iterations; ++it) {
     const Eigen::Vector3d u = a.unitOrthogonal(), v = a.cross(u);
-    Eigen::Matrix<double, 5, 5> jtj = Eigen::Matrix<double, 5, 5>::Zero();
-    Eigen::Matrix<double, 5, 1> jte = Eigen::Matrix<double, 5, 1>::Zero();
+    // Per point, with w = p - p0 in the basis (u, v, a): the radial offset is (w.u, w.v), so
+    // rho and the radial direction need no 3-vector; J^T J is symmetric (its lower half summed).
+    double s[15] = {0.0}, g[5] = {0.0};
     for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Vector3d w = points.col(i).cast<double>() - p0;
-      const double wa = w.dot(a);
-      const Eigen::Vector3d d = w - wa * a;
-      const double rho = d.norm();
+      const Eigen::Vector3d w = pts.col(i) - p0;
+      const double wu = w.dot(u), wv = w.dot(v), wa = w.dot(a);
+      const double rho = std::sqrt(wu * wu + wv * wv);
       if (rho <= 0.0)
         continue;
-      const Eigen::Vector3d dir = d / rho;
-      const double du = dir.dot(u), dv = dir.dot(v);
-      Eigen::Matrix<double, 5, 1> j;
-      j << -du, -dv, -wa * du, -wa * dv, -1.0;
-      jtj.noalias() += j * j.transpose();
-      jte.noalias() += j * (rho - r);
+      const double du = wu / rho, dv = wv / rho, e = rho - r;
+      const double j[5] = {-du, -dv, -wa * du, -wa * dv, -1.0};
+      for (int row = 0, k = 0; row < 5; ++row) {
+        g[row] += j[row] * e;
+        for (int col = 0; col <= row; ++col)
+          s[k++] += j[row] * j[col];
+      }
+    }
+    Eigen::Matrix<double, 5, 5> jtj;
+    Eigen::Matrix<double, 5, 1> jte;
+    for (int row = 0, k = 0; row < 5; ++row) {
+      jte(row) = g[row];
+      for (int col = 0; col <= row; ++col, ++k)
+        jtj(row, col) = jtj(col, row) = s[k];
     }
     const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(jtj);
     const Eigen::Matrix<double, 5, 1> delta = -ldlt.solve(jte);

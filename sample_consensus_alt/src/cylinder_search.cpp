@@ -150,9 +150,16 @@ selectInliers(const CylinderCues& cues, const std::vector<int>& columns, const C
               float cos_normal, bool outward)
 {
   std::vector<int> inliers;
+  // |rho - r| < threshold tested on rho^2 first: most points fail it, without a square root.
+  const float lo = std::max(0.f, c.radius - c.threshold), hi = c.radius + c.threshold;
+  const float lo2 = lo * lo, hi2 = hi * hi;
   for (const int s : columns) {
     const Eigen::Vector3f w = cues.points.col(s) - c.point_on_axis;
-    const Eigen::Vector3f d = w - w.dot(c.axis) * c.axis;
+    const float wa = w.dot(c.axis);
+    const float rho2 = w.squaredNorm() - wa * wa;
+    if (!(rho2 > lo2 && rho2 < hi2))
+      continue;
+    const Eigen::Vector3f d = w - wa * c.axis;
     const float rho = d.norm();
     if (std::abs(rho - c.radius) >= c.threshold || !(rho > 0.f))
       continue;
@@ -348,10 +355,11 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
   const bool auto_threshold = params.distance_threshold <= 0.f;
   const std::vector<int> support = supporters(cues, active, c.axis, params);
   const float cos_normal = std::cos(params.normal_angle_threshold);
+  std::vector<int> previous;
   for (int round = 0; round < 3; ++round) {
-    const std::vector<int> inliers =
-      selectInliers(cues, active, c, cos_normal, params.outward_normals);
-    if (inliers.size() < 6)
+    std::vector<int> inliers = selectInliers(cues, active, c, cos_normal, params.outward_normals);
+    // The same inliers again: the least squares on them converged last round already.
+    if (inliers.size() < 6 || inliers == previous)
       break;
     const Eigen::Matrix3Xf pts = cues.points(Eigen::all, inliers);
     Candidate next = c;
@@ -365,6 +373,7 @@ refineCandidate(const CylinderCues& cues, const std::vector<int>& active, Candid
     c = next;
     if (settled)
       break;
+    previous = std::move(inliers);
   }
   return c;
 }

@@ -124,8 +124,13 @@ struct RecognitionTiming {
  * if (rec.recognize(objects))
  *   for (const auto& o : objects) if (o.is_cylinder) use(o.cylinder);
  * \endcode
- * Errors (bad parameters, no cloud, no table) are reported with PCL_ERROR and make
- * recognize() return false with no objects. recognize() is not reentrant on one object;
+ * Errors (bad parameters, no cloud or an empty one) are reported with PCL_ERROR and make
+ * recognize() return false with no objects. A frame without a table is no error:
+ * recognize() returns true, tableFound() is false and the objects off any support are still
+ * reported (see TabletopSegmentation). Without setClassifier the decision is the evidence
+ * model's alone (facyl_detect --model none); facyl_detect loads the shipped network
+ * (CylinderClassifier::defaultModelPath()). Each object's points are its cluster.indices
+ * (into the input cloud). recognize() is not reentrant on one object;
  * distinct objects may run concurrently. Within recognize(), clusters are fitted on
  * TabletopRecognizerParameters::threads threads.
  */
