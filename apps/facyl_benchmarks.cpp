@@ -2,10 +2,11 @@
  * facyl_benchmarks: speed of the estimator, of the per-point cues and of whole frames
  * (Google Benchmark).
  * Run: ./build/apps/facyl_benchmarks [--benchmark_filter=REGEX]
- * BM_Frame runs the tabletop recognizer with the shipped classifier on the bundled scene, on a
- * simulated scene at 640 x 480 and at 1280 x 720 and,
- * when the shared data is there (FACYL_REAL_DATA, default ../shared/data/real beside the
- * sources), on every 4th mOSD learn frame; counters: the stages in ms per frame.
+ * BM_Frame runs the tabletop recognizer with the shipped classifier on the bundled scene, on
+ * simulated scenes at 640 x 480 and at 1280 x 720 (spread and realistic layouts) and, when the
+ * shared data is there (FACYL_REAL_DATA, default ../shared/data/real beside the sources), on
+ * every 4th mOSD learn frame and on every rgbd frame of other sensors; counters: the stages in
+ * ms per frame.
  */
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/features/point_cues.h>
@@ -419,9 +420,14 @@ BM_Frame(benchmark::State& state, const std::string& file)
  * sensor of \a width x \a height pixels with the field of view of a 640-pixel-wide one at
  * fx = 525 (a 16:9 frame sees less vertically). */
 void
-BM_SimulatedFrame(benchmark::State& state, int width, int height, int lattice_width)
+BM_SimulatedFrame(benchmark::State& state, int width, int height, int lattice_width,
+                  const std::string& layout)
 {
   facyl::TabletopSceneParameters params;
+  if (!facyl::parseLayoutPreset(layout, params)) {
+    state.SkipWithError(("unknown layout " + layout).c_str());
+    return;
+  }
   params.seed = 1;
   params.camera.width = width;
   params.camera.height = height;
@@ -434,7 +440,9 @@ BM_SimulatedFrame(benchmark::State& state, int width, int height, int lattice_wi
 }
 
 /** BM_Frame on the bundled scene, a simulated scene at VGA and at 1280 x 720 (and at 1280 x 720
- * on the lattice of lattice_width 640) and, when present, every 4th mOSD learn frame. */
+ * on the lattice of lattice_width 640), the realistic layout (a room: floor, furniture, a far
+ * background, many objects) at both sizes and, when present, every 4th mOSD learn frame and
+ * every rgbd frame of other sensors (RealSense-class, Kinect v1 in a kitchen). */
 void
 registerFrames()
 {
@@ -444,11 +452,16 @@ registerFrames()
   for (const auto& [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
     benchmark::RegisterBenchmark(
       ("BM_Frame/simulated_" + std::to_string(w) + "x" + std::to_string(h)).c_str(),
-      BM_SimulatedFrame, w, h, 0)
+      BM_SimulatedFrame, w, h, 0, "spread")
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("BM_Frame/simulated_1280x720_lattice640", BM_SimulatedFrame, 1280,
-                               720, 640)
+                               720, 640, "spread")
     ->Unit(benchmark::kMillisecond);
+  for (const auto& [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
+    benchmark::RegisterBenchmark(
+      ("BM_Frame/realistic_" + std::to_string(w) + "x" + std::to_string(h)).c_str(),
+      BM_SimulatedFrame, w, h, 0, "realistic")
+      ->Unit(benchmark::kMillisecond);
   const char* env = std::getenv("FACYL_REAL_DATA");
   const std::string real = env ? env : std::string(FACYL_SOURCE_DIR) + "/../shared/data/real";
   for (int k = 0; k <= 44; k += 4) {
@@ -456,6 +469,20 @@ registerFrames()
     if (std::filesystem::exists(file))
       benchmark::RegisterBenchmark(("BM_Frame/mosd_learn" + std::to_string(k)).c_str(), BM_Frame,
                                    file)
+        ->Unit(benchmark::kMillisecond);
+  }
+  for (const char* source : {"graspnet6dof", "posecnn", "sevenscenes"}) {
+    std::vector<std::filesystem::path> files;
+    const std::filesystem::path dir = real + "/rgbd/" + source;
+    if (std::filesystem::is_directory(dir))
+      for (const auto& entry : std::filesystem::directory_iterator(dir))
+        if (entry.path().extension() == ".pcd")
+          files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& file : files)
+      benchmark::RegisterBenchmark(
+        ("BM_Frame/" + std::string(source) + "_" + file.stem().string()).c_str(), BM_Frame,
+        file.string())
         ->Unit(benchmark::kMillisecond);
   }
 }
