@@ -230,7 +230,8 @@ private:
     std::vector<HoughCylinderEstimation<pcl::PointXYZ, NormalCurvature>> estimators;
     std::size_t upright{0};   ///< index of the estimator with the axis along the support's normal
     bool with_support{false}; ///< the cluster being fitted has a support
-    int retry_threads{1};     ///< threads that run a cluster's first fit and retries at once
+    Eigen::Vector3f up{Eigen::Vector3f::UnitZ()}; ///< z of the prior frame (usePriorFrameOf)
+    int retry_threads{1}; ///< threads that run a cluster's first fit and retries at once
   };
   /** Builds a fitter from the settings. */
   std::unique_ptr<Fitter> makeFitter() const;
@@ -256,6 +257,8 @@ private:
                      const std::vector<std::uint8_t>& alive) const;
   Fit fitOnce(Fitter& fitter, const FitInput& input, const std::vector<std::uint8_t>& alive,
               std::size_t estimator) const;
+  /** Whether retry \a estimator would look where \a fit's axis already is (retryRepeats). */
+  bool retryRepeats(const Fitter& fitter, std::size_t estimator, const Fit& fit) const;
   /** Fits and decides one cluster: one object, or several (recovery); the classifier's
    * probability \a p_network asks for the recovery when in doubt (applyClassifier judges the
    * objects). */

@@ -270,6 +270,7 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support)
   for (auto& hough : fitter.estimators)
     hough.setReferenceFrame(frame);
   fitter.with_support = support >= 0;
+  fitter.up = frame.col(2);
   if (fitter.upright < fitter.estimators.size())
     fitter.estimators[fitter.upright].setAccumulators(
       {OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
@@ -842,6 +843,30 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
   return f;
 }
 
+/* A retry of the vertical prior (VerticalStrong) or with the axis fixed along the support's
+ * normal (upright) looks where a fit within one accumulator cell of that normal already is, and
+ * the lying prior (Horizontal) where one within a cell of the support's plane is: the retry's
+ * axis would be that one again, refined alike (its vote cannot tell axes a cell apart). The
+ * other retries (any normal sign) ask another question and always run. */
+template <typename PointT>
+bool
+TabletopCylinderRecognizer<PointT>::retryRepeats(const Fitter& fitter, std::size_t estimator,
+                                                 const Fit& fit) const
+{
+  if (!fit.evidence.fitted || estimator >= fitter.estimators.size())
+    return false;
+  const auto& hough = fitter.estimators[estimator];
+  const float cell = std::sqrt(2.f / static_cast<float>(hough.getParameters().orientations));
+  const float along = std::abs(fit.model.axis.normalized().dot(fitter.up));
+  const float from_up = std::acos(std::min(1.f, along)); // rad, in [0, pi/2]
+  if (estimator == fitter.upright ||
+      hough.getParameters().prior == OrientationPrior::VerticalStrong)
+    return from_up < cell;
+  if (hough.getParameters().prior == OrientationPrior::Horizontal)
+    return 0.5f * static_cast<float>(M_PI) - from_up < cell;
+  return false;
+}
+
 template <typename PointT>
 typename TabletopCylinderRecognizer<PointT>::Fit
 TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInput& input,
@@ -874,6 +899,8 @@ TabletopCylinderRecognizer<PointT>::fitWithRetries(Fitter& fitter, const FitInpu
     fits[0] = fitOnce(fitter, input, alive, 0);
   Fit best = std::move(fits[0]);
   for (std::size_t i = 0; i < retries.size() && !best.accepted; ++i) {
+    if (retryRepeats(fitter, retries[i], best))
+      continue; // judged alike with threads to spare, so that results do not depend on them
     Fit f = at_once ? std::move(fits[i + 1]) : fitOnce(fitter, input, alive, retries[i]);
     // Of fits that are not accepted, the likelier cylinder (a fit that explains more of the
     // points by bending around them is not).
