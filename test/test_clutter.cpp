@@ -304,6 +304,15 @@ TEST(CylinderEvidence, ArcGapTaperAndJunctions)
   }
   EXPECT_LE(facyl::arcGap(m, half), 1.f / 36.f);
   EXPECT_GT(facyl::arcGap(m, two), 0.2f);
+  // Wherever the half circle lies around the axis: the empty half is one run, also where the
+  // sectors' numbering wraps inside it (it was two runs there, the shorter taken for a gap).
+  for (int turn = 0; turn < 36; ++turn) {
+    const Eigen::Matrix3f r =
+      Eigen::AngleAxisf(static_cast<float>(turn) * kPi / 18.f + 0.05f, Eigen::Vector3f::UnitZ())
+        .toRotationMatrix();
+    const Eigen::Matrix3Xf turned = r * half;
+    EXPECT_LE(facyl::arcGap(m, turned), 1.f / 36.f) << "turned by " << 10 * turn << " deg";
+  }
   // The side of a cylinder keeps its radius; a cone's shrinks.
   EXPECT_LT(facyl::taperAlongAxis(m, half, normals, {}), 0.01f);
   Eigen::Matrix3Xf cone = half;
