@@ -352,11 +352,13 @@ arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points)
   if (occupied < 2)
     return 0.f;
   // Empty runs around the circle; the longest one is outside the span, the next is the gap.
+  // The walk starts on an occupied sector, so that no run is cut in two where the circle's
+  // numbering wraps.
   std::vector<int> runs;
   int start = 0;
-  while (count[start] >= 2)
-    ++start; // an empty sector to start from (occupied < sectors or there is no gap)
-  for (int k = 0, run = 0; k <= sectors; ++k) {
+  while (count[start] < 2)
+    ++start; // occupied >= 2
+  for (int k = 1, run = 0; k <= sectors; ++k) {
     const bool empty = k < sectors && count[(start + k) % sectors] < 2;
     if (empty)
       ++run;

@@ -103,6 +103,9 @@ struct CandidateHulls {
   bool known{false};
   std::vector<Eigen::Vector2f> polygon, extent;
   float region{0.f};
+  /** Whether it lies inside the object band of a lower candidate of its family, and if so
+   * whether it is a support of its own (isElevatedSupport); judged once (judged). */
+  bool judged{false}, elevated{false}, elevated_support{false};
 };
 
 /** The candidates of a frame and the pixel sort's result, which every trial reads. */

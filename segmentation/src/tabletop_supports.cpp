@@ -12,6 +12,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 
 namespace facyl {
 namespace tabletop {
@@ -202,20 +203,239 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
     c.support = new_index[static_cast<std::size_t>(c.support)];
 }
 
-/** Whether candidate \a s lies inside the object band of a larger parallel candidate of \a
- * family (a shelf, a box top), at \a range from the sensor. */
-bool
-elevated(const Setup& setup, const std::vector<Candidate>& candidates,
-         const std::vector<std::size_t>& family, std::size_t s, float range)
+/** 2-D points in a grid of cells \a distance wide: near(p) tells whether one of them lies
+ * within \a distance of p. */
+class NearPoints2D {
+public:
+  NearPoints2D(const std::vector<Eigen::Vector2f>& points, float distance)
+      : cell_(distance > 0.f ? distance : 1.f)
+  {
+    for (const auto& p : points)
+      if (p.allFinite())
+        entries_.emplace_back(key(cellOf(p.x()), cellOf(p.y())), p);
+    std::sort(entries_.begin(), entries_.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+  }
+  bool near(const Eigen::Vector2f& p) const
+  {
+    const std::int64_t cx = cellOf(p.x()), cy = cellOf(p.y());
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const std::int64_t k = key(cx + dx, cy + dy);
+        auto it = std::lower_bound(entries_.begin(), entries_.end(), k,
+                                   [](const auto& e, std::int64_t v) { return e.first < v; });
+        for (; it != entries_.end() && it->first == k; ++it)
+          if ((it->second - p).squaredNorm() <= cell_ * cell_)
+            return true;
+      }
+    return false;
+  }
+
+private:
+  std::int64_t cellOf(float x) const
+  {
+    return static_cast<std::int64_t>(std::floor(x / cell_));
+  }
+  static std::int64_t key(std::int64_t x, std::int64_t y)
+  {
+    return (x << 32) ^ (y & 0xffffffff);
+  }
+  float cell_;
+  std::vector<std::pair<std::int64_t, Eigen::Vector2f>> entries_;
+};
+
+/** The candidate of \a family that \a s lies on: the highest one below it whose object band
+ * holds it (above its band at \a s's centre, at most max_height) and whose region's hull holds
+ * that centre (it lies over it, not beside it: a bench seat, a far table), or -1. By height
+ * and place, not size: a box top in a large pile may hold more points than the table seen
+ * around it. */
+int
+lowerSupportOf(const Setup& setup, const SortedFrame& sorted,
+               const std::vector<std::size_t>& family, std::size_t s)
 {
-  bool out = false;
+  const Eigen::Affine3f to_plane = sorted.all[s].frame.inverse();
+  const Eigen::Vector3f centre = sorted.all[s].frame.translation();
+  const float range = (centre - setup.frame.viewpoint).norm();
+  int out = -1;
+  float nearest = 0.f;
   for (const std::size_t t : family) {
-    const float height = candidates[t].plane[3] - candidates[s].plane[3];
-    out =
-      out || (t != s && candidates[t].support > candidates[s].support &&
-              height > candidates[t].band.halfWidth(range) && height <= setup.params.max_height);
+    const Eigen::Vector4f& plane = sorted.candidates[t].plane;
+    const float height = plane.head<3>().dot(centre) + plane[3];
+    if (t == s || !(height > sorted.candidates[t].band.halfWidth(range)) ||
+        height > setup.params.max_height || (out >= 0 && height >= nearest))
+      continue;
+    std::vector<Eigen::Vector2f> region;
+    for (const auto i : hullCandidates(setup, sorted.candidates[t].points))
+      region.push_back((to_plane * setup.frame.point(static_cast<std::size_t>(i))).head<2>());
+    if (pointInPolygon((to_plane * centre).head<2>(), convexHull2D(std::move(region))))
+      out = static_cast<int>(t), nearest = height;
   }
   return out;
+}
+
+/** The walls under the edge of E's region hull \a region (counter-clockwise, in the
+ * coordinates of E's plane \a to_plane): \a e's facing_pieces and walled (see ElevatedPlane).
+ * The points of the frame above L (in its object band) that lie below E's band and within \a
+ * margin of the hull's edge are the sides under it; a piece of the edge is walled when they
+ * fill the height from L up to E there, in slices as high as L's contact (e.contact): noise
+ * over L beside E's edge fills the lowest slice, a table's apron the highest, its legs few
+ * pieces. */
+void
+measureWalls(const Setup& setup, const SortedFrame& sorted, const Eigen::Affine3f& to_plane,
+             const std::vector<Eigen::Vector2f>& region, std::size_t s, std::size_t lower,
+             float margin, ElevatedPlane& e)
+{
+  const std::size_t n = region.size();
+  std::vector<float> start(n + 1, 0.f); // arc length at each vertex
+  for (std::size_t i = 0; i < n; ++i)
+    start[i + 1] = start[i] + (region[(i + 1) % n] - region[i]).norm();
+  const float perimeter = start[n];
+  if (!(perimeter > 0.f))
+    return;
+  const Eigen::Vector2f eye = (to_plane * setup.frame.viewpoint).head<2>();
+  const auto pieceOf = [&](float arc) {
+    return std::min(kEdgePieces - 1, static_cast<int>(arc / perimeter * kEdgePieces));
+  };
+  // A piece faces the sensor when the edge at its middle has the sensor on its outer side.
+  std::vector<char> facing(kEdgePieces, 0);
+  for (int k = 0; k < kEdgePieces; ++k) {
+    const float arc = (static_cast<float>(k) + 0.5f) / kEdgePieces * perimeter;
+    const std::size_t i = static_cast<std::size_t>(
+      std::upper_bound(start.begin(), start.end(), arc) - start.begin() - 1);
+    const Eigen::Vector2f a = region[std::min(i, n - 1)], d = region[(i + 1) % n] - a;
+    facing[static_cast<std::size_t>(k)] = (d.y() * (eye - a).x() - d.x() * (eye - a).y()) > 0.f;
+  }
+  // Slices of e.contact up to E's band at E's centre (at most 32: bits of a mask).
+  const Eigen::Vector3f centre = sorted.all[s].frame.translation();
+  const float wall =
+    e.height - sorted.candidates[s].band.halfWidth((centre - setup.frame.viewpoint).norm());
+  const int slices = std::clamp(static_cast<int>(std::ceil(wall / e.contact)), 1, 32);
+  const std::uint32_t full = slices == 32 ? ~0u : (1u << slices) - 1u;
+  std::vector<std::uint32_t> filled(kEdgePieces, 0u);
+  const Eigen::Vector4f& over = sorted.candidates[lower].plane;
+  const Eigen::Vector4f& top = sorted.candidates[s].plane;
+  const DepthBand& band = sorted.candidates[s].band;
+  const auto bit = static_cast<std::uint8_t>(1u << lower);
+  // Only the points near the hull's edge, and at most about 20000 of the points above L: a
+  // piece of wall holds hundreds of pixels at any range a plane is found at.
+  Eigen::AlignedBox2f near_edge;
+  for (const auto& v : region)
+    near_edge.extend(v);
+  near_edge.min().array() -= margin;
+  near_edge.max().array() += margin;
+  const std::vector<PointOverPlanes>& above = *sorted.above;
+  const std::size_t stride = std::max<std::size_t>(1, above.size() / 20000);
+  for (std::size_t k = 0; k < above.size(); k += stride) {
+    const PointOverPlanes& a = above[k];
+    if (!(a.above & bit))
+      continue;
+    const Eigen::Vector3f x = setup.frame.point(static_cast<std::size_t>(a.index));
+    const Eigen::Vector2f q = (to_plane * x).head<2>();
+    // Near the edge and below E's band (not E itself, nor what stands on it).
+    if (!near_edge.contains(q) ||
+        top.head<3>().dot(x) + top[3] >= -band.halfWidth((x - setup.frame.viewpoint).norm()))
+      continue;
+    const int slice =
+      std::clamp(static_cast<int>((over.head<3>().dot(x) + over[3]) / e.contact), 0, slices - 1);
+    float best = margin;
+    int piece = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2f d = region[(i + 1) % n] - region[i];
+      const float t =
+        std::clamp((q - region[i]).dot(d) / std::max(d.squaredNorm(), 1e-12f), 0.f, 1.f);
+      const float dist = (region[i] + t * d - q).norm();
+      if (dist <= best)
+        best = dist, piece = pieceOf(start[i] + t * (start[i + 1] - start[i]));
+    }
+    if (piece >= 0)
+      filled[static_cast<std::size_t>(piece)] |= 1u << slice;
+  }
+  int walled = 0;
+  for (int k = 0; k < kEdgePieces; ++k)
+    if (facing[static_cast<std::size_t>(k)]) {
+      ++e.facing_pieces;
+      walled += filled[static_cast<std::size_t>(k)] == full;
+    }
+  e.walled =
+    e.facing_pieces ? static_cast<float>(walled) / static_cast<float>(e.facing_pieces) : 0.f;
+}
+
+/** What isElevatedSupport measures of candidate \a s lying on candidate \a lower. */
+ElevatedPlane
+measureElevated(const Setup& setup, const SortedFrame& sorted, std::size_t s, std::size_t lower,
+                float min_area)
+{
+  const Candidate& c = sorted.candidates[s];
+  const Eigen::Affine3f& frame = sorted.all[s].frame;
+  const Eigen::Affine3f to_plane = frame.inverse();
+  const Eigen::Vector3f centre = frame.translation();
+  const Eigen::Vector4f& under = sorted.candidates[lower].plane;
+  ElevatedPlane e;
+  e.height = under.head<3>().dot(centre) + under[3];
+  e.contact = setup.params.contact_height +
+              sorted.candidates[lower].band.halfWidth((centre - setup.frame.viewpoint).norm());
+  std::vector<Eigen::Vector2f> region_points;
+  for (const auto i : c.points)
+    region_points.push_back((to_plane * setup.frame.point(static_cast<std::size_t>(i))).head<2>());
+  const std::vector<Eigen::Vector2f> region = convexHull2D(region_points);
+  e.region_area = polygonArea(region);
+  e.diameter = polygonDiameter(region);
+  // What isElevatedSupport reads first is measured first: the rest only when it could
+  // change the verdict.
+  if (c.points.empty() || region.size() < 3 || !(e.region_area >= min_area) ||
+      !(e.height > e.contact))
+    return e;
+  // L's points under E: inside E's region hull shrunk by the uncertainty of its edges (about
+  // a cell of the region: a block of the plane grid, a sample's spacing; L's points that close
+  // may be the foot of E's own sides), and under the region itself, near one of its cells:
+  // the tops of separate objects at one height (boxes side by side, a box and a can) make one
+  // region whose hull spans the table seen between them.
+  const float spacing = std::sqrt(e.region_area / static_cast<float>(c.points.size()));
+  const NearPoints2D cells(region_points, 2.f * spacing);
+  const pcl::Indices& lower_points = sorted.all[lower].inliers.indices;
+  const std::size_t stride = std::max<std::size_t>(1, lower_points.size() / 20000);
+  Eigen::AlignedBox2f bounds;
+  for (const auto& v : region)
+    bounds.extend(v);
+  std::size_t seen = 0;
+  for (std::size_t k = 0; k < lower_points.size(); k += stride) {
+    const Eigen::Vector2f p =
+      (to_plane * setup.frame.point(static_cast<std::size_t>(lower_points[k]))).head<2>();
+    seen += bounds.contains(p) && insideConvexBy(p, region, 2.f * spacing) && cells.near(p);
+  }
+  e.seen_under =
+    static_cast<float>(seen * stride) / static_cast<float>(std::max<std::size_t>(1, c.support));
+  if (e.seen_under >= kSeenUnderShare)
+    return e;
+  measureWalls(setup, sorted, to_plane, region, s, lower, 2.f * spacing, e);
+  return e;
+}
+
+/** For each candidate of \a family not judged yet: whether it lies inside the object band of
+ * a lower one (a shelf, a low table; a box top, books, a tray) and, if so, whether it is a
+ * support of its own (isElevatedSupport). Before any trial moves the inliers out. */
+void
+judgeElevated(const Setup& setup, SortedFrame& sorted, const std::vector<std::size_t>& family)
+{
+  const auto& p = setup.params;
+  for (const std::size_t s : family) {
+    CandidateHulls& hulls = sorted.hulls[s];
+    if (hulls.judged)
+      continue;
+    hulls.judged = true;
+    const int lower = lowerSupportOf(setup, sorted, family, s);
+    hulls.elevated = lower >= 0;
+    if (!hulls.elevated)
+      continue;
+    const ElevatedPlane e =
+      measureElevated(setup, sorted, s, static_cast<std::size_t>(lower), p.min_shelf_area);
+    hulls.elevated_support = isElevatedSupport(e, p.min_shelf_area, p.max_height);
+    PCL_DEBUG("[facyl::TabletopSegmentation] plane %zu on plane %d: %.3f m above it (contact "
+              "%.3f), region %.3f m^2, %.2f m across, seen under it %.2f, walled %.2f of "
+              "%d pieces: %s\n",
+              s, lower, e.height, e.contact, e.region_area, e.diameter, e.seen_under, e.walled,
+              e.facing_pieces, hulls.elevated_support ? "a support" : "an object's top");
+  }
 }
 
 } // namespace
@@ -297,12 +517,12 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
 {
   const auto& p = setup.params;
   const bool largest = p.support == TabletopSegmentationParameters::Support::LargestPlane;
-  const Eigen::Vector3f viewpoint = setup.frame.viewpoint;
   const auto& candidates = sorted.candidates;
   auto& all = sorted.all;
   std::vector<SupportPlane> supports;
   std::vector<std::vector<Eigen::Vector2f>> extents; ///< hulls of all the supports' points
   std::uint8_t kept = 0;
+  judgeElevated(setup, sorted, family);
   for (const std::size_t s : family) {
     SupportPlane support;
     support.plane = all[s].plane;
@@ -315,10 +535,10 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
       hulls.known = true;
     }
     support.polygon = hulls.polygon;
-    // A plane inside the object band of a larger parallel one (a shelf, a box top) is judged
-    // by the region found on it: its infinite plane slices through the objects around it.
-    const bool high =
-      elevated(setup, candidates, family, s, (support.frame.translation() - viewpoint).norm());
+    // A plane inside the object band of a lower parallel one (a shelf, a box top) is judged
+    // by the region found on it (its infinite plane slices through the objects around it) and
+    // by what holds it up (judgeElevated).
+    const bool high = hulls.elevated;
     // Its own region must be sizeable too: a small region's infinite plane can cross a
     // table.
     const float region = hulls.region;
@@ -328,7 +548,7 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
                 "%.3f, %zu inliers, hull %.3f m^2, region %.3f m^2%s\n",
                 s, support.plane[0], support.plane[1], support.plane[2], support.plane[3],
                 all[s].inliers.indices.size(), hull, region, high ? ", elevated" : "");
-    const bool large = high ? region >= p.min_shelf_area
+    const bool large = high ? hulls.elevated_support
                             : hull >= p.min_support_area && region >= 0.25f * p.min_support_area;
     if (support.polygon.size() < 3 || !(largest || large))
       continue;

@@ -55,4 +55,35 @@ polygonArea(const std::vector<Eigen::Vector2f>& polygon)
   return static_cast<float>(0.5 * std::abs(twice));
 }
 
+/** \brief Whether \a p lies inside the convex, counter-clockwise \a polygon (convexHull2D's
+ * order) at least \a margin (>= 0) from each of its edges: inside the polygon shrunk by \a
+ * margin. False for fewer than 3 vertices. */
+inline bool
+insideConvexBy(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon, float margin)
+{
+  if (polygon.size() < 3)
+    return false;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2f& a = polygon[i];
+    const Eigen::Vector2f e = polygon[(i + 1) % polygon.size()] - a;
+    const float length = e.norm();
+    // Signed distance to the left of the edge (inside for a counter-clockwise polygon).
+    if (!(length > 0.f) || (e.x() * (p - a).y() - e.y() * (p - a).x()) < margin * length)
+      return false;
+  }
+  return true;
+}
+
+/** \brief Largest distance between two vertices of \a polygon (its diameter, for a convex
+ * one); 0 for fewer than 2 vertices. */
+inline float
+polygonDiameter(const std::vector<Eigen::Vector2f>& polygon)
+{
+  float d2 = 0.f;
+  for (std::size_t i = 0; i < polygon.size(); ++i)
+    for (std::size_t j = i + 1; j < polygon.size(); ++j)
+      d2 = std::max(d2, (polygon[i] - polygon[j]).squaredNorm());
+  return std::sqrt(d2);
+}
+
 } // namespace facyl

@@ -179,6 +179,54 @@ HeightProfile heightProfile(const Eigen::Matrix3Xf& points, const Eigen::Vector4
                             const DepthBand& band, const Eigen::Vector3f& viewpoint,
                             float min_height, float max_height);
 
+/** \brief What is measured of a plane E inside the object band of a lower parallel plane L
+ * (a shelf or a low table over a table or the floor; or the top of a box in a pile, books, a
+ * tray standing on it), to tell a support from the top face of an object. */
+struct ElevatedPlane {
+  float height{0.f};      ///< of E's region above L's plane (m)
+  float contact{0.f};     ///< L's band there plus the contact height (m): see isElevatedSupport
+  float region_area{0.f}; ///< of the convex hull of the region found on E (m^2)
+  float diameter{0.f};    ///< of that hull (m)
+  /** L's points seen under E (inside E's region hull shrunk by twice the spacing of its
+   * region's cells), per point of E's region: the space under E, where the view shows it. */
+  float seen_under{0.f};
+  /** The pieces of E's hull edge that face the sensor (of kEdgePieces around it): where the
+   * view would show what holds E up. */
+  int facing_pieces{0};
+  /** Of those, the share under which points reach down from E to L's contact (a wall): the
+   * sides of a box, of books, of a tray. The legs of a table or a stool hold few of them. */
+  float walled{0.f};
+};
+
+/** \brief The pieces of equal length E's hull edge is cut into to measure ElevatedPlane::walled:
+ * a table's legs fill a piece or two at its corners, a box's side fills all those it shows. */
+constexpr int kEdgePieces = 32;
+
+/** \brief The share of E's points that L's points seen under E must reach for the space under
+ * E to be seen (ElevatedPlane::seen_under): a tenth, so that a strip along E's edge (the
+ * cells' uncertainty, a sensor's fattened edges) does not count, while the floor seen under a
+ * low table, or a lower shelf board under the one above, does. */
+constexpr float kSeenUnderShare = 0.1f;
+
+/** \brief Whether E (\a e) is a support of its own rather than the top face of an object
+ * standing on L. A shelf, a low table or a stool is held up by legs or panels with room
+ * beneath; a box in a pile, books or a tray are solid down to L. So E is a support when its
+ * region is at least \a min_area (m^2), it stands clear of L (height above \a e.contact:
+ * what stands on a plane within the contact height of L stands on L as well), and either the
+ * space under it is seen (seen_under >= kSeenUnderShare), or most of its edge that faces the
+ * sensor shows no wall down to L (walled < 1/2), or, where no edge faces the sensor (seen
+ * from above), it is larger than any object (diameter > \a max_extent, the object band's
+ * width, as in standsOn). */
+inline bool
+isElevatedSupport(const ElevatedPlane& e, float min_area, float max_extent)
+{
+  if (!(e.region_area >= min_area && e.height > e.contact))
+    return false;
+  if (e.seen_under >= kSeenUnderShare)
+    return true;
+  return e.facing_pieces > 0 ? e.walled < 0.5f : e.diameter > max_extent;
+}
+
 /** \brief A cluster stands on a plane when it reaches down to it (base <= contact) and is
  * whole inside the object band, a box max_height high and wide (top below max_height -
  * margin, extent below max_height): a table's objects do; the legs of a table over a floor
