@@ -265,6 +265,8 @@ processScene(const std::string& file, const std::string& name, const Settings& s
   rec.setUpDirection(s.up);
   rec.setClassifier(s.classifier);
   rec.setInputCloud(cloud);
+  if (stream) // the tracks' table, where the camera's motion puts it
+    stream->tracker.prepare(rec);
   std::vector<facyl::RecognizedObject> objects;
   std::vector<facyl::RecognitionTiming> timings;
   for (int r = 0; r < s.repeat; ++r) {
@@ -427,8 +429,10 @@ parseSettings(int argc, char** argv, std::vector<std::string>& files)
   s.roll = static_cast<int>(roll / 90);
   s.verbose = args.has("--verbose");
   s.track = args.has("--track");
-  if (!s.track && (args.has("--track-confirm-hits") || args.has("--track-max-misses")))
-    throw std::invalid_argument("--track-confirm-hits and --track-max-misses need --track");
+  if (!s.track && (args.has("--track-confirm-hits") || args.has("--track-max-misses") ||
+                   args.has("--track-support-switch-frames")))
+    throw std::invalid_argument(
+      "--track-confirm-hits, --track-max-misses and --track-support-switch-frames need --track");
   facyl_cli::applyOptions(facyl_cli::trackerOptions(), args, s.tracking);
   s.many = files.size() > 1;
   checkOutputs(s, files, args.text("--model", ""));

@@ -209,6 +209,7 @@ evaluateSequence(const Options& opt, std::uint64_t seed,
       facyl::renderSequenceFrame(seq, f, p.camera, p.sensor, facyl::sequenceFrameSeed(seed, f));
     Cloud::Ptr cloud(new Cloud(r.cloud));
     rec.setInputCloud(cloud);
+    tracker.prepare(rec); // the tracks' table, where the camera's motion puts it
     std::vector<facyl::RecognizedObject> objects;
     const bool ok = rec.recognize(objects);
     const auto t0 = std::chrono::steady_clock::now();
@@ -476,7 +477,8 @@ printHelp(const char* self)
   std::printf(
     "Usage: %s [--sequences N] [--frames F] [--first-seed S] [--sensor kinect|stereo]\n"
     "          [--layout cluttered|spread|realistic] [--change mixed|none|remove|add]\n"
-    "          [--orbit RAD] [--track-confirm-hits N] [--track-max-misses N] [--csv FILE]\n"
+    "          [--orbit RAD] [--track-confirm-hits N] [--track-max-misses N]\n"
+    "          [--track-support-switch-frames N] [--csv FILE]\n"
     "          [recognizer options]\n"
     "Renders N simulated streams (default 20) of F frames (default 30): a camera moving\n"
     "around a static table (facyl_synth --sequence; seeds S.., default 3000; --change mixed:\n"

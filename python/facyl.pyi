@@ -131,6 +131,7 @@ class Tracker:
         model: str = "default",
         track_confirm_hits: int = 2,
         track_max_misses: int = 5,
+        track_support_switch_frames: int = 3,
         **options: Any,  # detect()'s recognizer options
     ) -> None: ...
     def update(

@@ -628,12 +628,15 @@ class PyTracker {
 public:
   PyTracker(const std::optional<std::vector<double>>& camera, const py::object& up,
             const std::string& model, const py::object& confirm_hits, const py::object& max_misses,
-            const py::kwargs& options)
+            const py::object& switch_frames, const py::kwargs& options)
   {
     configureRecognizer(rec_, camera, up, model, options);
     facyl::CylinderTrackerParameters tp;
     applyKeywords(facyl_cli::trackerOptions(),
-                  {{"track_confirm_hits", confirm_hits}, {"track_max_misses", max_misses}}, tp);
+                  {{"track_confirm_hits", confirm_hits},
+                   {"track_max_misses", max_misses},
+                   {"track_support_switch_frames", switch_frames}},
+                  tp);
     tracker_.setParameters(tp);
     tracker_.setCamera(cameraOf(camera));
   }
@@ -656,6 +659,7 @@ public:
       py::gil_scoped_release release;
       std::lock_guard<std::mutex> lock(mutex_);
       rec_.setInputCloud(cloud);
+      tracker_.prepare(rec_); // the tracks' table, where the camera's motion puts it
       ok = rec_.recognize(objects);
       if (ok) {
         tracker_.update(rec_, objects);
@@ -1118,17 +1122,21 @@ the camera pose and the object ids present.)");
 (facyl_detect --track; C++ facyl::CylinderTracker): a camera moving over a static table.
 
 Tracker(camera=None, up=None, model="default", track_confirm_hits=2, track_max_misses=5,
-**options): camera, up, model and the other keywords as in detect() (facyl_detect's recognizer
+track_support_switch_frames=3, **options): camera, up, model and the other keywords as in detect() (facyl_detect's recognizer
 options, '_' for '-'); track_confirm_hits: frames a new track must be seen in before it is
 confirmed (a cylinder seen in one frame only never becomes a track); track_max_misses: missed
 frames a confirmed track survives (occlusion; longer when the frame shows it hidden or out of
-view). update() is serialised: one frame at a time, from any thread (the GIL is released).)")
+view); track_support_switch_frames: frames in a row another support must win before it replaces
+the tracks' table (the last frames' table is handed to the recognizer as its support prior).
+update() is serialised: one frame at a time, from any thread (the GIL is released).)")
     .def(py::init<const std::optional<std::vector<double>>&, const py::object&, const std::string&,
-                  const py::object&, const py::object&, const py::kwargs&>(),
+                  const py::object&, const py::object&, const py::object&, const py::kwargs&>(),
          py::kw_only(), py::arg("camera") = py::none(), py::arg("up") = py::none(),
          py::arg("model") = facyl_cli::RecognizerSettings{}.model,
          py::arg("track_confirm_hits") = facyl::CylinderTrackerParameters{}.confirm_hits,
-         py::arg("track_max_misses") = facyl::CylinderTrackerParameters{}.max_misses)
+         py::arg("track_max_misses") = facyl::CylinderTrackerParameters{}.max_misses,
+         py::arg("track_support_switch_frames") =
+           facyl::CylinderTrackerParameters{}.support_switch_frames)
     .def("update", &PyTracker::update, py::arg("points"), py::arg("colors") = py::none(),
          R"(The next frame of the stream (points and colors as for detect()). Returns facyl_detect
 --track's JSON line as a dict: detect()'s fields, with per object "track_id" (int, stable across

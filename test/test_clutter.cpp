@@ -608,6 +608,58 @@ TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
     EXPECT_EQ(c.support, -1);
 }
 
+TEST(SupportPlanes, ASupportPriorKeepsItsPlaneTheTable)
+{
+  // The small table above the floor, seen from 1.6 m: alone, the table (the objects stand on
+  // it). With a support prior on the floor (a stream whose tracks stand on the floor; the
+  // floor and the table are parallel, one family), the floor stays the table and the objects
+  // are still found, on the table top. A default prior changes nothing.
+  facyl::TabletopSceneParameters small;
+  small.table_width = {0.55f, 0.55f};
+  small.table_depth = {0.45f, 0.45f};
+  small.table_height = {0.5f, 0.5f};
+  small.table_legs = true;
+  facyl::TabletopScene scene = emptyTable(small);
+  scene.objects.push_back(can(0.035f, 0.12f, {-0.1f, 0.f, 0.f}));
+  scene.objects.push_back(box({0.1f, 0.08f, 0.1f}, {0.1f, 0.05f, 0.f}, 0.4f));
+  scene.objects.push_back(can(0.03f, 0.1f, {0.05f, -0.12f, 0.f}));
+  const facyl::RenderedScene s = render(scene, {0.1f, -1.1f, 1.35f}, {0.f, 0.f, 0.04f});
+  Cloud::Ptr cloud(new Cloud(s.cloud));
+  const Eigen::Vector3f n = s.table_plane.head<3>();
+  facyl::SupportPrior floor;
+  floor.plane = s.table_plane;
+  floor.plane[3] += 0.5f; // 0.5 m below the table, away from the sensor
+  floor.centre = -floor.plane[3] * n;
+  floor.max_angle = 0.1f;
+  floor.max_offset = 0.1f;
+  ASSERT_TRUE(floor.valid());
+  for (const bool with_prior : {false, true}) {
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setInputCloud(cloud);
+    if (with_prior)
+      seg.setSupportPrior(floor);
+    std::vector<facyl::TabletopCluster> clusters;
+    ASSERT_TRUE(seg.segment(clusters));
+    const auto& c = seg.getTableCoefficients().values;
+    const Eigen::Vector4f table(c[0], c[1], c[2], c[3]);
+    const facyl::SupportPriorResult& result = seg.getSupportPriorResult();
+    EXPECT_EQ(result.given, with_prior);
+    EXPECT_EQ(result.support >= 0, with_prior);
+    EXPECT_NEAR(table[3], with_prior ? floor.plane[3] : s.table_plane[3], 0.02f) << with_prior;
+    EXPECT_EQ(facyl::consistentWithPrior(floor, table), with_prior);
+    EXPECT_TRUE(seg.tableFound());
+    // The objects: on the table top either way (a support other than the floor).
+    std::size_t on_top = 0;
+    for (const auto& k : clusters) {
+      if (k.support < 0)
+        continue;
+      const auto& sp = seg.getSupports()[static_cast<std::size_t>(k.support)];
+      on_top += std::abs(sp.plane[3] - s.table_plane[3]) < 0.02f;
+    }
+    EXPECT_EQ(on_top, 3u) << with_prior;
+  }
+}
+
 // ---------------------------------------------------------------- recognition
 
 TEST(ClutterRecognition, StackedCoaxialCylindersAndACanAgainstABox)

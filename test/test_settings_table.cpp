@@ -410,8 +410,12 @@ TEST(SettingsTable, TrackerOptions)
   expectRoundTrips(
     table, Samples<Tracking>{
              {"track-confirm-hits", {"3", [](const Tracking& s) { return s.confirm_hits == 3; }}},
-             {"track-max-misses", {"9", [](const Tracking& s) { return s.max_misses == 9; }}}});
-  expectRefusals(table, {{"track-confirm-hits", "0"}, {"track-max-misses", "1001"}});
+             {"track-max-misses", {"9", [](const Tracking& s) { return s.max_misses == 9; }}},
+             {"track-support-switch-frames",
+              {"5", [](const Tracking& s) { return s.support_switch_frames == 5; }}}});
+  expectRefusals(table, {{"track-confirm-hits", "0"},
+                         {"track-max-misses", "1001"},
+                         {"track-support-switch-frames", "0"}});
   expectHelpListsDefaults(table);
   // validate()'s message, after the option.
   EXPECT_EQ(refusal(table, {"--track-confirm-hits", "0"}),

@@ -356,44 +356,138 @@ confirmedTrack(const facyl::TrackObservation& o, int id)
 
 } // namespace
 
+namespace {
+
+/** A support whose plane is z = 0 of \a frame (its normal, frame's z, towards the sensor). */
+facyl::SupportPlane
+supportAt(const Eigen::Affine3f& frame)
+{
+  facyl::SupportPlane s;
+  s.frame = frame;
+  const Eigen::Vector3f n = frame.linear().col(2);
+  s.plane = Eigen::Vector4f(n.x(), n.y(), n.z(), -n.dot(frame.translation()));
+  return s;
+}
+
+/** The prior of the plane z = \a height, seen last at (0, 0, height), within 0.35 rad and
+ * 0.15 m (the tracker's default tolerances). */
+facyl::SupportPrior
+priorAt(float height)
+{
+  facyl::SupportPrior p;
+  p.plane << 0.f, 0.f, 1.f, -height;
+  p.centre << 0.f, 0.f, height;
+  p.max_angle = 0.35f;
+  p.max_offset = 0.15f;
+  return p;
+}
+
+} // namespace
+
 TEST(TrackerSteps, AnchorIsTheTableThenTheSupportMostObjectsStandOn)
 {
-  const facyl::CylinderTrackerParameters params;
   // Three supports: the world's plane (identity), one tilted 30 degrees, one 40 cm higher.
-  std::vector<facyl::SupportPlane> supports(3);
-  supports[1].frame = Eigen::AngleAxisf(0.52f, Eigen::Vector3f::UnitX());
-  supports[2].frame = Eigen::Translation3f(0.f, 0.f, 0.4f);
+  const std::vector<facyl::SupportPlane> supports{
+    supportAt(Eigen::Affine3f::Identity()),
+    supportAt(Eigen::Affine3f(Eigen::AngleAxisf(0.52f, Eigen::Vector3f::UnitX()))),
+    supportAt(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, 0.4f)))};
   std::vector<facyl::RecognizedObject> objects(4);
   objects[0].cluster.support = 0;
   objects[1].cluster.support = objects[2].cluster.support = objects[3].cluster.support = 2;
-  const Eigen::Affine3f identity = Eigen::Affine3f::Identity();
   // A new world: the table, else the support most objects stand on.
-  auto c = facyl::chooseAnchor(supports, 1, objects, false, identity, params);
+  auto c = facyl::chooseAnchor(supports, 1, objects, nullptr);
   EXPECT_EQ(c.anchor, 1);
   EXPECT_FALSE(c.plane_jump);
-  EXPECT_EQ(facyl::chooseAnchor(supports, -1, objects, false, identity, params).anchor, 2);
+  EXPECT_EQ(facyl::chooseAnchor(supports, -1, objects, nullptr).anchor, 2);
   // A support without a finite frame is never the anchor.
   auto broken = supports;
   broken[2].frame.matrix()(0, 0) = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(facyl::chooseAnchor(broken, -1, objects, false, identity, params).anchor, 0);
-  // Continuing the world's plane: the first in that order that continues it, the table or not.
-  c = facyl::chooseAnchor(supports, 1, objects, true, identity, params);
+  EXPECT_EQ(facyl::chooseAnchor(broken, -1, objects, nullptr).anchor, 0);
+  // Continuing the tracks' plane: the first in that order that is it, the table or not.
+  const facyl::SupportPrior here = priorAt(0.f);
+  c = facyl::chooseAnchor(supports, 1, objects, &here);
   EXPECT_EQ(c.anchor, 0);
   EXPECT_FALSE(c.plane_jump);
-  // None continues it: the first, a jump.
-  const Eigen::Affine3f away(Eigen::Translation3f(0.f, 0.f, 1.f));
-  c = facyl::chooseAnchor(supports, 1, objects, true, away, params);
+  // None is it: the first, a jump.
+  const facyl::SupportPrior away = priorAt(1.f);
+  c = facyl::chooseAnchor(supports, 1, objects, &away);
   EXPECT_EQ(c.anchor, 1);
   EXPECT_TRUE(c.plane_jump);
-  EXPECT_EQ(facyl::chooseAnchor({}, -1, objects, true, identity, params).anchor, -1);
-  // continuesPlane: angle and height within the limits, the normal on the world's side.
-  EXPECT_TRUE(facyl::continuesPlane(identity, 0.35f, 0.15f));
-  EXPECT_TRUE(facyl::continuesPlane(
-    Eigen::Affine3f(Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitY())), 0.35f, 0.15f));
-  EXPECT_FALSE(facyl::continuesPlane(supports[1].frame, 0.35f, 0.15f));
-  EXPECT_FALSE(facyl::continuesPlane(supports[2].frame, 0.35f, 0.15f));
-  EXPECT_FALSE(facyl::continuesPlane(
-    Eigen::Affine3f(Eigen::AngleAxisf(kPi, Eigen::Vector3f::UnitX())), 0.35f, 0.15f));
+  EXPECT_EQ(facyl::chooseAnchor({}, -1, objects, &here).anchor, -1);
+}
+
+TEST(TrackerSteps, ConsistentWithPriorWithinItsAngleAndOffset)
+{
+  const facyl::SupportPrior prior = priorAt(0.f);
+  ASSERT_TRUE(prior.valid());
+  const auto planeOf = [](const Eigen::Affine3f& frame) { return supportAt(frame).plane; };
+  EXPECT_TRUE(facyl::consistentWithPrior(prior, planeOf(Eigen::Affine3f::Identity())));
+  // Within the angle (0.3 of 0.35 rad) and the offset (0.14 of 0.15 m, at the centre).
+  EXPECT_TRUE(facyl::consistentWithPrior(
+    prior, planeOf(Eigen::Affine3f(Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitY())))));
+  EXPECT_TRUE(facyl::consistentWithPrior(
+    prior, planeOf(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, 0.14f)))));
+  // Beyond either, or the normal away from the sensor (the underside of the plane).
+  EXPECT_FALSE(facyl::consistentWithPrior(
+    prior, planeOf(Eigen::Affine3f(Eigen::AngleAxisf(0.4f, Eigen::Vector3f::UnitY())))));
+  EXPECT_FALSE(facyl::consistentWithPrior(
+    prior, planeOf(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, 0.16f)))));
+  EXPECT_FALSE(facyl::consistentWithPrior(
+    prior, planeOf(Eigen::Affine3f(Eigen::AngleAxisf(kPi, Eigen::Vector3f::UnitX())))));
+  // The offset is measured at the prior's centre: a plane tilted 0.3 rad through the centre is
+  // the prior's, one through a point 1 m beside it (0.3 m off at the centre) is not.
+  facyl::SupportPrior beside = prior;
+  beside.centre << 1.f, 0.f, 0.f;
+  const Eigen::Vector4f tilted =
+    planeOf(Eigen::Affine3f(Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitY())));
+  EXPECT_TRUE(facyl::consistentWithPrior(prior, tilted));
+  EXPECT_FALSE(facyl::consistentWithPrior(beside, tilted));
+  // An invalid prior (no plane, or no angle) holds no plane.
+  EXPECT_FALSE(facyl::consistentWithPrior(facyl::SupportPrior{}, tilted));
+  facyl::SupportPrior no_angle = prior;
+  no_angle.max_angle = 0.f;
+  EXPECT_FALSE(no_angle.valid());
+  EXPECT_FALSE(facyl::consistentWithPrior(no_angle, planeOf(Eigen::Affine3f::Identity())));
+}
+
+TEST(TrackerSteps, DecisionsHaveHysteresis)
+{
+  // decideWithHysteresis: a side changes only beyond the margin; margin 0 is the threshold.
+  EXPECT_FALSE(facyl::decideWithHysteresis(false, 0.3f, 0.f, 0.5f));
+  EXPECT_TRUE(facyl::decideWithHysteresis(false, 0.6f, 0.f, 0.5f));
+  EXPECT_TRUE(facyl::decideWithHysteresis(true, -0.3f, 0.f, 0.5f));
+  EXPECT_FALSE(facyl::decideWithHysteresis(true, -0.6f, 0.f, 0.5f));
+  EXPECT_TRUE(facyl::decideWithHysteresis(false, 0.f, 0.f, 0.f));
+  EXPECT_FALSE(facyl::decideWithHysteresis(true, -1e-3f, 0.f, 0.f));
+  // The margin: the spread of the evidence, at most half the clamp of the log-odds.
+  EXPECT_FLOAT_EQ(facyl::decisionMargin(0.25f, 4.6f), 0.5f);
+  EXPECT_FLOAT_EQ(facyl::decisionMargin(100.f, 4.6f), 2.3f);
+  EXPECT_FLOAT_EQ(facyl::decisionMargin(-1.f, 4.6f), 0.f);
+  // A static object whose frames disagree (p 0.7, 0.3, 0.7, ...): its log-odds swing across
+  // min_probability's every frame, the plain threshold flips every frame, the decision does
+  // not; steady evidence still changes it.
+  const facyl::CylinderTrackerParameters params;
+  facyl::TrackObservation o;
+  o.valid = true;
+  o.p = 0.4f;
+  facyl::CylinderTrack t = facyl::newTrack(o, 0, 0, params);
+  EXPECT_FALSE(t.decided_cylinder);
+  int plain_flips = 0, flips = 0;
+  bool plain = t.pCylinder() >= params.min_probability, decided = t.decided_cylinder;
+  for (std::size_t n = 2; n <= 12; ++n) {
+    facyl::recordEvidence(t, n % 2 == 0 ? 0.7f : 0.3f, n, params);
+    const bool now_plain = t.pCylinder() >= params.min_probability;
+    plain_flips += now_plain != plain;
+    flips += t.decided_cylinder != decided;
+    plain = now_plain;
+    decided = t.decided_cylinder;
+  }
+  EXPECT_EQ(plain_flips, 11);
+  EXPECT_EQ(flips, 0);
+  EXPECT_FALSE(t.decided_cylinder);
+  for (std::size_t n = 13; n <= 15; ++n)
+    facyl::recordEvidence(t, 0.9f, n, params);
+  EXPECT_TRUE(t.decided_cylinder);
 }
 
 TEST(TrackerSteps, RegistrationCandidatesAgreeInSizeAndHeight)
@@ -832,6 +926,45 @@ TEST(CylinderTracker, OneFrameFalsePositiveIsNeverConfirmed)
   EXPECT_EQ(tracker.getTracks().size(), table.items.size());
 }
 
+TEST(CylinderTracker, AWallForOneFrameDoesNotReplaceTheTable)
+{
+  // Frame 6 of a stream over a table reports a wall behind it as its table (its objects on
+  // it): the tracks' plane stays the table (the frame is not anchored, its pose predicted, no
+  // new scene), every track keeps its id, and the prior handed on is still the table's.
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  std::set<int> ids;
+  for (int k = 0; k < 12; ++k) {
+    auto supports = table.supports(k);
+    auto objects = table.objects(k);
+    if (k == 6) {
+      const Eigen::Affine3f to_camera = table.camera(k).inverse();
+      const Eigen::Vector3f n = to_camera.linear() * Eigen::Vector3f(0.f, -1.f, 0.f);
+      const Eigen::Vector4f wall(n.x(), n.y(), n.z(),
+                                 -n.dot(to_camera * Eigen::Vector3f(0.f, 0.5f, 0.3f)));
+      supports[0].plane = wall;
+      supports[0].frame = facyl::planeFrame(wall, to_camera * Eigen::Vector3f(0.f, 0.5f, 0.3f));
+    }
+    tracker.update(supports, 0, objects);
+    const auto& info = tracker.getFrameInfo();
+    EXPECT_FALSE(info.new_scene) << "frame " << k;
+    EXPECT_EQ(info.scene, 0u);
+    EXPECT_EQ(info.anchored, k != 6) << "frame " << k;
+    for (const auto& t : tracker.getTracks()) {
+      if (k == 5)
+        ids.insert(t.id);
+      else if (k > 5) {
+        EXPECT_EQ(ids.count(t.id), 1u) << "frame " << k << ", track " << t.id;
+      }
+    }
+    // The prior for the next frame: the table as the next camera sees it.
+    const facyl::SupportPrior prior = tracker.supportPrior();
+    ASSERT_TRUE(prior.valid()) << "frame " << k;
+    EXPECT_TRUE(facyl::consistentWithPrior(prior, table.supports(k + 1)[0].plane)) << k;
+  }
+  EXPECT_EQ(ids.size(), table.items.size());
+}
+
 TEST(CylinderTracker, OneFrameMissKeepsTheTrack)
 {
   SyntheticTable table;
@@ -983,7 +1116,7 @@ TEST(CylinderTracker, TakenAwayObjectEndsWhenTheSensorSeesThroughItsPlace)
 TEST(CylinderTracker, NewSceneStartsNewTracks)
 {
   // Another table, seen from elsewhere (its plane does not continue the tracks' and its
-  // objects match none): every track ends, new ones start.
+  // objects match none), frame after frame: every track ends, new ones start.
   SyntheticTable first, second;
   second.items = {{true, {0.3f, 0.3f, 0.f}, 0.09f, 0.05f},
                   {false, {-0.2f, 0.25f, 0.06f}, 0.f, 0.f},
@@ -996,7 +1129,17 @@ TEST(CylinderTracker, NewSceneStartsNewTracks)
     tracker.update(first.supports(k), 0, first.objects(k));
   for (const auto& t : tracker.getTracks())
     first_ids.insert(t.id);
+  // The tracks' plane stays for support_switch_frames - 1 frames of another plane (not
+  // anchored, the pose predicted); the next one anchors on it: a new scene.
+  const int hold = facyl::CylinderTrackerParameters{}.support_switch_frames;
+  for (int k = 0; k + 1 < hold; ++k) {
+    tracker.update(second.supports(0), 0, second.objects(0));
+    EXPECT_FALSE(tracker.getFrameInfo().anchored);
+    EXPECT_FALSE(tracker.getFrameInfo().new_scene);
+    EXPECT_EQ(tracker.getFrameInfo().prior_unseen_frames, k + 1);
+  }
   tracker.update(second.supports(0), 0, second.objects(0));
+  EXPECT_TRUE(tracker.getFrameInfo().anchored);
   EXPECT_TRUE(tracker.getFrameInfo().new_scene);
   EXPECT_EQ(tracker.getFrameInfo().scene, 1u);
   for (const auto& t : tracker.getTracks())

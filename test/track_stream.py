@@ -2,9 +2,9 @@
 """Streams as a user runs them (CTest track_stream): facyl_synth --sequence writes a stream with
 ground truth; facyl_detect --track runs it as one stream with bad input in the middle (a file
 that is not a PCD, an empty cloud, a frame of another size, a frame without any support) and a
-new scene at the end: every object has an integer track_id, the cylinders confirmed early keep
-their ids to the end, failed frames say why and keep the tracks, the new scene starts new
-tracks; --overlay draws what the lines say (issue 41): each box in the colour of the track's
+new scene at the end, three frames: every object has an integer track_id, the cylinders
+confirmed early keep their ids to the end, failed frames say why and keep the tracks, the
+tracks' table stays for two frames of another and the third starts a new scene with new tracks; --overlay draws what the lines say (issue 41): each box in the colour of the track's
 decision with the track's id over it, this frame's own cylinder dashed magenta; facyl_viewer
 --stream plays the folder through pcl::PCDGrabber under xvfb-run (when built and xvfb-run is
 there) with the same track ids, and its JSON lines are facyl_detect --track's (plus "frame").
@@ -65,8 +65,8 @@ try:
                 "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n")
     frame = lambda k: os.path.join(tmp, f"s_f{k:04d}.pcd")
     stream = [frame(0), frame(1), frame(2), notes, small + "_f0003.pcd", empty,
-              os.path.join(data, "default_cylinder.pcd"), frame(4), frame(5), frame(6), frame(7),
-              os.path.join(data, "default_scene.pcd")]
+              os.path.join(data, "default_cylinder.pcd"), frame(4), frame(5), frame(6),
+              frame(7)] + [os.path.join(data, "default_scene.pcd")] * 3
     r = run([detect, "--track"] + stream)
     lines = [json.loads(l) for l in r.stdout.splitlines() if l.strip()]
     check("facyl_detect --track: one line per frame, exit status 1 (two frames failed)",
@@ -101,7 +101,14 @@ try:
                   abs(o["cylinder"]["radius"] - o["cylinder_frame"]["radius"]) < 0.01
                   for o in lines[8]["objects"]))
         previous = {t["track_id"] for t in lines[10]["tracks"]}
-        last = lines[11]
+        # Another scene (its table another plane): the tracks' table stays for two frames (not
+        # anchored, the tracks kept), the third (support_switch_frames) starts a new scene.
+        check("two frames of another table keep the tracks' table and the tracks",
+              all(not l["stream"]["anchored"] and not l["stream"]["new_scene"] and
+                  l["stream"]["support_prior"]["unseen_frames"] == k + 1 and
+                  previous <= {t["track_id"] for t in l["tracks"]}
+                  for k, l in enumerate(lines[11:13])), [l["stream"] for l in lines[11:13]])
+        last = lines[13]
         check("a new scene starts new tracks",
               last["stream"]["new_scene"] and
               not ({o["track_id"] for o in last["objects"]} & previous), last["stream"])

@@ -201,6 +201,7 @@ runStream(const StreamSettings& s)
       error = "the cloud has no finite point";
     else {
       rec.setInputCloud(cloud);
+      tracker.prepare(rec); // the tracks' table, where the camera's motion puts it
       if (!rec.recognize(objects))
         error = "recognition failed (see the message above)";
     }

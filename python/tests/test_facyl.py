@@ -587,14 +587,19 @@ def _truth_of(frame, obj):
 
 
 def test_tracker_keeps_ids_on_a_simulated_stream():
-    # facyl.Tracker on 8 frames of a moving camera: the tracked objects keep their ids, and the
-    # result has facyl_detect --track's fields.
+    # facyl.Tracker on 8 frames of a moving camera: the tracked objects keep their ids, the
+    # support prior is handed on, and the result has facyl_detect --track's fields.
     tracker = facyl.Tracker()
     ids_of = {}
     for k in range(8):
         frame = facyl.render_sequence_frame(seed=11, frame=k, frames=8)
         out = tracker.update(frame["points"], frame["colors"])
         assert out["stream"]["frame"] == k and out["stream"]["anchored"]
+        # The tracks' table reached the recognizer as its support prior from the second frame
+        # on (Tracker goes through facyl_detect --track's path) and stayed the table.
+        prior = out["stream"]["support_prior"]
+        assert prior["given"] == (k > 0) and prior["held"] == (k > 0), prior
+        assert prior["unseen_frames"] == 0 and not prior["challenged"], prior
         for o in out["objects"]:
             assert isinstance(o["track_id"], int)
             assert {"cylinder_frame", "is_cylinder_frame", "track", "role", "indices"} <= o.keys()

@@ -74,11 +74,13 @@ msSince(Clock::time_point a)
  * upright camera would choose (see chooseFamily). */
 constexpr float kFamilyMargin = 1.5f;
 
-/** Of \a families (rankFamilies' order), the one whose supports most objects stand on. */
+/** Of \a families (rankFamilies' order), the one whose supports most objects stand on; with a
+ * prior, its family while it has supports (familyWithPrior; \a prior: whether the frame alone
+ * chose another). */
 std::size_t
 chooseFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
              const std::vector<std::vector<std::size_t>>& families, std::size_t& tried,
-             TabletopWorkspace& workspace)
+             TabletopWorkspace& workspace, SupportPriorResult& prior)
 {
   // The family of supports is the one most objects stand on: no camera roll is assumed.
   // Several families: each is judged on a coarse grid of its object points (a clustering at
@@ -93,9 +95,13 @@ chooseFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   if (families.size() < 2)
     return chosen;
   const int stride = setup.as_image ? setup.plane_step : 1;
+  std::vector<char> with_supports(families.size(), 0);
+  std::vector<std::size_t> standing(families.size(), 0);
   for (std::size_t f = 0; f < families.size(); ++f) {
     const Trial coarse = tryFamily(setup, cues, sorted, families[f], stride, false, workspace);
     tried += !coarse.supports.empty();
+    with_supports[f] = !coarse.supports.empty();
+    standing[f] = coarse.standing_objects;
     const Eigen::Vector4f& first = sorted.candidates[families[f].front()].plane;
     PCL_DEBUG("[facyl::TabletopSegmentation] family %zu (%zu planes, first (%.3f %.3f %.3f)): "
               "%zu supports, %zu objects standing (%zu points, coarse)\n",
@@ -105,7 +111,8 @@ chooseFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
                                                      kFamilyMargin * static_cast<float>(most)))
       chosen = f, most = coarse.standing_objects;
   }
-  return chosen;
+  return familyWithPrior(priorFamily(setup, sorted, families), chosen, with_supports, standing,
+                         prior);
 }
 
 /** \a out's supports, table and clusters from \a trial; when nothing stands on the supports,
@@ -116,7 +123,11 @@ adoptTrial(const Setup& setup, const FrameCues& cues, Trial trial, TabletopSegme
 {
   out.supports = std::move(trial.supports);
   out.table = trial.table;
-  out.table_found = out.supports[out.table].standing_points > 0;
+  // Something stands on the supports (the frame's own table is the one most stands on; the
+  // prior's may hold less).
+  out.table_found = std::any_of(out.supports.begin(), out.supports.end(),
+                                [](const SupportPlane& s) { return s.standing_points > 0; });
+  out.prior.support = trial.table_is_prior ? static_cast<int>(out.table) : -1;
   out.clusters = std::move(trial.clusters);
   if (out.table_found)
     return;
@@ -151,9 +162,18 @@ searchedAsImage(const PointFrame& frame, const TabletopSegmentationParameters& p
 
 Setup
 makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
-          const PinholeCamera& camera, const Eigen::Vector3f& up)
+          const PinholeCamera& camera, const Eigen::Vector3f& up, const SupportPrior* prior)
 {
-  return Setup{frame, params, camera, up, planeStep(frame, params), searchedAsImage(frame, params)};
+  // The prior guides the choice among the planes objects stand on (ObjectsStanding).
+  const bool use_prior = prior && prior->valid() &&
+                         params.support == TabletopSegmentationParameters::Support::ObjectsStanding;
+  return Setup{frame,
+               params,
+               camera,
+               up,
+               planeStep(frame, params),
+               searchedAsImage(frame, params),
+               use_prior ? prior : nullptr};
 }
 
 void
@@ -169,6 +189,12 @@ segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace)
 {
   const auto t0 = Clock::now();
   TabletopSegments out;
+  out.prior.given = setup.prior != nullptr;
+  if (setup.prior)
+    PCL_DEBUG("[facyl::TabletopSegmentation] support prior (%.3f %.3f %.3f) d %.3f, within %.3f "
+              "rad and %.3f m\n",
+              setup.prior->plane[0], setup.prior->plane[1], setup.prior->plane[2],
+              setup.prior->plane[3], setup.prior->max_angle, setup.prior->max_offset);
   // 1. The support candidates; 2. every point sorted onto and above them.
   std::vector<Candidate> candidates = findCandidates(setup, cues, workspace);
   const double t_planes = msSince(t0);
@@ -177,7 +203,8 @@ segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace)
   // 3. The family of supports that objects stand on, and its objects at full resolution.
   const auto families = rankFamilies(setup, cues, sorted);
   std::size_t tried = 0;
-  const std::size_t chosen = chooseFamily(setup, cues, sorted, families, tried, workspace);
+  const std::size_t chosen =
+    chooseFamily(setup, cues, sorted, families, tried, workspace, out.prior);
   std::optional<Trial> best;
   if (!families.empty()) {
     Trial trial = tryFamily(setup, cues, sorted, families[chosen], 1, true, workspace);
@@ -208,7 +235,8 @@ segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace)
 
 TabletopSegments
 segmentTabletop(const PointFrame& frame, const PinholeCamera& camera, const Eigen::Vector3f& up,
-                const TabletopSegmentationParameters& params, TabletopWorkspace& workspace)
+                const TabletopSegmentationParameters& params, TabletopWorkspace& workspace,
+                const SupportPrior* prior)
 {
   const auto t0 = tabletop::Clock::now();
   if (const std::string why = validate(params); !why.empty())
@@ -221,7 +249,7 @@ segmentTabletop(const PointFrame& frame, const PinholeCamera& camera, const Eige
   if ((frame.size > 0 && !frame.xyz) || frame.stride < 3)
     throw std::invalid_argument("facyl::segmentTabletop: a frame needs its points' memory and "
                                 "a stride of at least 3 floats");
-  const tabletop::Setup setup = tabletop::makeSetup(frame, params, camera, up);
+  const tabletop::Setup setup = tabletop::makeSetup(frame, params, camera, up, prior);
   const int step = latticeStep(frame, params);
   TabletopSegments out;
   if (step > 1)

@@ -226,7 +226,7 @@ segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace)
   const double t_lattice = ms(t0);
   FrameCues cues;
   TabletopSegments out =
-    segmentFrame(makeSetup(lattice, params, camera, setup.up), cues, workspace);
+    segmentFrame(makeSetup(lattice, params, camera, setup.up, setup.prior), cues, workspace);
   const auto t1 = Clock::now();
   out.clusters = clustersAtFullResolution(setup, cues, out.clusters, out.supports, lattice, step);
   supportsAtFullResolution(setup.frame, step, out.supports);

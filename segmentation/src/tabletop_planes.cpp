@@ -355,8 +355,10 @@ keepSupportCandidates(const Setup& setup, std::vector<Candidate>& candidates)
       candidates.resize(1);
     return;
   }
-  if (candidates.size() > p.max_planes)
+  if (candidates.size() > p.max_planes) {
+    keepPriorCandidate(setup, candidates, p.max_planes);
     candidates.resize(p.max_planes);
+  }
 }
 
 } // namespace

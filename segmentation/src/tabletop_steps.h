@@ -29,6 +29,8 @@ struct Setup {
   Eigen::Vector3f up;
   int plane_step; ///< the block size of the plane search on an image (see plane_step)
   bool as_image;  ///< searched as an image (see searchedAsImage), else as a point set
+  /** Where the last frames' support is expected (a valid SupportPrior), nullptr: none. */
+  const SupportPrior* prior{nullptr};
 };
 
 /** The block size of the plane search on organized frames: plane_step, or width / 160. */
@@ -39,8 +41,10 @@ int planeStep(const PointFrame& frame, const TabletopSegmentationParameters& par
  * few rings, a strip) are point sets. */
 bool searchedAsImage(const PointFrame& frame, const TabletopSegmentationParameters& params);
 
+/** The Setup of a run; \a prior is kept only when valid (SupportPrior::valid). */
 Setup makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
-                const PinholeCamera& camera, const Eigen::Vector3f& up);
+                const PinholeCamera& camera, const Eigen::Vector3f& up,
+                const SupportPrior* prior = nullptr);
 
 /** Calls \a f with each index of the points to segment (the frame's indices, else all). */
 template <typename F>
@@ -136,6 +140,7 @@ struct Trial {
   std::size_t table{0};
   std::size_t standing{0};         ///< object points standing on the supports
   std::size_t standing_objects{0}; ///< objects standing on them
+  bool table_is_prior{false};      ///< the table is the prior's plane (tableWithPrior)
 };
 
 /** The supports of \a family (large enough, see min_support_area) and the objects on them, on
@@ -145,6 +150,39 @@ struct Trial {
 Trial tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
                 const std::vector<std::size_t>& family, int stride, bool final,
                 TabletopWorkspace& workspace);
+
+// --------------------------------------------------------------------- tabletop_prior.cpp
+
+/** The index of the candidate of \a candidates that is setup.prior's plane (consistentWithPrior,
+ * with the centre of its region's points; the first, i.e. the largest, of several), -1: none or
+ * no prior. */
+int priorCandidate(const Setup& setup, const std::vector<Candidate>& candidates);
+
+/** With a prior: when the candidate that is the prior's plane (priorCandidate) comes after the
+ * first \a kept of \a candidates (which are cut there), it takes the last of those places, so
+ * that the cut keeps it. */
+void keepPriorCandidate(const Setup& setup, std::vector<Candidate>& candidates, std::size_t kept);
+
+/** The family of \a families (rankFamilies') that holds setup.prior's plane (a candidate of
+ * \a sorted consistent with it), else one parallel to it (normals within its max_angle); -1:
+ * none, or no prior. */
+int priorFamily(const Setup& setup, const SortedFrame& sorted,
+                const std::vector<std::vector<std::size_t>>& families);
+
+/** The family chosen with a prior: \a prior_family (priorFamily) when its coarse trial found
+ * supports (\a with_supports), else \a chosen, the frame's own choice. \a result.challenged
+ * when the frame's own choice is another family with more \a standing objects. */
+std::size_t familyWithPrior(int prior_family, std::size_t chosen,
+                            const std::vector<char>& with_supports,
+                            const std::vector<std::size_t>& standing, SupportPriorResult& result);
+
+/** The table among a family's \a supports, whose objects were counted: the one with the most
+ * object points standing on it (else the one with the most inliers); with a prior, its plane
+ * when it is one of them (the first consistent one): of parallel supports in view (a counter
+ * and a table, a table and the floor), the one the tracks are anchored on stays the table, and
+ * every object is found on whichever holds it. Sets \a trial.standing and table_is_prior. */
+std::size_t tableWithPrior(const Setup& setup, const std::vector<SupportPlane>& supports,
+                           Trial& trial);
 
 // ------------------------------------------------------------------- tabletop_objects.cpp
 

@@ -182,15 +182,8 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
     if (scale == 1)
       trial.clusters.push_back(makeCluster(setup, std::move(group), pl.support));
   }
-  // The table: the most object points standing on it; else the largest support.
-  std::size_t table = 0;
-  for (std::size_t s = 0; s < supports.size(); ++s) {
-    trial.standing += supports[s].standing_points;
-    if (supports[s].standing_points > supports[table].standing_points ||
-        (supports[s].standing_points == supports[table].standing_points &&
-         supports[s].inliers.indices.size() > supports[table].inliers.indices.size()))
-      table = s;
-  }
+  // The table: the most object points standing on it, else the largest support; or the prior's.
+  const std::size_t table = tableWithPrior(setup, supports, trial);
   // Keep the supports that hold objects, and the table.
   std::vector<int> new_index(supports.size(), -1);
   for (std::size_t s = 0; s < supports.size(); ++s)

@@ -45,6 +45,8 @@ validate(const CylinderTrackerParameters& p)
     why << "max_plane_angle " << p.max_plane_angle << " is not in (0, pi/2]; ";
   if (!(p.max_plane_offset > 0.f && std::isfinite(p.max_plane_offset)))
     why << "max_plane_offset " << p.max_plane_offset << " must be > 0; ";
+  if (!in(p.support_switch_frames, 1, 1000))
+    why << "support_switch_frames " << p.support_switch_frames << " is not in [1, 1000]; ";
   if (!in(p.min_overlap, 0, 1))
     why << "min_overlap " << p.min_overlap << " is not in [0, 1]; ";
   const auto& r = p.registration;
@@ -185,7 +187,7 @@ CylinderTracker::findTrack(int id) const
 bool
 CylinderTracker::isCylinder(const CylinderTrack& t) const
 {
-  return t.confirmed && t.has_cylinder && t.pCylinder() >= params_.min_probability;
+  return t.confirmed && t.has_cylinder && t.decided_cylinder;
 }
 
 CylinderModel
@@ -227,6 +229,10 @@ CylinderTracker::reset()
   has_pose_ = false;
   has_velocity_ = false;
   world_on_support_ = false;
+  prior_held_ = false;
+  prior_unseen_ = prior_challenged_ = 0;
+  plane_angle_innovations_.clear();
+  plane_offset_innovations_.clear();
   frame_to_world_ = Eigen::Affine3f::Identity();
 }
 
@@ -252,7 +258,8 @@ CylinderTracker::predict()
 
 bool
 CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
-                        const std::vector<RecognizedObject>& objects, const TrackerView& view)
+                        const std::vector<RecognizedObject>& objects, const TrackerView& view,
+                        const SupportPriorResult& prior)
 {
   ++info_.frame;
   TrackerFrameInfo info;
@@ -270,7 +277,7 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
   }
   predict();
   sensor_pose_ = view.sensor_pose;
-  locateFrame(supports, table, objects, view, info);
+  locateFrame(supports, table, objects, view, prior, info);
 
   std::vector<TrackObservation> obs(objects.size());
   for (std::size_t i = 0; i < objects.size(); ++i)
@@ -285,22 +292,101 @@ CylinderTracker::update(const std::vector<SupportPlane>& supports, int table,
   return true;
 }
 
+Eigen::Affine3f
+CylinderTracker::predictedPose() const
+{
+  // The camera keeps its motion between two frames (constant velocity) when the last two
+  // frames were anchored one after the other; else it stays where it was.
+  return has_velocity_ ? Eigen::Affine3f(frame_to_world_ *
+                                         (previous_frame_to_world_.inverse() * frame_to_world_))
+                       : frame_to_world_;
+}
+
+SupportPrior
+CylinderTracker::expectedPlane(const Eigen::Affine3f& cloud_to_world) const
+{
+  SupportPrior prior;
+  const Eigen::Affine3f world_to_cloud = cloud_to_world.inverse();
+  Eigen::Vector3f normal = (world_to_cloud.linear() * Eigen::Vector3f::UnitZ()).normalized();
+  const Eigen::Vector3f origin = world_to_cloud * Eigen::Vector3f::Zero();
+  if (normal.dot(sensor_pose_.translation() - origin) < 0.f) // towards the sensor
+    normal = -normal;
+  prior.plane = Eigen::Vector4f(normal.x(), normal.y(), normal.z(), -normal.dot(origin));
+  // Where the plane was seen last, on it.
+  const Eigen::Vector3f seen = world_to_cloud * anchor_centre_;
+  prior.centre = seen - normal * (normal.dot(seen) + prior.plane[3]);
+  prior.max_angle = predictionTolerance(plane_angle_innovations_, params_.max_plane_angle);
+  prior.max_offset = predictionTolerance(plane_offset_innovations_, params_.max_plane_offset);
+  return prior;
+}
+
+SupportPrior
+CylinderTracker::supportPrior() const
+{
+  if (!has_pose_ || !world_on_support_ || !prior_held_)
+    return SupportPrior{};
+  return expectedPlane(predictedPose());
+}
+
+void
+CylinderTracker::recordPlaneInnovation(const SupportPrior& expected, const Eigen::Vector4f& plane)
+{
+  // What consistentWithPrior tests: the angle between the normals, the measured plane's height
+  // at the expected centre.
+  const float cos_angle = std::min(1.f, std::abs(expected.plane.head<3>().dot(plane.head<3>())));
+  plane_angle_innovations_.push_back(std::acos(cos_angle));
+  plane_offset_innovations_.push_back(plane.head<3>().dot(expected.centre) + plane[3]);
+  for (auto* v : {&plane_angle_innovations_, &plane_offset_innovations_})
+    if (v->size() > static_cast<std::size_t>(params_.history))
+      v->erase(v->begin(), v->end() - params_.history);
+}
+
+void
+CylinderTracker::keepTracksPlane(const std::vector<SupportPlane>& supports,
+                                 const SupportPriorResult& prior, AnchorChoice& choice,
+                                 TrackerFrameInfo& info)
+{
+  info.prior_held = prior_held_;
+  info.prior_given = prior.given;
+  info.prior_challenged = prior.challenged;
+  if (!prior_held_ || supports.empty()) // nothing to keep, or a frame that cannot tell
+    return;
+  prior_unseen_ = choice.plane_jump ? prior_unseen_ + 1 : 0;
+  prior_challenged_ = prior.challenged ? prior_challenged_ + 1 : 0;
+  info.prior_unseen_frames = prior_unseen_;
+  info.prior_challenged_frames = prior_challenged_;
+  if (prior_challenged_ >= params_.support_switch_frames) {
+    // The frame alone would have chosen another family of supports, frame after frame: the
+    // next frame chooses alone.
+    prior_held_ = false;
+    prior_challenged_ = 0;
+  }
+  if (!choice.plane_jump)
+    return;
+  if (prior_unseen_ < params_.support_switch_frames)
+    choice = AnchorChoice{}; // another plane for a frame or a few: the pose is predicted
+  else
+    prior_unseen_ = 0; // the tracks' plane is out of view: the frame's own anchors, as ever
+}
+
 void
 CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int table,
                              const std::vector<RecognizedObject>& objects, const TrackerView& view,
-                             TrackerFrameInfo& info)
+                             const SupportPriorResult& prior, TrackerFrameInfo& info)
 {
   const bool continuing = has_pose_ && world_on_support_;
-  // The camera keeps its motion between two frames (constant velocity) when the last two
-  // frames were anchored one after the other; else it stays where it was.
-  const Eigen::Affine3f predicted =
-    has_velocity_
-      ? Eigen::Affine3f(frame_to_world_ * (previous_frame_to_world_.inverse() * frame_to_world_))
-      : frame_to_world_;
+  const Eigen::Affine3f predicted = predictedPose();
   const Eigen::Affine3f last_pose = frame_to_world_;
   const bool last_anchored = info_.anchored && !info_.skipped;
-  const AnchorChoice choice =
-    chooseAnchor(supports, table, objects, continuing, predicted, params_);
+  // A support continues the tracks' plane when it is the support prior's plane (one test for
+  // both).
+  const SupportPrior expected = continuing ? expectedPlane(predicted) : SupportPrior{};
+  AnchorChoice choice =
+    chooseAnchor(supports, table, objects, expected.valid() ? &expected : nullptr);
+  const bool was_held = prior_held_;
+  keepTracksPlane(supports, prior, choice, info);
+  if (expected.valid() && choice.anchor >= 0 && !choice.plane_jump)
+    recordPlaneInnovation(expected, supports[static_cast<std::size_t>(choice.anchor)].plane);
 
   Eigen::Affine3f pose = has_pose_ ? predicted : Eigen::Affine3f::Identity();
   bool new_scene = false;
@@ -323,6 +409,11 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
   }
   else if (!has_pose_)
     world_on_support_ = false; // the world is this cloud's frame until a support is seen
+  if (choice.anchor >= 0) {
+    anchor_centre_ = pose * supports[static_cast<std::size_t>(choice.anchor)].frame.translation();
+    // Held from the first anchored frame on; after a release, from the frame after the next.
+    prior_held_ = prior_held_ || !was_held;
+  }
   has_velocity_ = has_pose_ && info.anchored && last_anchored && !new_scene;
   previous_frame_to_world_ = last_pose;
   frame_to_world_ = pose;
@@ -496,7 +587,7 @@ CylinderTracker::takeBack(CylinderTrack& t, int object, const TrackObservation& 
       other.misses = params_.max_tentative_misses + 1;
   filterPoint(t.centroid, t.var_centroid, o.geometry.centroid, square(params_.measurement_centroid),
               params_.huber_k);
-  t.log_odds = updateLogOdds(t.log_odds, o.p, params_.confidence_limit);
+  recordEvidence(t, o.p, t.hits + 1, params_);
   ++t.hits;
   t.misses = t.occluded = t.out_of_view = t.seen_through = 0;
   t.status = TrackStatus::Seen;
@@ -517,6 +608,7 @@ CylinderTracker::joinAndEndTracks()
       if (i == j || !areOneObject(older, younger, params_.association))
         continue;
       absorbTrack(older, younger, params_.history, params_.confidence_limit);
+      decide(older, false, params_);
       for (auto& a_k : assignments_) {
         if (a_k.track_id == younger.id)
           a_k.track_id = older.id;

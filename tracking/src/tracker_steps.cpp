@@ -55,18 +55,9 @@ lyingAxis(const AssociationGeometry& g)
 
 // --------------------------------------------------------------------------- anchoring
 
-bool
-continuesPlane(const Eigen::Affine3f& m, float max_angle, float max_offset)
-{
-  const float cos_angle = std::min(1.f, std::abs(m.linear().col(2).normalized().z()));
-  return std::acos(cos_angle) <= max_angle && std::abs(m.translation().z()) <= max_offset &&
-         m.linear().col(2).z() > 0.f;
-}
-
 AnchorChoice
 chooseAnchor(const std::vector<SupportPlane>& supports, int table,
-             const std::vector<RecognizedObject>& objects, bool continuing,
-             const Eigen::Affine3f& predicted, const CylinderTrackerParameters& params)
+             const std::vector<RecognizedObject>& objects, const SupportPrior* tracks_plane)
 {
   std::vector<std::size_t> on(supports.size(), 0);
   for (const auto& o : objects)
@@ -90,8 +81,8 @@ chooseAnchor(const std::vector<SupportPlane>& supports, int table,
     preference.end());
   AnchorChoice choice;
   for (const int k : preference)
-    if (!continuing || continuesPlane(predicted * supports[static_cast<std::size_t>(k)].frame,
-                                      params.max_plane_angle, params.max_plane_offset)) {
+    if (!tracks_plane ||
+        consistentWithPrior(*tracks_plane, supports[static_cast<std::size_t>(k)].plane)) {
       choice.anchor = k;
       break;
     }
@@ -306,7 +297,7 @@ newTrack(const TrackObservation& o, int id, int object, const CylinderTrackerPar
   t.support = o.support;
   t.centroid = o.geometry.centroid;
   t.var_centroid = square(params.measurement_centroid);
-  t.log_odds = updateLogOdds(0.f, o.p, params.confidence_limit);
+  recordEvidence(t, o.p, 1, params);
   if (o.geometry.cylinder) {
     t.has_cylinder = true;
     t.cylinder_hits = 1;
@@ -371,6 +362,28 @@ cylinderFromHistory(CylinderTrack& t, float axis_agreement)
 }
 
 void
+decide(CylinderTrack& t, bool first, const CylinderTrackerParameters& params)
+{
+  // The threshold's log-odds unclamped: min_probability 0 (every track) and 1 (none) keep
+  // their meaning.
+  const float p = params.min_probability;
+  const float threshold = p <= 0.f   ? -std::numeric_limits<float>::infinity()
+                          : p >= 1.f ? std::numeric_limits<float>::infinity()
+                                     : std::log(p / (1.f - p));
+  const float margin = first ? 0.f : decisionMargin(t.evidence_var, params.confidence_limit);
+  t.decided_cylinder =
+    decideWithHysteresis(first ? false : t.decided_cylinder, t.log_odds, threshold, margin);
+}
+
+void
+recordEvidence(CylinderTrack& t, float p, std::size_t n, const CylinderTrackerParameters& params)
+{
+  t.log_odds = updateLogOdds(t.log_odds, p, params.confidence_limit);
+  updateEvidenceSpread(t.evidence_mean, t.evidence_var, n, logOdds(p), params.history);
+  decide(t, n <= 1, params);
+}
+
+void
 correctTrack(CylinderTrack& t, const TrackObservation& o, float weight,
              const CylinderTrackerParameters& params)
 {
@@ -410,7 +423,7 @@ correctTrack(CylinderTrack& t, const TrackObservation& o, float weight,
     axisUp(t);
     ++t.cylinder_hits;
   }
-  t.log_odds = updateLogOdds(t.log_odds, o.p, params.confidence_limit);
+  recordEvidence(t, o.p, t.hits + 1, params);
   t.support = o.support;
   ++t.hits;
   t.misses = 0;

@@ -648,4 +648,41 @@ probability(float l)
   return 1.f / (1.f + std::exp(-l));
 }
 
+float
+predictionTolerance(const std::vector<float>& innovations, float cap)
+{
+  double sum = static_cast<double>(cap) * cap / 9.0;
+  for (const float x : innovations)
+    sum += static_cast<double>(x) * x;
+  const double rms = std::sqrt(sum / static_cast<double>(innovations.size() + 1));
+  return std::min(cap, static_cast<float>(3.0 * rms));
+}
+
+void
+updateEvidenceSpread(float& mean, float& var, std::size_t n, float evidence, int memory)
+{
+  if (n <= 1) {
+    mean = evidence;
+    var = 0.f;
+    return;
+  }
+  const float w =
+    std::max(1.f / static_cast<float>(n), 1.f / static_cast<float>(std::max(memory, 1)));
+  const float d = evidence - mean;
+  mean += w * d;
+  var = (1.f - w) * (var + w * d * d);
+}
+
+float
+decisionMargin(float evidence_var, float limit)
+{
+  return std::min(std::sqrt(std::max(evidence_var, 0.f)), 0.5f * limit);
+}
+
+bool
+decideWithHysteresis(bool current, float l, float threshold, float margin)
+{
+  return current ? !(l < threshold - margin) : l >= threshold + margin;
+}
+
 } // namespace facyl

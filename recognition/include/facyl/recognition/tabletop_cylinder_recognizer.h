@@ -174,6 +174,23 @@ public:
     up_ = up;
   }
 
+  /** \brief Where the support of the last frames of a stream is expected in this cloud (see
+   * TabletopSegmentation::setSupportPrior; in the cloud's frame); the default leaves every
+   * frame to itself. CylinderTracker::prepare sets it. */
+  void setSupportPrior(const SupportPrior& prior)
+  {
+    prior_ = prior;
+  }
+  const SupportPrior& getSupportPrior() const
+  {
+    return prior_;
+  }
+  /** \brief What the last run made of the support prior (TabletopSegmentation's). */
+  const SupportPriorResult& getSupportPriorResult() const
+  {
+    return segmentation_.getSupportPriorResult();
+  }
+
   /** \brief Runs the pipeline. \return false on error (see the class description). */
   bool recognize(std::vector<RecognizedObject>& objects);
 
@@ -278,6 +295,7 @@ private:
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
+  SupportPrior prior_;
   ShapeClassifier::Ptr classifier_;
   TabletopSegmentation<PointT> segmentation_;
   /** What segmentation_ was last given by setIndices (none at first, as it starts): given

@@ -112,6 +112,57 @@ std::string validate(const TabletopSegmentationParameters& params);
  * plane_distance is 0: it only makes seeds; each support's band is measured on it afterwards. */
 constexpr float kSeedDistance = 0.015f;
 
+/** \brief Where the support of the last frames of a stream is expected in this one (the
+ * tracker's prediction, CylinderTracker::supportPrior): the segmentation then prefers it as the
+ * table, and its family of parallel planes over the others, so that a wall or a far plane that
+ * holds more objects in one frame does not replace it. A default (invalid) prior changes
+ * nothing: a single frame is segmented alone. (It does not make a plane the plane search missed:
+ * grown from the cells near the predicted plane, a dark or glossy table with few depth pixels
+ * gave mixtures of it, the table beside it and the objects, bands of +-0.15 m, on the 7-Scenes
+ * stream.) A frame's plane is the prior's (consistentWithPrior) when its
+ * normal lies within max_angle of the prior's and it passes within max_offset of the prior's
+ * centre, where the support was seen last: the tolerances of the prediction (how far the
+ * camera's motion may have moved the plane since it was measured, and how far its estimate
+ * varies from frame to frame), which is best there (away from it an error of the predicted
+ * tilt grows with the distance). */
+struct SupportPrior {
+  /** a, b, c, d with a unit normal towards the sensor, in the frame of the points segmented;
+   * zero: no prior. */
+  Eigen::Vector4f plane{Eigen::Vector4f::Zero()};
+  /** A point of the plane where the support was seen last (the centre of its points). */
+  Eigen::Vector3f centre{Eigen::Vector3f::Zero()};
+  /** rad, in (0, pi/2]: how far the predicted normal may be off. */
+  float max_angle{0.f};
+  /** m, >= 0: how far the predicted plane may be off along its normal at the centre. */
+  float max_offset{0.f};
+
+  /** \brief True when the prior holds a plane and a usable angle (else it is ignored). */
+  bool valid() const
+  {
+    return plane.allFinite() && centre.allFinite() &&
+           std::abs(plane.head<3>().norm() - 1.f) < 1e-3f && max_angle > 0.f &&
+           max_angle <= 1.5708f && max_offset >= 0.f && std::isfinite(max_offset);
+  }
+  /** \brief \a prior moved by the rigid transform \a t (its plane and centre). */
+  SupportPrior transformed(const Eigen::Affine3f& t) const;
+};
+
+/** \brief True when \a plane (a, b, c, d, unit normal towards the sensor) is \a prior's plane
+ * (see SupportPrior): its normal within max_angle of the prior's, its height at the prior's
+ * centre within max_offset. */
+bool consistentWithPrior(const SupportPrior& prior, const Eigen::Vector4f& plane);
+
+/** \brief What a segmentation made of its SupportPrior. */
+struct SupportPriorResult {
+  bool given{false}; ///< a valid prior was given
+  /** The support (index into the supports) that is the prior's plane, -1: none was found. */
+  int support{-1};
+  /** The frame alone would have chosen another family of supports, which holds more objects
+   * standing on it than the prior's (of parallel supports, the prior's stays the table while it
+   * is in view: its objects are found on every one of them alike). */
+  bool challenged{false};
+};
+
 /** \brief Wall-clock time per step of a segmentation (ms). */
 struct SegmentationTiming {
   double planes{0.0};  ///< the plane grid, its seeds and their regions (the candidates)
@@ -270,6 +321,7 @@ struct TabletopSegments {
   bool table_found{false};   ///< some object stands on the table
   float focal{0.f};          ///< pixels (organized frames: the camera's, or estimated); else 0
   SegmentationTiming timing; ///< its steps, and their total
+  SupportPriorResult prior;  ///< what became of the prior (given false without one)
 };
 
 /** \brief Supports, objects above them and object clusters of \a frame (paper III-A; the steps:
@@ -282,12 +334,14 @@ struct TabletopSegments {
  * \param up      gravity's opposite in the sensor's frame, or zero: unknown.
  * \param params  valid settings (validate).
  * \param workspace  scratch buffers (see TabletopWorkspace).
+ * \param prior   where the last frames' support is expected (in the sensor's frame, as \a frame);
+ *                nullptr or an invalid one: none, the frame alone decides.
  * \throws std::invalid_argument on invalid \a params, an unusable valid \a camera, a non-finite
  *         \a up, or a frame without points memory or with a stride below 3. */
 TabletopSegments segmentTabletop(const PointFrame& frame, const PinholeCamera& camera,
                                  const Eigen::Vector3f& up,
                                  const TabletopSegmentationParameters& params,
-                                 TabletopWorkspace& workspace);
+                                 TabletopWorkspace& workspace, const SupportPrior* prior = nullptr);
 
 /** \brief The lattice step of \a params.lattice_width for a frame: s = round(width /
  * lattice_width) for organized frames searched as images (at least 16 plane-grid cells wide

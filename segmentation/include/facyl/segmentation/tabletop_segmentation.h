@@ -187,6 +187,26 @@ public:
     return up_;
   }
 
+  /** \brief Where the support of the last frames of a stream is expected in this cloud (in the
+   * cloud's frame; see SupportPrior): the table is then that plane while a support is found
+   * there and its family is preferred over the others; getSupportPriorResult() tells what
+   * became of it. A
+   * tracker sets it before each frame (CylinderTracker::prepare); the default, an invalid prior,
+   * leaves every frame to itself. */
+  void setSupportPrior(const SupportPrior& prior)
+  {
+    prior_ = prior;
+  }
+  const SupportPrior& getSupportPrior() const
+  {
+    return prior_;
+  }
+  /** \brief What the last run made of the support prior (given false without a valid one). */
+  const SupportPriorResult& getSupportPriorResult() const
+  {
+    return prior_result_;
+  }
+
   /** \brief Runs the segmentation. \return false (with PCL_ERROR) on bad input. */
   bool segment(std::vector<TabletopCluster>& clusters)
   {
@@ -269,6 +289,8 @@ private:
   TabletopSegmentationParameters params_;
   PinholeCamera camera_;
   Eigen::Vector3f up_{Eigen::Vector3f::Zero()};
+  SupportPrior prior_;
+  SupportPriorResult prior_result_;
   std::vector<SupportPlane> supports_;
   SegmentationTiming timing_;
   std::size_t table_{0};

@@ -21,6 +21,7 @@
 namespace facyl {
 
 struct TrackObservation; // tracker_steps.h
+struct AnchorChoice;     // tracker_steps.h
 
 /** \brief Settings of CylinderTracker. Lengths in metres, angles in radians, counts in frames
  * given to update(). */
@@ -45,11 +46,21 @@ struct CylinderTrackerParameters {
   int see_through_misses{3};
 
   // ---- where the frame is (re-anchoring)
-  /** A support continues the tracks' plane when, under the previous frame's pose, its normal
-   * is within this angle of the plane's (rad, in (0, pi/2]) ... */
+  /** A support continues the tracks' plane when, under the pose predicted for the frame, its
+   * normal is within this angle of the plane's (rad, in (0, pi/2]) ... */
   float max_plane_angle{0.35f};
-  /** ... and its height within this distance (m, > 0). */
+  /** ... and its height within this distance (m, > 0). The support prior handed to the
+   * recognizer (supportPrior) takes the same two tolerances. */
   float max_plane_offset{0.15f};
+  /** The tracks' plane stays the table, in the recognizer (the support prior, supportPrior)
+   * and as the anchor, until this many frames in a row, in [1, 1000]:
+   * - show supports none of which continues it (a wall or a far plane filling the view,
+   *   another table): until then such a frame is not anchored (its pose is predicted); the
+   *   last one anchors on its own support, which becomes the tracks' plane;
+   * - or would alone have chosen another family of supports, with more objects standing on
+   *   it (SupportPriorResult::challenged): after the last one the next frame chooses alone.
+   * Frames without any support count for neither. */
+  int support_switch_frames{3};
   /** A frame is of a new scene (every track ends, new ones start) when the registration
    * matches fewer than this share of the confirmed tracks expected in view (at least 3
    * expected and 3 objects seen), or, when its support does not continue the plane, fewer than
@@ -94,7 +105,10 @@ struct CylinderTrackerParameters {
    * > 0. */
   float confidence_limit{4.6f};
   /** A track is a cylinder when its p_cylinder is at least this (and it has a cylinder
-   * estimate), in [0, 1]. */
+   * estimate), in [0, 1], with hysteresis: once decided, the decision changes only when the
+   * log-odds cross this threshold's by more than the standard deviation of the track's
+   * per-frame evidence (decisionMargin), so that frames that disagree about an object do not
+   * flip it at every frame. */
   float min_probability{0.5f};
   /** A frame's evidence: its decision sets the side, its p_cylinder (when known) the
    * strength. An accepted cylinder counts as p_cylinder clamped to at least this, another
@@ -161,6 +175,12 @@ struct CylinderTrack {
   };
   std::vector<Fit> fits; ///< the last observations (history), oldest first
   float log_odds{0.f};   ///< of being a cylinder, from every frame's evidence
+  /** Mean and variance of the frames' evidence (log-odds of each frame's p), over about the
+   * last history frames (updateEvidenceSpread). */
+  float evidence_mean{0.f}, evidence_var{0.f};
+  /** The decision on log_odds with hysteresis (see CylinderTrackerParameters::
+   * min_probability): what isCylinder reports for a confirmed track with a cylinder. */
+  bool decided_cylinder{false};
 
   /** \brief The filtered probability that the object is a cylinder. */
   float pCylinder() const
@@ -220,6 +240,19 @@ struct TrackerFrameInfo {
   bool skipped{false};       ///< skipFrame(): nothing known about this frame
   std::size_t registered{0}; ///< objects the in-plane registration matched to tracks
   PlanarRigid registration;  ///< the anchor's plane coordinates to the world's
+  /** The tracks' plane was the table to keep in this frame (the support prior supportPrior
+   * gave before it). */
+  bool prior_held{false};
+  /** The recognizer was given a support prior for this frame (SupportPriorResult::given: the
+   * caller handed supportPrior on, see prepare). */
+  bool prior_given{false};
+  /** The recognizer reported that the frame alone would have chosen another support
+   * (SupportPriorResult::challenged). */
+  bool prior_challenged{false};
+  /** Frames in a row, this one included, whose supports did not continue the tracks' plane
+   * (see support_switch_frames), and frames in a row the recognizer reported challenged; 0 when
+   * this one did, or held no support. */
+  int prior_unseen_frames{0}, prior_challenged_frames{0};
 };
 
 /** \brief Tracks objects and cylinders across the frames of a stream: each frame's result of
@@ -291,22 +324,41 @@ public:
 
   /** \brief One frame's result: \a supports and the index of the table among them (\a table,
    * -1: none; the support most objects stand on is then the anchor), \a objects (the
-   * recognizer's, in the same cloud frame), and what is known of the sensor (\a view).
+   * recognizer's, in the same cloud frame), what is known of the sensor (\a view), and what
+   * the segmentation made of the support prior handed to it (\a prior; see prepare).
    * \return false (PCL_ERROR, nothing changed but the frame count) when \a table is out of
    * range. Objects without a finite centroid are ignored (Role::Ignored). */
   bool update(const std::vector<SupportPlane>& supports, int table,
-              const std::vector<RecognizedObject>& objects, const TrackerView& view = {});
+              const std::vector<RecognizedObject>& objects, const TrackerView& view = {},
+              const SupportPriorResult& prior = {});
 
-  /** \brief update() with the last result of \a rec: its supports and table, and the view of
-   * its input cloud (trackerViewOf; intrinsics estimated from an organized cloud unless
-   * setCamera). */
+  /** \brief update() with the last result of \a rec: its supports and table, the view of its
+   * input cloud (trackerViewOf; intrinsics estimated from an organized cloud unless
+   * setCamera) and its support prior's result. */
   template <typename PointT>
   bool update(const TabletopCylinderRecognizer<PointT>& rec,
               const std::vector<RecognizedObject>& objects)
   {
     return update(rec.getSupports(),
                   tableIndex(rec.getSupports(), rec.getTableCoefficients().values), objects,
-                  trackerViewOf<PointT>(rec.getInputCloud(), camera_));
+                  trackerViewOf<PointT>(rec.getInputCloud(), camera_), rec.getSupportPriorResult());
+  }
+
+  /** \brief Where the next frame's support is expected: the tracks' plane (the support the
+   * last frames were anchored on) in the next frame's cloud frame, as the camera's motion
+   * predicts it (constant velocity), with tolerances of 3 times the
+   * root-mean-square error of that prediction in the last frames (predictionTolerance, at most
+   * max_plane_angle and max_plane_offset). Invalid (SupportPrior::valid false) before the first
+   * frame anchored on a support, after reset(), and for the frame after support_switch_frames
+   * dissenting ones. */
+  SupportPrior supportPrior() const;
+
+  /** \brief Hands supportPrior() to \a rec for the next frame (call it before
+   * rec.recognize()): the recognizer then keeps the tracks' plane as the table while it is in
+   * view and a wall or a far plane with more objects in one frame does not replace it. */
+  template <typename PointT> void prepare(TabletopCylinderRecognizer<PointT>& rec) const
+  {
+    rec.setSupportPrior(supportPrior());
   }
 
   /** \brief A frame that could not be processed (unreadable, empty, recognition failed): the
@@ -350,8 +402,9 @@ public:
   {
     return frame_to_world_;
   }
-  /** \brief True when \a t is confirmed, has a cylinder estimate and its p_cylinder is at
-   * least min_probability. */
+  /** \brief True when \a t is confirmed, has a cylinder estimate and is decided a cylinder:
+   * its p_cylinder reached min_probability and did not fall back below it by its hysteresis
+   * margin since (CylinderTrack::decided_cylinder). */
   bool isCylinder(const CylinderTrack& t) const;
   /** \brief \a t's cylinder in the last frame's cloud frame, with the recognizer's convention
    * (base nearest the support, axis away from it; lying: towards the sensor; orientCylinder);
@@ -376,7 +429,21 @@ private:
    * and end when the frame starts a new scene. */
   void locateFrame(const std::vector<SupportPlane>& supports, int table,
                    const std::vector<RecognizedObject>& objects, const TrackerView& view,
-                   TrackerFrameInfo& info);
+                   const SupportPriorResult& prior, TrackerFrameInfo& info);
+  /** The anchor \a choice under the support prior: counts the frame's dissent (\a info) and
+   * drops a plane jump while the tracks' plane is kept; releases the prior after
+   * support_switch_frames dissenting frames. */
+  void keepTracksPlane(const std::vector<SupportPlane>& supports, const SupportPriorResult& prior,
+                       AnchorChoice& choice, TrackerFrameInfo& info);
+  /** The next frame's cloud to the world: the last pose, moved on by the camera's motion
+   * between the last two frames when both were anchored one after the other. */
+  Eigen::Affine3f predictedPose() const;
+  /** The tracks' plane in the cloud of a frame at \a cloud_to_world, with the prediction's
+   * tolerances (predictionTolerance of the innovations). */
+  SupportPrior expectedPlane(const Eigen::Affine3f& cloud_to_world) const;
+  /** The prediction's error for a frame anchored on the tracks' plane: the \a expected plane
+   * (expectedPlane) against the anchor's measured \a plane. */
+  void recordPlaneInnovation(const SupportPrior& expected, const Eigen::Vector4f& plane);
   /** The frame, anchored on the support at \a plane_to_cloud that continues the tracks' plane,
    * registered against the tracks (\a pose: cloud to world). \return true when it starts a
    * new scene (the tracks ended, \a pose the support's plane). */
@@ -419,6 +486,17 @@ private:
   bool has_velocity_{false};
   bool has_pose_{false};         ///< frame_to_world_ holds a pose
   bool world_on_support_{false}; ///< the world frame is a support's plane
+  /** The tracks' plane is the table to keep (handed on by supportPrior): from the first frame
+   * anchored on a support, until support_switch_frames frames in a row dissent. */
+  bool prior_held_{false};
+  int prior_unseen_{0};     ///< frames in a row whose supports did not continue the plane
+  int prior_challenged_{0}; ///< frames in a row that alone chose another family
+  /** The centre of that support's points, in the world (on its plane, z near 0). */
+  Eigen::Vector3f anchor_centre_{Eigen::Vector3f::Zero()};
+  /** Of the last frames (history) anchored on the tracks' plane: the angle (rad) between its
+   * predicted and measured normal, and its measured height over the predicted plane (m): the
+   * support prior's tolerances (predictionTolerance). */
+  std::vector<float> plane_angle_innovations_, plane_offset_innovations_;
   int next_id_{0};
 };
 

@@ -42,21 +42,15 @@ struct AnchorChoice {
   bool plane_jump{false};
 };
 
-/** \brief True when a support whose frame, taken to the world by the predicted pose, is
- * \a support_to_world continues the tracks' plane: its normal within \a max_angle (rad) of world
- * z and on its side, its origin within \a max_offset (m) of the world's height 0. */
-bool continuesPlane(const Eigen::Affine3f& support_to_world, float max_angle, float max_offset);
-
 /** \brief The frame's anchor among \a supports: in order of preference the table (\a table, -1:
  * none), then the others by the number of \a objects standing on them (most first, ties in
- * their order), supports without a finite frame left out. When \a continuing (the world is a
- * support's plane), the first that continues it (continuesPlane under \a predicted, the pose
- * predicted for this frame, with \a params' max_plane_angle and max_plane_offset); when none
- * does, the first with plane_jump. Otherwise the first. */
+ * their order), supports without a finite frame left out. With \a tracks_plane (the plane the
+ * tracks stand on, as expected in this frame: CylinderTracker's support prior), the first that
+ * is that plane (consistentWithPrior); when none is, the first with plane_jump. Without
+ * (nullptr: a new world), the first. */
 AnchorChoice chooseAnchor(const std::vector<SupportPlane>& supports, int table,
-                          const std::vector<RecognizedObject>& objects, bool continuing,
-                          const Eigen::Affine3f& predicted,
-                          const CylinderTrackerParameters& params);
+                          const std::vector<RecognizedObject>& objects,
+                          const SupportPrior* tracks_plane);
 
 /** \brief The correspondences that may register a frame's \a objects (in the support's plane)
  * against \a tracks (world): every valid object with every track whose size and height agree.
@@ -132,6 +126,18 @@ CylinderTrack newTrack(const TrackObservation& o, int id, int object,
  * axis, twice) and their weighted median radius. Estimates that cannot be formed (no agreeing
  * fit) are kept. */
 void cylinderFromHistory(CylinderTrack& t, float axis_agreement);
+
+/** \brief \a t's decision (decided_cylinder) on its log-odds, with hysteresis
+ * (decideWithHysteresis at the log-odds of params.min_probability, decisionMargin of the spread
+ * of its evidence); a track with no evidence before (\a first) decides without. */
+void decide(CylinderTrack& t, bool first, const CylinderTrackerParameters& params);
+
+/** \brief The evidence \a p of one frame (a probability that the object is a cylinder, see
+ * observe) added to \a t: its log-odds (updateLogOdds), the spread of its evidence
+ * (updateEvidenceSpread over params.history frames; \a n: the frames of evidence, this one
+ * included) and its decision (decide). */
+void recordEvidence(CylinderTrack& t, float p, std::size_t n,
+                    const CylinderTrackerParameters& params);
 
 /** \brief \a t corrected by observation \a o, which counts with \a weight (less in a frame
  * without a support): the centroid filtered (filterPoint); a cylinder started from the first

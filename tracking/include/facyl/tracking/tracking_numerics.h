@@ -207,4 +207,28 @@ float updateLogOdds(float l, float p_observed, float limit);
 /** \brief Probability of log-odds \a l. */
 float probability(float l);
 
+/** \brief How far a prediction may be off, from how far it was (\a innovations: the last
+ * frames' differences between the predicted and the measured value, e.g. of the support
+ * plane's normal or height): 3 root-mean-square innovations, the mean taken with one pseudo
+ * innovation of cap / 3 (the first frames, with few or none measured, get cap), at most
+ * \a cap. */
+float predictionTolerance(const std::vector<float>& innovations, float cap);
+
+/** \brief The running \a mean and variance \a var of a track's per-frame evidence, updated with
+ * the \a n-th value \a evidence (n >= 1; the first sets the mean, variance 0): Welford's update
+ * with the weight max(1 / n, 1 / \a memory), so that it follows about the last \a memory frames
+ * (exponential forgetting). */
+void updateEvidenceSpread(float& mean, float& var, std::size_t n, float evidence, int memory);
+
+/** \brief The hysteresis margin of a track's decision (log-odds): the standard deviation of its
+ * frames' evidence, \a evidence_var (one typical frame's disagreement cannot flip a decision
+ * that sits at the threshold), at most half of \a limit (the clamp of the log-odds: beyond it a
+ * decision could never change back). */
+float decisionMargin(float evidence_var, float limit);
+
+/** \brief A decision with hysteresis: \a current (true: above) changes only when the log-odds
+ * \a l pass \a threshold by \a margin on the other side (true: l below threshold - margin;
+ * false: l at least threshold + margin). With margin 0, l >= threshold. */
+bool decideWithHysteresis(bool current, float l, float threshold, float margin);
+
 } // namespace facyl

@@ -108,6 +108,12 @@ addStreamFields(Json& frame, const facyl::CylinderTracker& tracker,
   stream["new_scene"] = info.new_scene;
   stream["skipped"] = info.skipped;
   stream["registered"] = info.registered;
+  Json& prior = stream["support_prior"];
+  prior["held"] = info.prior_held;
+  prior["given"] = info.prior_given;
+  prior["challenged"] = info.prior_challenged;
+  prior["unseen_frames"] = info.prior_unseen_frames;
+  prior["challenged_frames"] = info.prior_challenged_frames;
   Json& tracks = frame["tracks"] = Json::array();
   for (const auto& t : tracker.getTracks()) {
     const facyl::RecognizedObject* seen =

@@ -34,6 +34,10 @@ trackerOptions()
     t.options.push_back(integerOption<S>(
       "track-max-misses", "N", [](auto& s) -> auto& { return s.max_misses; },
       "missed frames a confirmed track survives (default {})"));
+    t.options.push_back(integerOption<S>(
+      "track-support-switch-frames", "N", [](auto& s) -> auto& { return s.support_switch_frames; },
+      "frames in a row another support must win before it replaces the tracks' table "
+      "(default {})"));
     return t;
   }();
   return table;

@@ -132,14 +132,18 @@ TabletopCylinderRecognizer<PointT>::recognize(std::vector<RecognizedObject>& obj
       TabletopCylinderRecognizer& rec;
       const PointCloudConstPtr input;
       const Eigen::Vector3f up;
+      const SupportPrior prior;
       ~Restore()
       {
         rec.input_ = input;
         rec.up_ = up;
+        rec.prior_ = prior;
       }
-    } restore{*this, given, up_};
+    } restore{*this, given, up_, prior_};
     input_ = sensorFrameCopy(*given, pose);
     up_ = pose.linear().transpose() * up_;
+    if (prior_.valid())
+      prior_ = prior_.transformed(pose.inverse());
     found = recognizeInSensorFrame(objects, t0);
   }
   segmentation_.setInputCloud(given);
@@ -174,6 +178,7 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   }
   segmentation_.setCamera(camera_);
   segmentation_.setUpDirection(up_);
+  segmentation_.setSupportPrior(prior_);
   // The cloud is in the sensor's frame, its far points gone (recognize() saw to it).
   const bool segmented = segmentation_.segmentInSensorFrame(clusters);
   timing_.segmentation = ms(t0, Clock::now());

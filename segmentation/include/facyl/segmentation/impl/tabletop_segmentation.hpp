@@ -24,6 +24,7 @@ TabletopSegmentation<PointT>::reset()
   focal_ = 0.f;
   table_coefficients_.values.clear();
   hull_.clear();
+  prior_result_ = SupportPriorResult{};
 }
 
 template <typename PointT>
@@ -81,16 +82,19 @@ TabletopSegmentation<PointT>::run(std::vector<TabletopCluster>& clusters, bool c
              far, static_cast<double>(kMaxCoordinate));
   // PCL's list of every index is not read when no indices were given.
   const pcl::Indices* given = fake_indices_ ? nullptr : indices_.get();
+  const SupportPrior* prior = prior_.valid() ? &prior_ : nullptr;
   if (isIdentityPose(pose) && far == 0)
-    adopt(segmentTabletop(pointFrame(*input_, given, xyz_), camera_, up_, params_, workspace_),
-          clusters);
+    adopt(
+      segmentTabletop(pointFrame(*input_, given, xyz_), camera_, up_, params_, workspace_, prior),
+      clusters);
   else {
     // The search works in the sensor's frame (depth along the line of sight, pixels seen
     // from the origin): on a copy of the cloud moved there, the results then moved back to
     // the cloud's frame.
     const auto local = sensorFrameCopy(*input_, pose);
+    const SupportPrior local_prior = prior_.transformed(pose.inverse());
     adopt(segmentTabletop(pointFrame(*local, given, xyz_), camera_, pose.linear().transpose() * up_,
-                          params_, workspace_),
+                          params_, workspace_, prior ? &local_prior : nullptr),
           clusters);
     transformResults(pose, clusters);
   }
@@ -110,6 +114,7 @@ TabletopSegmentation<PointT>::adopt(TabletopSegments segments,
   table_found_ = segments.table_found;
   focal_ = segments.focal;
   timing_ = segments.timing;
+  prior_result_ = segments.prior;
   clusters = std::move(segments.clusters);
   if (supports_.empty())
     return;
