@@ -127,10 +127,10 @@ TEST(ThinSupports, PilesKeepEveryObject)
       const auto out = segmentAndScore(s);
       std::string line;
       for (const auto& o : out) {
-        line += " " + std::to_string(o.object) + (o.recovered ? "+" : "-") +
-                (o.merged ? "m" : "") + (o.split ? "s" : "");
-        EXPECT_TRUE(o.recovered) << pile.name << ", " << sensor << ": object " << o.object
-                                 << " (" << s.scene.objects[static_cast<std::size_t>(o.object - 2)].kind
+        line += " " + std::to_string(o.object) + (o.recovered ? "+" : "-") + (o.merged ? "m" : "") +
+                (o.split ? "s" : "");
+        EXPECT_TRUE(o.recovered) << pile.name << ", " << sensor << ": object " << o.object << " ("
+                                 << s.scene.objects[static_cast<std::size_t>(o.object - 2)].kind
                                  << "), IoU " << o.best_iou;
       }
       std::printf("[ figures ] %s, %s:%s\n", pile.name, sensor.c_str(), line.c_str());

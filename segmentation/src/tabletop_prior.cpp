@@ -50,8 +50,8 @@ keepPriorCandidate(const Setup& setup, std::vector<Candidate>& candidates, std::
   if (kept == 0 || k < 0 || static_cast<std::size_t>(k) < kept)
     return;
   // Its place: the last one kept; the candidates between move one on.
-  std::rotate(candidates.begin() + static_cast<std::ptrdiff_t>(kept - 1),
-              candidates.begin() + k, candidates.begin() + k + 1);
+  std::rotate(candidates.begin() + static_cast<std::ptrdiff_t>(kept - 1), candidates.begin() + k,
+              candidates.begin() + k + 1);
 }
 
 int
