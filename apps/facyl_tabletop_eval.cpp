@@ -163,9 +163,17 @@ reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
   std::printf("\n%s\n\n| score | threshold | TP | FP | FN | precision | recall |\n"
               "|---|---|---|---|---|---|---|\n",
               title.c_str());
-  for (const auto score :
-       {facyl::CylinderDecision::Score::InlierRatio, facyl::CylinderDecision::Score::SurfaceRatio})
-    for (float t : {0.3f, 0.4f, 0.5f, 0.6f, 0.7f}) {
+  for (const auto score : {facyl::CylinderDecision::Score::InlierRatio,
+                           facyl::CylinderDecision::Score::SurfaceRatio}) {
+    // The thresholds, and the recognizer's own among them (its decisions: the default row).
+    std::vector<float> thresholds{0.3f, 0.4f, 0.5f, 0.6f, 0.7f};
+    if (score == base.score && std::none_of(thresholds.begin(), thresholds.end(), [&](float t) {
+          return std::abs(t - base.min_score) < 1e-6f;
+        })) {
+      thresholds.push_back(base.min_score);
+      std::sort(thresholds.begin(), thresholds.end());
+    }
+    for (float t : thresholds) {
       facyl::CylinderDecision d = base;
       d.score = score;
       d.min_score = t;
@@ -181,13 +189,14 @@ reportDetection(const std::vector<Row>& rows, const std::vector<Stray>& stray,
       }
       for (const Stray& e : stray)
         fp += is_default ? e.is_cylinder : facyl::acceptCylinder(e.evidence, d);
-      std::printf("| %s | %.1f%s | %zu | %zu | %zu | %.3f | %.3f |\n",
+      std::printf("| %s | %.2g%s | %zu | %zu | %zu | %.3f | %.3f |\n",
                   score == facyl::CylinderDecision::Score::SurfaceRatio ? "surface ratio"
                                                                         : "inlier ratio (eq. 4)",
                   t, is_default ? " (default)" : "", tp, fp, fn,
                   tp + fp ? static_cast<double>(tp) / static_cast<double>(tp + fp) : NAN,
                   tp + fn ? static_cast<double>(tp) / static_cast<double>(tp + fn) : NAN);
     }
+  }
 }
 
 /** Segmentation totals of rows selected by \a keep, as a table line. */

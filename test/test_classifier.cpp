@@ -326,7 +326,7 @@ TEST(CylinderEvidence, TheEvidenceModelDecidesAmongTheFitsThatPassTheGates)
   EXPECT_TRUE(facyl::acceptGeometry(e, d)); // the geometric decision alone
   e.p_cylinder = 0.9f;
   EXPECT_TRUE(facyl::acceptCylinder(e, d));
-  e.surface_ratio = 0.3f; // a gate: the model is not asked
+  e.surface_ratio = 0.2f; // a gate: the model is not asked
   EXPECT_FALSE(facyl::acceptCylinder(e, d));
   EXPECT_FALSE(facyl::passesGates(e, d));
   e.surface_ratio = 0.9f;

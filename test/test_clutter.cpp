@@ -435,15 +435,15 @@ TEST(CylinderEvidence, TheDecisionUsesEveryCheck)
   EXPECT_FALSE(facyl::acceptCylinder(shape, d));
   shape = e;
   shape.shape.profile_range = 0.3f;
-  shape.shape.inner_share = 0.3f;
-  shape.shape.aspect = 0.5f;
+  shape.shape.inner_share = 0.5f;
+  shape.shape.aspect = 0.3f;
   EXPECT_FALSE(facyl::acceptCylinder(shape, d));
   shape = e;
   shape.shape.axis_bend = 0.3f;
   shape.shape.profile_range = 0.1f;
   EXPECT_FALSE(facyl::acceptCylinder(shape, d));
   auto worse = e;
-  worse.surface_ratio = 0.4f;
+  worse.surface_ratio = 0.2f; // below the floor (min_score): not the object's shape
   EXPECT_FALSE(facyl::acceptCylinder(worse, d));
   worse = e;
   worse.curvature_ratio = 0.5f;

@@ -111,7 +111,7 @@ def passes_gates(obj, gates):
             and not bad(v("arc_gap"), gates["max_arc_gap"]) and not bad(v("taper"), gates["max_taper"]))
 
 
-GATES = {"min_score": 0.5, "max_curvature_ratio": 0.35, "min_angular_coverage": 0.2,
+GATES = {"min_score": 0.25, "max_curvature_ratio": 0.35, "min_angular_coverage": 0.2,
          "max_arc_gap": 0.1, "max_taper": 0.15}
 
 
