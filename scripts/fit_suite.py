@@ -19,7 +19,6 @@ for name, args in cases.items():
         r = math.exp(rnd.uniform(math.log(0.02), math.log(0.5)))
         h = r * rnd.uniform(2, 4)
         path = os.path.join(d, "c.pcd")
-        subprocess.run([sim, "--radius", "%.4f" % r, "--height", "%.4f" % h, "--random-axis", "--seed", str(k)] + args + [path], check=True, stdout=subprocess.DEVNULL)
         truth = json.loads(subprocess.run([sim, "--radius", "%.4f" % r, "--height", "%.4f" % h, "--random-axis", "--seed", str(k)] + args + [path], check=True, capture_output=True, text=True).stdout)
         out = json.loads(subprocess.run([fit] + extra + [path], capture_output=True, text=True).stdout.strip().splitlines()[0])
         cyl = out.get("cylinders") or []

@@ -198,8 +198,8 @@ TEST(HoughCylinderEstimation, UpOrientsTheCylinders)
   // the recognizer's cylinders; a lying one points towards the sensor. Zero: the fit's sign.
   auto p = randomCylinder(3, 0.f, 0.f);
   const auto sim = facyl::simulateCylinder(p);
-  for (const Eigen::Vector3f up : {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f),
-                                   Eigen::Vector3f(sim.truth.axis)}) {
+  for (const Eigen::Vector3f& up : {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.f, 0.f, -1.f),
+                                    Eigen::Vector3f(sim.truth.axis)}) {
     Hough hough;
     hough.setUpDirection(up);
     hough.setOrientationPrior(facyl::OrientationPrior::Uniform);

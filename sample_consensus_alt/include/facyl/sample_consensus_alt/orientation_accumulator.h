@@ -94,11 +94,17 @@ public:
   {
     return static_cast<std::size_t>(directions_.cols());
   }
-  /** \brief Nominal angular radius of a cell (rad): sqrt(2 / N_d), the radius of N_d equal
-   * disks covering a hemisphere (3.8 deg for the paper's N_d = 450). */
+  /** \brief Nominal angular radius of a cell (rad): nominalCellRadius(size()). */
   float cellRadius() const
   {
-    return size() > 0 ? std::sqrt(2.f / static_cast<float>(size())) : 0.f;
+    return nominalCellRadius(size());
+  }
+  /** \brief Nominal angular radius (rad) of a cell of an accumulator of \a cells cells:
+   * sqrt(2 / N_d), the radius of N_d equal disks covering a hemisphere (3.8 deg for the
+   * paper's N_d = 450); 0 without cells. */
+  static float nominalCellRadius(std::size_t cells)
+  {
+    return cells > 0 ? std::sqrt(2.f / static_cast<float>(cells)) : 0.f;
   }
 
 private:

@@ -861,7 +861,7 @@ TabletopCylinderRecognizer<PointT>::retryRepeats(const Fitter& fitter, std::size
   if (!fit.evidence.fitted || estimator >= fitter.estimators.size())
     return false;
   const auto& hough = fitter.estimators[estimator];
-  const float cell = std::sqrt(2.f / static_cast<float>(hough.getParameters().orientations));
+  const float cell = OrientationAccumulator::nominalCellRadius(hough.getParameters().orientations);
   const float along = std::abs(fit.model.axis.normalized().dot(fitter.up));
   const float from_up = std::acos(std::min(1.f, along)); // rad, in [0, pi/2]
   if (estimator == fitter.upright ||
