@@ -7,6 +7,7 @@
 #include "test_helpers.h"
 
 #include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/cylinder_parts.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/object_segmentation.h>
 #include <facyl/segmentation/segmentation_score.h>
@@ -337,6 +338,103 @@ TEST(CylinderEvidence, ArcGapTaperAndJunctions)
   }
   EXPECT_LT(facyl::convexJunctionShare(pts, nrm, left, right, 0.005f, 0.1f), 0.1f);
   EXPECT_TRUE(std::isnan(facyl::convexJunctionShare(pts, nrm, left, right, 1e-6f, 0.1f)));
+}
+
+/** A lying tin: radius 9.6 cm, its wall fitted from x = 0 to 0.084 m along the axis (x), 0.8 m
+ * in front of the sensor; the inlier threshold 3 mm. */
+facyl::CylinderModel
+lyingTin()
+{
+  facyl::CylinderModel c;
+  c.radius = 0.096f;
+  c.axis = Eigen::Vector3f::UnitX();
+  c.base = c.point_on_axis = Eigen::Vector3f(0.f, 0.f, 0.8f);
+  c.top = c.base + 0.084f * c.axis;
+  c.height = 0.084f;
+  c.distance_threshold = 0.003f;
+  return c;
+}
+
+/** Points of a disc across the x axis at x = \a x, centre (x, 0, 0.8), of \a radius, normals
+ * along -x, \a n x \a n of them on a grid. */
+void
+disc(float x, float radius, int n, Eigen::Matrix3Xf& points, Eigen::Matrix3Xf& normals)
+{
+  std::vector<Eigen::Vector3f> p;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const float y = radius * (2.f * static_cast<float>(i) / static_cast<float>(n - 1) - 1.f);
+      const float z = radius * (2.f * static_cast<float>(j) / static_cast<float>(n - 1) - 1.f);
+      if (y * y + z * z <= radius * radius)
+        p.emplace_back(x, y, 0.8f + z);
+    }
+  points.resize(3, static_cast<Eigen::Index>(p.size()));
+  for (std::size_t k = 0; k < p.size(); ++k)
+    points.col(static_cast<Eigen::Index>(k)) = p[k];
+  normals = Eigen::Vector3f(-1.f, 0.f, 0.f).replicate(1, points.cols());
+}
+
+TEST(CylinderParts, AnEndSetIntoTheRimIsAPartOfTheCylinder)
+{
+  // The lid of a lying tin set 13 mm into its rim (cut off by the concave crease at the rim,
+  // learn38 of mOSD), and its ends flush with the wall's: parts of the tin.
+  const facyl::CylinderModel tin = lyingTin();
+  Eigen::Matrix3Xf pts, nrm;
+  for (const float x : {0.013f, 0.f, 0.084f, -0.01f}) {
+    disc(x, 0.09f, 20, pts, nrm);
+    EXPECT_TRUE(facyl::isEndCap(tin, pts, nrm)) << x;
+  }
+  // Not an end: a disc beyond the band off the ends (another object stacked on the end) ...
+  disc(-0.03f, 0.09f, 20, pts, nrm);
+  EXPECT_FALSE(facyl::isEndCap(tin, pts, nrm));
+  // ... a disc wider than the tin (the face of a box behind it) ...
+  disc(0.013f, 0.2f, 20, pts, nrm);
+  EXPECT_FALSE(facyl::isEndCap(tin, pts, nrm));
+  // ... a disc whose normals run across the axis (a face along it, seen edge-on) ...
+  disc(0.013f, 0.09f, 20, pts, nrm);
+  const Eigen::Matrix3Xf across = Eigen::Vector3f(0.f, 0.f, -1.f).replicate(1, pts.cols());
+  EXPECT_FALSE(facyl::isEndCap(tin, pts, across));
+  // ... a can lying along the tin's axis inside its span (points spread along the axis, not
+  // on one section), and nothing.
+  Eigen::Matrix3Xf can(3, 50);
+  for (int k = 0; k < 50; ++k)
+    can.col(k) = Eigen::Vector3f(0.0016f * static_cast<float>(k), 0.02f, 0.75f);
+  const Eigen::Matrix3Xf can_normals = Eigen::Vector3f(-1.f, 0.f, 0.f).replicate(1, 50);
+  EXPECT_FALSE(facyl::isEndCap(tin, can, can_normals));
+  EXPECT_FALSE(facyl::isEndCap(tin, Eigen::Matrix3Xf(3, 0), Eigen::Matrix3Xf(3, 0)));
+  // Unknown normals: no end (nothing tells it faces along the axis).
+  disc(0.013f, 0.09f, 20, pts, nrm);
+  nrm.setConstant(std::numeric_limits<float>::quiet_NaN());
+  EXPECT_FALSE(facyl::isEndCap(tin, pts, nrm));
+}
+
+TEST(CylinderParts, InsidesAndAttachments)
+{
+  // An upright cup, radius 4 cm, 9 cm tall: its inside wall seen through the opening (normals
+  // facing the axis), and a handle beside it.
+  facyl::CylinderModel cup;
+  cup.radius = 0.04f;
+  cup.axis = Eigen::Vector3f::UnitZ();
+  cup.base = cup.point_on_axis = Eigen::Vector3f::Zero();
+  cup.top = Eigen::Vector3f(0.f, 0.f, 0.09f);
+  cup.height = 0.09f;
+  Eigen::Matrix3Xf inside(3, 36), facing(3, 36), away(3, 36);
+  for (int k = 0; k < 36; ++k) {
+    const float a = 3.14159f * static_cast<float>(k) / 35.f; // the far half
+    const Eigen::Vector3f radial(std::cos(a), std::sin(a), 0.f);
+    inside.col(k) = 0.037f * radial + Eigen::Vector3f(0.f, 0.f, 0.03f + 0.0015f * k);
+    facing.col(k) = -radial;
+    away.col(k) = radial;
+  }
+  EXPECT_TRUE(facyl::isContainerInside(cup, inside, facing));
+  EXPECT_FALSE(facyl::isContainerInside(cup, inside, away)); // convex: an object's outside
+  Eigen::Matrix3Xf handle(3, 20), far(3, 20);
+  for (int k = 0; k < 20; ++k) {
+    handle.col(k) = Eigen::Vector3f(0.055f, 0.f, 0.02f + 0.0025f * static_cast<float>(k));
+    far.col(k) = Eigen::Vector3f(0.15f, 0.f, 0.02f + 0.0025f * static_cast<float>(k));
+  }
+  EXPECT_TRUE(facyl::isAttachment(cup, handle));
+  EXPECT_FALSE(facyl::isAttachment(cup, far));
 }
 
 TEST(ShapeEvidence, TellsACylinderFromTheShapesItAlsoFits)

@@ -990,18 +990,28 @@ TEST(RealData, LidDominatedAndLyingTins)
       rec.setInputCloud(cloud);
       std::vector<facyl::RecognizedObject> objects;
       ASSERT_TRUE(rec.recognize(objects));
+      // The tin is one object (learn38's lid, set into the rim, is cut off by the crease
+      // there: joined again as the tin's end, cylinder_parts.h).
+      const auto isTin = [&](pcl::index_t i) {
+        return static_cast<int>(labelled[i].label / 10) == id && labelled[i].label >= 20;
+      };
+      std::size_t tin_points = 0, most = 0;
+      for (std::size_t i = 0; i < labelled.size(); ++i)
+        tin_points += isTin(static_cast<pcl::index_t>(i));
       const facyl::RecognizedObject* tin = nullptr;
       for (const auto& o : objects) {
         std::size_t on_tin = 0;
         for (const auto i : o.cluster.indices.indices)
-          on_tin += static_cast<int>(labelled[i].label / 10) == id && labelled[i].label >= 20;
-        if (2 * on_tin > o.cluster.indices.indices.size())
-          tin = &o;
+          on_tin += isTin(i);
+        if (2 * on_tin > o.cluster.indices.indices.size() && on_tin > most)
+          tin = &o, most = on_tin;
       }
       ASSERT_NE(tin, nullptr) << name;
       const float r = tin->evidence.fitted ? tin->cylinder.radius : 0.f;
       radii += " " + std::to_string(static_cast<int>(std::lround(r * 1000.f)));
       right += tin->is_cylinder && r > 0.09f && r < 0.11f;
+      if (retry)
+        EXPECT_GT(static_cast<float>(most), 0.9f * static_cast<float>(tin_points)) << name;
     }
     std::printf("[ figures ] cookie tins, retry %s: %zu of %zu found with radius 90-110 mm; "
                 "radii (mm):%s\n",

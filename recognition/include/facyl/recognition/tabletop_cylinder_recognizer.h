@@ -260,10 +260,15 @@ private:
    * timing_.fitting (0 when no cluster is fitted). */
   std::vector<std::vector<RecognizedObject>> fitClusters(std::vector<TabletopCluster>& clusters,
                                                          const std::vector<float>& p_network);
-  /** Joins each object lying inside the cylinder fitted to another (the inside of an open
-   * container, cut off at its rim), and each small fragment beside one (a mug's handle), to
-   * that one, which keeps its fit and is classified again as a whole. */
-  void joinContainerInsides(std::vector<RecognizedObject>& objects);
+  /** Joins each object that is a part of another's cylinder (cylinder_parts.h: the inside of
+   * an open container, cut off at its rim; a small fragment beside it, a mug's handle; an end
+   * set into its rim, a tin's lid) to that one, which keeps its fit and is classified again
+   * as a whole. */
+  void joinCylinderParts(std::vector<RecognizedObject>& objects);
+  /** About 200 of \a indices' points (organized input), each with its normal from the pixel
+   * grid (NaN where unknown), as columns. */
+  void sampleWithNormals(const pcl::Indices& indices, Eigen::Matrix3Xf& points,
+                         Eigen::Matrix3Xf& normals) const;
   /** Subsamples \a cluster and estimates normals and curvatures (with \a fitter). The fitting
    * functions below change only their fitter: threads with fitters of their own may run them
    * at once. */

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/features/parallel.h>
+#include <facyl/recognition/cylinder_parts.h>
 #include <facyl/recognition/impl/classifier_input.hpp>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
@@ -199,7 +200,7 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
     if (classifier_)
       applyClassifier(objects, first, p_network[k]);
   }
-  joinContainerInsides(objects);
+  joinCylinderParts(objects);
   if (!classifier_) // the evidence model without a network
     for (auto& o : objects)
       if (o.evidence.fitted)
@@ -283,98 +284,39 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support)
 
 template <typename PointT>
 void
-TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedObject>& objects)
+TabletopCylinderRecognizer<PointT>::joinCylinderParts(std::vector<RecognizedObject>& objects)
 {
-  // The inside of an open container (a cup, a bowl) seen through its opening is cut off its
-  // outside at the near rim, a depth jump: an object lying within the cylinder fitted to
-  // another's outer wall (most of it within the rim, which may be wider than the wall fitted
-  // below it, and a good part within the wall's radius: an object beside or behind is not),
-  // up to a radius above its top (a bowl's rim rises above that wall), and facing the axis
-  // (concave, unlike an object stacked on a lid) is
-  // that container's inside. The two are joined and judged again as one object (a bowl,
-  // whole, no longer looks like a can). Organized clouds only: the normals come from the
-  // pixel grid.
-  constexpr float kRim = 1.3f, kInside = 0.6f, kWithinWall = 0.4f, kFacingAxis = 0.6f;
+  // Parts of one object that the segmentation cut apart where its surface jumps or turns
+  // inwards (cylinder_parts.h): an open container's inside seen through its opening (cut off
+  // its outside at the near rim: the two, joined and judged again as one, are a bowl, no longer
+  // like a can), a small fragment beside it (a mug's handle), an end set into its rim (a tin's
+  // lid). Organized clouds only: the normals come from the pixel grid.
+  constexpr float kAttachmentSize = 0.1f; // of the cylinder's object's points, at most
   if (!input_->isOrganized())
     return;
-  const auto w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
-  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
-  /** A point of the object and its normal from the pixel grid (NaN when unknown). */
-  const auto pointAndNormal = [&](pcl::index_t i, Eigen::Vector3f& p, Eigen::Vector3f& n) {
-    const int u = static_cast<int>(i % w), v = static_cast<int>(i / w), s = 2;
-    p = (*input_)[i].getVector3fMap();
-    n = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
-    if (u < s || v < s || u + s >= w || v + s >= h)
-      return;
-    const auto at = [&](int du, int dv) {
-      return Eigen::Vector3f(
-        (*input_)[static_cast<std::size_t>((v + dv) * w + u + du)].getVector3fMap());
-    };
-    const Eigen::Vector3f m = (at(s, 0) - at(-s, 0)).cross(at(0, s) - at(0, -s));
-    if (m.allFinite() && m.norm() > 0.f)
-      n = m.dot(viewpoint - p) >= 0.f ? Eigen::Vector3f(m.normalized())
-                                      : Eigen::Vector3f(-m.normalized());
-  };
-  const auto isInside = [&](const CylinderModel& c, const RecognizedObject& o) {
-    const Eigen::Vector3f axis = c.axis.normalized();
-    const float height = (c.top - c.base).dot(axis);
-    const auto& idx = o.cluster.indices.indices;
-    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
-    std::size_t n = 0, inside = 0, within_wall = 0, facing = 0, sided = 0;
-    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
-      Eigen::Vector3f p, q;
-      pointAndNormal(idx[k], p, q);
-      const Eigen::Vector3f d = p - c.base;
-      const float t = d.dot(axis);
-      const Eigen::Vector3f radial = d - t * axis;
-      if (radial.norm() > kRim * c.radius || t < -0.2f * c.radius || t > height + c.radius)
-        continue;
-      ++inside;
-      within_wall += radial.norm() <= c.radius;
-      const float side = q.allFinite() ? q.dot(radial.normalized()) : 0.f;
-      if (std::abs(side) > 0.3f) {
-        ++sided;
-        facing += side < 0.f;
-      }
-    }
-    return n > 0 && static_cast<float>(inside) >= kInside * static_cast<float>(n) &&
-           static_cast<float>(within_wall) >= kWithinWall * static_cast<float>(n) && sided > 0 &&
-           static_cast<float>(facing) >= kFacingAxis * static_cast<float>(sided);
-  };
-  // A small fragment beside a cylinder, within its height and a radius of its wall (a mug's
-  // handle, cut off at the depth jump between handle and body), is a part of it.
-  constexpr float kAttachmentSize = 0.1f, kAttachmentReach = 2.f, kAttached = 0.8f;
-  const auto isAttachment = [&](const RecognizedObject& outer, const RecognizedObject& o) {
-    const auto& idx = o.cluster.indices.indices;
-    if (static_cast<float>(idx.size()) >
-        kAttachmentSize * static_cast<float>(outer.cluster.indices.indices.size()))
-      return false;
-    const CylinderModel& c = outer.cylinder;
-    const Eigen::Vector3f axis = c.axis.normalized();
-    const float height = (c.top - c.base).dot(axis);
-    const std::size_t stride = std::max<std::size_t>(1, idx.size() / 200);
-    std::size_t n = 0, near = 0;
-    for (std::size_t k = 0; k < idx.size(); k += stride, ++n) {
-      const Eigen::Vector3f d = (*input_)[idx[k]].getVector3fMap() - c.base;
-      const float t = d.dot(axis);
-      near += (d - t * axis).norm() <= kAttachmentReach * c.radius && t >= -0.2f * c.radius &&
-              t <= height + 0.2f * c.radius;
-    }
-    return n > 0 && static_cast<float>(near) >= kAttached * static_cast<float>(n);
-  };
+  std::vector<Eigen::Matrix3Xf> points(objects.size()), normals(objects.size());
+  for (std::size_t k = 0; k < objects.size(); ++k)
+    sampleWithNormals(objects[k].cluster.indices.indices, points[k], normals[k]);
   std::vector<int> host(objects.size(), -1);
   bool any = false;
   for (std::size_t a = 0; a < objects.size(); ++a) {
     const RecognizedObject& outer = objects[a];
     if (!outer.evidence.fitted || !acceptGeometry(outer.evidence, params_.decision))
       continue;
+    const CylinderModel& c = outer.cylinder;
+    const std::size_t size = outer.cluster.indices.indices.size();
     for (std::size_t b = 0; b < objects.size(); ++b) {
-      // An object that is a cylinder on its own is no part of another (a can beside a tin
-      // that a wide cylinder was fitted to).
       if (b == a || host[b] >= 0 || host[a] >= 0 ||
-          objects[b].cluster.support != outer.cluster.support || objects[b].is_cylinder)
+          objects[b].cluster.support != outer.cluster.support)
         continue;
-      if (isInside(outer.cylinder, objects[b]) || isAttachment(outer, objects[b])) {
+      // An end (smaller than the wall it closes) is a disc, whatever it looks like alone; an
+      // object that is a cylinder on its own is no inside or attachment of another (a can
+      // beside a tin that a wide cylinder was fitted to).
+      const std::size_t part = objects[b].cluster.indices.indices.size();
+      const bool small = static_cast<float>(part) <= kAttachmentSize * static_cast<float>(size);
+      if ((part < size && isEndCap(c, points[b], normals[b])) ||
+          (!objects[b].is_cylinder && (isContainerInside(c, points[b], normals[b]) ||
+                                       (small && isAttachment(c, points[b]))))) {
         host[b] = static_cast<int>(a);
         any = true;
       }
@@ -400,7 +342,7 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
         c.indices.indices.insert(c.indices.indices.end(),
                                  objects[b].cluster.indices.indices.begin(),
                                  objects[b].cluster.indices.indices.end());
-        if (isInside(o.cylinder, objects[b]))
+        if (isContainerInside(o.cylinder, points[b], normals[b]))
           inside += objects[b].cluster.indices.indices.size();
       }
     // The evidence of the whole: its inside is what an open container shows (a bowl's is most
@@ -418,8 +360,8 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
                                   : projectedBox(pts, camera_);
     joined.push_back(std::move(o));
   }
-  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides or "
-            "attachments\n",
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] %zu cylinders joined with their insides, "
+            "attachments or ends\n",
             joined.size());
   if (classifier_) {
     std::vector<TabletopCluster> views;
@@ -437,6 +379,40 @@ TabletopCylinderRecognizer<PointT>::joinContainerInsides(std::vector<RecognizedO
   objects = std::move(kept);
   for (auto& o : joined)
     objects.push_back(std::move(o));
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::sampleWithNormals(const pcl::Indices& indices,
+                                                      Eigen::Matrix3Xf& points,
+                                                      Eigen::Matrix3Xf& normals) const
+{
+  // About 200 of the points, each with the normal of the pixel grid (the cross product of its
+  // neighbours 2 pixels away, towards the sensor; NaN at the image's border and where a
+  // neighbour has no depth).
+  const auto w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
+  const Eigen::Vector3f viewpoint = input_->sensor_origin_.head(3);
+  const std::size_t stride = std::max<std::size_t>(1, indices.size() / 200);
+  const auto n = static_cast<Eigen::Index>((indices.size() + stride - 1) / stride);
+  points.resize(3, n);
+  normals.setConstant(3, n, std::numeric_limits<float>::quiet_NaN());
+  constexpr int s = 2;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const pcl::index_t i = indices[static_cast<std::size_t>(j) * stride];
+    const int u = static_cast<int>(i % w), v = static_cast<int>(i / w);
+    const Eigen::Vector3f p = (*input_)[i].getVector3fMap();
+    points.col(j) = p;
+    if (u < s || v < s || u + s >= w || v + s >= h)
+      continue;
+    const auto at = [&](int du, int dv) {
+      return Eigen::Vector3f(
+        (*input_)[static_cast<std::size_t>((v + dv) * w + u + du)].getVector3fMap());
+    };
+    const Eigen::Vector3f m = (at(s, 0) - at(-s, 0)).cross(at(0, s) - at(0, -s));
+    if (m.allFinite() && m.norm() > 0.f)
+      normals.col(j) = m.dot(viewpoint - p) >= 0.f ? Eigen::Vector3f(m.normalized())
+                                                   : Eigen::Vector3f(-m.normalized());
+  }
 }
 
 template <typename PointT>
