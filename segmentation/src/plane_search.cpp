@@ -434,6 +434,12 @@ ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, double sc
   }
 }
 
+bool
+facesImageTop(const Eigen::Vector4f& plane, const Eigen::Vector3f& image_down)
+{
+  return plane.head<3>().dot(image_down) <= -0.1f;
+}
+
 std::vector<std::vector<std::size_t>>
 rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
                     const std::vector<std::size_t>& points, bool up_known,
@@ -451,7 +457,7 @@ rankSupportFamilies(const std::vector<Eigen::Vector4f>& planes,
   // image's down direction, measured on organized clouds); walls and ceilings do not. Those
   // come first (the order breaks ties), then the family with most points.
   const auto faces_up = [&](const std::vector<std::size_t>& f) {
-    return up_known || planes[f.front()].head<3>().dot(image_down) <= -0.1f;
+    return up_known || facesImageTop(planes[f.front()], image_down);
   };
   const auto sum = [&](const std::vector<std::size_t>& f) {
     std::size_t total = 0;

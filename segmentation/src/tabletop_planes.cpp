@@ -301,9 +301,11 @@ regionCentre(const PointFrame& frame, const Candidate& c, bool at_least_one)
 }
 
 /** Supports span a plane that does not pass by the sensor, are not a part of a larger
- * candidate, and (with an up direction) are horizontal. */
+ * candidate, and (with an up direction) are horizontal; at most max_planes, those facing the
+ * top of the image (\a image_down; zero: unknown) first. */
 void
-keepSupportCandidates(const Setup& setup, std::vector<Candidate>& candidates)
+keepSupportCandidates(const Setup& setup, const Eigen::Vector3f& image_down,
+                      std::vector<Candidate>& candidates)
 {
   const auto& p = setup.params;
   const Eigen::Vector3f viewpoint = setup.frame.viewpoint;
@@ -356,6 +358,12 @@ keepSupportCandidates(const Setup& setup, std::vector<Candidate>& candidates)
     return;
   }
   if (candidates.size() > p.max_planes) {
+    // The candidates an upright camera would see facing up (the first families tried, see
+    // rankSupportFamilies) are kept before the others: a dark table's few pixels must not
+    // give way to the walls and cabinet fronts that a room shows more of.
+    if (setup.up.isZero() && !image_down.isZero())
+      std::stable_partition(candidates.begin(), candidates.end(),
+                            [&](const Candidate& c) { return facesImageTop(c.plane, image_down); });
     keepPriorCandidate(setup, candidates, p.max_planes);
     candidates.resize(p.max_planes);
   }
@@ -368,7 +376,7 @@ findCandidates(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace
 {
   std::vector<Candidate> candidates =
     setup.as_image ? findPlanesOrganized(setup, cues, workspace) : findPlanesUnorganized(setup);
-  keepSupportCandidates(setup, candidates);
+  keepSupportCandidates(setup, cues.image_down, candidates);
   if (!candidates.empty())
     cues.noise = candidates.front().band;
   return candidates;

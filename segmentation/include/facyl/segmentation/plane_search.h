@@ -184,6 +184,11 @@ void ransacPlaneSeeds(const SampledPlaneCues& cues, std::size_t max_planes, doub
                       const std::function<void(const std::vector<std::uint8_t>&)>& grow,
                       std::vector<std::uint8_t>& taken);
 
+/** \brief True when \a plane (a, b, c, d, unit normal towards the sensor) faces the top of
+ * the image, as an upright camera sees a support: its normal points against \a image_down
+ * (the image's down direction, unit), by more than 0.1. */
+bool facesImageTop(const Eigen::Vector4f& plane, const Eigen::Vector3f& image_down);
+
 /** \brief The families of parallel \a planes (unit normals within 0.1 rad), those an upright
  * camera would see facing up first (\a up_known: all of them; else the normal points against
  * \a image_down, the image's down direction), then by their \a points. \a planes are largest
