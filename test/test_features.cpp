@@ -179,14 +179,16 @@ TEST(NeighbourSearch, GridNeighboursAreTheTreesNeighbours)
           const float dg = (pts.col(grid.begin(i)[j]) - q).squaredNorm();
           EXPECT_FLOAT_EQ(dg, (pts.col(tree.begin(i)[j]) - q).squaredNorm())
             << "shape " << kind << " k " << k << " query " << i << " rank " << j;
-          if (j > 0)
+          if (j > 0) {
             EXPECT_LE((pts.col(grid.begin(i)[j - 1]) - q).squaredNorm(), dg);
+          }
         }
       }
       EXPECT_EQ(grid.count(102), 0u);
       EXPECT_EQ(grid.count(0), std::min<std::size_t>(static_cast<std::size_t>(k), 699u));
-      if (kind != 4) // a surface point finds itself first (coincident points: any of them)
+      if (kind != 4) { // a surface point finds itself first (coincident points: any of them)
         EXPECT_EQ(grid.begin(0)[0], 0);
+      }
     }
   }
   const Eigen::Matrix3Xf none(3, 0), one = Eigen::Vector3f(1.f, 2.f, 3.f);

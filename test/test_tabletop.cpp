@@ -1010,8 +1010,9 @@ TEST(RealData, LidDominatedAndLyingTins)
       const float r = tin->evidence.fitted ? tin->cylinder.radius : 0.f;
       radii += " " + std::to_string(static_cast<int>(std::lround(r * 1000.f)));
       right += tin->is_cylinder && r > 0.09f && r < 0.11f;
-      if (retry)
+      if (retry) {
         EXPECT_GT(static_cast<float>(most), 0.9f * static_cast<float>(tin_points)) << name;
+      }
     }
     std::printf("[ figures ] cookie tins, retry %s: %zu of %zu found with radius 90-110 mm; "
                 "radii (mm):%s\n",
