@@ -193,6 +193,13 @@ TEST(SegmentTabletop, PointFrameReadsTheCloudOrACopyOfItsCoordinates)
   EXPECT_TRUE(buffer.empty());
   EXPECT_EQ(own.size, cloud->size());
   EXPECT_TRUE(own.isOrganized());
+  // Its colours too (blue, green, red at the rgba field), for the colour edges.
+  EXPECT_EQ(own.bgr, reinterpret_cast<const std::uint8_t*>(&cloud->points.front().rgba));
+  EXPECT_EQ(own.bgr_stride, sizeof(pcl::PointXYZRGBA));
+  EXPECT_EQ(own.bgr[1000 * own.bgr_stride + 2], (*cloud)[1000].r);
+  // Without colour (as the copy below), the same points segment as PointXYZ's do.
+  facyl::PointFrame own_xyz = own;
+  own_xyz.bgr = nullptr;
 
   pcl::PointCloud<TrailingXyz>::Ptr trailing(new pcl::PointCloud<TrailingXyz>);
   trailing->resize(cloud->size());
@@ -207,14 +214,15 @@ TEST(SegmentTabletop, PointFrameReadsTheCloudOrACopyOfItsCoordinates)
   EXPECT_EQ(copied.stride, 4u);
   ASSERT_EQ(buffer.size(), 4 * cloud->size());
   EXPECT_EQ(std::memcmp(copied.xyz + 4 * 1000, &(*cloud)[1000].x, 3 * sizeof(float)), 0);
+  EXPECT_EQ(copied.bgr, nullptr);
   const facyl::TabletopSegmentationParameters p;
-  expectSame(segmentFresh(copied, p), segmentFresh(own, p));
+  expectSame(segmentFresh(copied, p), segmentFresh(own_xyz, p));
   // The front on that type, through the same copy.
   facyl::TabletopSegmentation<TrailingXyz> seg;
   seg.setInputCloud(trailing);
   std::vector<facyl::TabletopCluster> clusters;
   ASSERT_TRUE(seg.segment(clusters));
-  const facyl::TabletopSegments core = segmentFresh(own, p);
+  const facyl::TabletopSegments core = segmentFresh(own_xyz, p);
   ASSERT_EQ(clusters.size(), core.clusters.size());
   for (std::size_t k = 0; k < clusters.size(); ++k)
     EXPECT_EQ(clusters[k].indices.indices, core.clusters[k].indices.indices);

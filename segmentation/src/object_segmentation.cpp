@@ -35,11 +35,20 @@ validate(const ObjectSegmentationParameters& p)
   else if (!(p.bridge_max_gap > 0.f && p.bridge_max_gap <= 2.f) ||
            !(p.bridge_angle > 0.f && p.bridge_angle < 1.57f) || !(p.bridge_distance > 0.f))
     s << "bridge settings must be positive (gap <= 2 m, angle < pi/2)";
+  else if (!(p.colour_edge >= 0.f && p.colour_edge <= 100.f))
+    s << "colour_edge must be in [0, 100] (0: off)";
   return s.str();
 }
 
 namespace edge_aware {
 namespace {
+
+/** A weak crease turns by this share of the crease angle: where two touching objects meet,
+ * the surface turns less than at a crease once noise and the pixel footprint blur the valley
+ * (colourCuts). */
+constexpr float kWeakCrease = 0.5f;
+/** How far (pixels) from an edge a weak crease may take a colour edge (colourCuts). */
+constexpr int kColourReach = 2;
 
 class UnionFind {
 public:
@@ -114,15 +123,19 @@ roundHalfAway(float x)
   return static_cast<long>(d >= 0.0 ? std::floor(d + 0.5) : std::ceil(d - 0.5));
 }
 
-/** Per valid pixel: 1 on a concave crease (see concaveCreases). */
+/** Per valid pixel: 1 on a concave crease (see concaveCreases); with \a weak, also 1 in it
+ * where the surface turns by half the crease angle (kWeakCrease), in the same pass. */
 std::vector<std::uint8_t>
 creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
-        const ObjectSegmentationParameters& p)
+        const ObjectSegmentationParameters& p, std::vector<std::uint8_t>* weak = nullptr)
 {
   std::vector<std::uint8_t> crease(grid.size(), 0);
+  if (weak)
+    weak->assign(grid.size(), 0);
   if (!(p.crease_angle > 0.f) || !(focal > 0.f))
     return crease;
   const float cos_max = std::cos(p.crease_angle);
+  const float cos_weak = weak ? std::cos(kWeakCrease * p.crease_angle) : cos_max;
   const AcrossMeans across[2] = {acrossMeans(grid, true), acrossMeans(grid, false)};
   for (std::size_t c = 0; c < grid.size(); ++c) {
     const float range = grid.range(static_cast<int>(c));
@@ -145,10 +158,15 @@ creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
       // Much longer than the span: a depth jump, which the connection test handles.
       if (!(l1 > 0.f && l2 > 0.f) || l1 > 8.f * span || l2 > 8.f * span)
         continue;
-      if (e1.dot(e2) > cos_max * l1 * l2)
+      const float turn = e1.dot(e2);
+      if (turn > cos_weak * l1 * l2)
         continue;
       // Concave seen from the sensor: the middle lies behind the chord.
-      crease[c] = (pb - 0.5f * (pa + pc)).dot(pb - viewpoint) > 0.f;
+      if ((pb - 0.5f * (pa + pc)).dot(pb - viewpoint) <= 0.f)
+        continue;
+      if (weak)
+        (*weak)[c] = 1;
+      crease[c] = turn <= cos_max * l1 * l2;
     }
   }
   return crease;
@@ -182,37 +200,123 @@ components(const Grid& grid, Use use, std::vector<int>& label, int next)
   return next;
 }
 
+/** The squared difference of the colours of valid pixels \a a and \a b. */
+float
+colourDifference2(const Grid& grid, const ColourImage& colour, int a, int b)
+{
+  return (colour.at(grid.pixel(a)) - colour.at(grid.pixel(b))).squaredNorm();
+}
+
+/** The pixels where colour edges cut objects apart that depth alone cannot tell (see
+ * ObjectSegmentationParameters::colour_edge): both pixels of each linked pair whose colours
+ * differ by more than colour_edge times the typical difference of linked neighbours (the
+ * median of a sample: noise, texture, shading), one of them on a weak crease that continues
+ * an edge (a depth discontinuity, a missing neighbour or a crease within kColourReach pixels:
+ * noise alone makes weak creases everywhere on a far surface). Sets \a threshold2 to the
+ * squared colour difference of an edge. Empty without \a colour. */
+std::vector<std::uint8_t>
+colourCuts(const Grid& grid, const ColourImage* colour, const std::vector<std::uint8_t>& weak,
+           const std::vector<std::uint8_t>& crease, const ObjectSegmentationParameters& p,
+           float& threshold2)
+{
+  std::vector<std::uint8_t> cut;
+  if (!colour || !colour->bgr || !(p.colour_edge > 0.f))
+    return cut;
+  const int n = static_cast<int>(grid.size());
+  std::vector<float> sample;
+  const int step = std::max(1, n / 4096);
+  for (int a = 0; a < n; a += step) {
+    int u, v;
+    grid.position(a, u, v);
+    for (const int b : {grid.at(u + 1, v), grid.at(u, v + 1)})
+      if (b >= 0 && grid.linked(a, b))
+        sample.push_back(colourDifference2(grid, *colour, a, b));
+  }
+  if (sample.empty())
+    return cut;
+  const auto mid = sample.begin() + static_cast<std::ptrdiff_t>(sample.size() / 2);
+  std::nth_element(sample.begin(), mid, sample.end());
+  // At least one level of an 8-bit channel: a flat colour has no edges.
+  threshold2 = p.colour_edge * p.colour_edge * std::max(*mid, 1.f);
+  std::vector<std::uint8_t> near(grid.size(), 0);
+  for (int a = 0; a < n; ++a) {
+    bool edge = crease[static_cast<std::size_t>(a)] != 0;
+    if (!edge)
+      grid.forNeighbours(
+        a, [&](int b) { edge = edge || !grid.linked(a, b); }, [&] { edge = true; });
+    if (!edge)
+      continue;
+    int u, v;
+    grid.position(a, u, v);
+    for (int dv = -kColourReach; dv <= kColourReach; ++dv)
+      for (int du = -kColourReach; du <= kColourReach; ++du) {
+        const int b = grid.at(u + du, v + dv);
+        if (b >= 0)
+          near[static_cast<std::size_t>(b)] = 1;
+      }
+  }
+  cut.assign(grid.size(), 0);
+  for (int a = 0; a < n; ++a)
+    if (weak[static_cast<std::size_t>(a)] && near[static_cast<std::size_t>(a)])
+      grid.forNeighbours(
+        a,
+        [&](int b) {
+          if (colourDifference2(grid, *colour, a, b) > threshold2 && grid.linked(a, b))
+            cut[static_cast<std::size_t>(a)] = cut[static_cast<std::size_t>(b)] = 1;
+        },
+        [] {});
+  return cut;
+}
+
 /** segmentObjectsOrganized on its grid of valid pixels. */
 std::vector<pcl::Indices>
 segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float focal,
-            const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p)
+            const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
+            const ColourImage* colour = nullptr)
 {
   if (grid.size() == 0)
     return {};
-  const std::vector<std::uint8_t> crease = creases(grid, focal, viewpoint, p);
-  // 1. Components without the crease pixels.
+  const bool with_colour = colour && colour->bgr && p.colour_edge > 0.f;
+  std::vector<std::uint8_t> weak;
+  const std::vector<std::uint8_t> crease =
+    creases(grid, focal, viewpoint, p, with_colour ? &weak : nullptr);
+  float threshold2 = 0.f;
+  const std::vector<std::uint8_t> cut = colourCuts(grid, colour, weak, crease, p, threshold2);
+  const auto apart = [&](int a) {
+    return crease[static_cast<std::size_t>(a)] ||
+           (!cut.empty() && cut[static_cast<std::size_t>(a)]);
+  };
+  // 1. Components without the crease and colour-cut pixels.
   std::vector<int> label(grid.size(), -1);
   int count = components(
-    grid, [&](int a) { return !crease[static_cast<std::size_t>(a)]; }, label, 0);
-  // Crease pixels join the component that reaches them first (breadth first from all).
+    grid, [&](int a) { return !apart(a); }, label, 0);
+  // Those pixels join the component that reaches them first (breadth first from all); first
+  // a colour-cut pixel only from a pixel of its colour (the other side's is another object),
+  // then from any that reaches it.
   std::vector<int> queue;
   queue.reserve(grid.size());
   for (int a = 0; a < static_cast<int>(grid.size()); ++a)
     if (label[static_cast<std::size_t>(a)] >= 0)
       queue.push_back(a);
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const int a = queue[head];
-    grid.forNeighbours(
-      a,
-      [&](int b) {
-        if (label[static_cast<std::size_t>(b)] < 0 && grid.linked(a, b)) {
-          label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
-          queue.push_back(b);
-        }
-      },
-      [] {});
+  for (const bool by_colour : {true, false}) {
+    if (by_colour && cut.empty())
+      continue;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const int a = queue[head];
+      grid.forNeighbours(
+        a,
+        [&](int b) {
+          if (label[static_cast<std::size_t>(b)] < 0 && grid.linked(a, b) &&
+              (!by_colour || !cut[static_cast<std::size_t>(b)] ||
+               colourDifference2(grid, *colour, a, b) <= threshold2)) {
+            label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
+            queue.push_back(b);
+          }
+        },
+        [] {});
+    }
   }
-  // Crease pixels no component reached (thin parts) are components of their own.
+  // Pixels no component reached (thin parts) are components of their own.
   count = components(
     grid, [](int) { return true; }, label, count);
   // 2. Fragments and enclosed segments join their neighbour; 3. occluded parts are joined.
@@ -322,7 +426,7 @@ segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixe
                         std::uint32_t width, std::uint32_t height,
                         const std::vector<std::uint8_t>& has_depth, float focal,
                         const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-                        const DepthBand* noise)
+                        const DepthBand* noise, const ColourImage* colour)
 {
   const std::size_t size = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (width == 0 || height < 2 || !(focal > 0.f) || has_depth.size() != size ||
@@ -332,7 +436,7 @@ segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixe
   return edge_aware::segmentGrid(edge_aware::Grid(points, pixels, static_cast<int>(width),
                                                   static_cast<int>(height), focal, viewpoint, p,
                                                   noise),
-                                 has_depth, focal, viewpoint, p);
+                                 has_depth, focal, viewpoint, p, colour);
 }
 
 } // namespace facyl

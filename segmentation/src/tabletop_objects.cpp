@@ -45,8 +45,10 @@ clusterOrganized(const Setup& setup, const FrameCues& cues, const pcl::Indices& 
     Eigen::Matrix3Xf points(3, static_cast<Eigen::Index>(pixels.size()));
     for (std::size_t k = 0; k < pixels.size(); ++k)
       points.col(static_cast<Eigen::Index>(k)) = frame.point(static_cast<std::size_t>(pixels[k]));
+    const ColourImage colour{frame.bgr, frame.bgr_stride};
     return segmentObjectsOrganized(points, pixels, frame.width, frame.height, *has_depth,
-                                   cues.focal, frame.viewpoint, params.objects, cues.noiseBand());
+                                   cues.focal, frame.viewpoint, params.objects, cues.noiseBand(),
+                                   frame.bgr ? &colour : nullptr);
   }
   // A sparse copy with only the object points finite: the components then never visit the
   // rest of the image. (Buffers kept between calls: fresh VGA-sized allocations cost more in

@@ -46,6 +46,28 @@ struct ObjectSegmentationParameters {
   float bridge_max_gap{0.25f};
   float bridge_angle{0.3f};
   float bridge_distance{0.015f};
+  /** Colour edges where depth alone cannot tell (segmentObjectsOrganized with a
+   * ColourImage): where the surface turns concave by half crease_angle (a weak crease: two
+   * touching objects, the valley blurred by noise and the pixel footprint) within 2 pixels of
+   * an edge (a depth discontinuity, a crease, the object's outline), linked neighbours whose
+   * colours differ by more than colour_edge times the frame's typical difference of linked
+   * neighbours (the median: noise, texture, shading) are cut apart like a crease; the cut
+   * pixels then join the segment of their colour. A label's edge on a smooth surface lies on
+   * no crease and cuts nothing. In [0, 100]; 0 turns them off. */
+  float colour_edge{6.f};
+};
+
+/** \brief The colours of an image's pixels: 8-bit blue, green, red at \a bgr + pixel *
+ * \a stride (PCL's rgb/rgba field layout). */
+struct ColourImage {
+  const std::uint8_t* bgr{nullptr};
+  std::size_t stride{0};
+  Eigen::Vector3f at(std::size_t pixel) const
+  {
+    const std::uint8_t* c = bgr + pixel * stride;
+    return Eigen::Vector3f(static_cast<float>(c[2]), static_cast<float>(c[1]),
+                           static_cast<float>(c[0]));
+  }
 };
 
 /** \brief Checks \a params. \return an empty string, or what is wrong. */
@@ -108,12 +130,10 @@ bool strictlyAscending(const pcl::Indices& indices);
  * \a height image). The same segments as the cloud version on a cloud that holds these points
  * and NaN elsewhere, without an image-sized cloud to fill. Empty on invalid input (sizes that
  * disagree, pixels out of the image or not ascending, focal <= 0). */
-std::vector<pcl::Indices> segmentObjectsOrganized(const Eigen::Matrix3Xf& points,
-                                                  const pcl::Indices& pixels, std::uint32_t width,
-                                                  std::uint32_t height,
-                                                  const std::vector<std::uint8_t>& has_depth,
-                                                  float focal, const Eigen::Vector3f& viewpoint,
-                                                  const ObjectSegmentationParameters& params,
-                                                  const DepthBand* noise = nullptr);
+std::vector<pcl::Indices> segmentObjectsOrganized(
+  const Eigen::Matrix3Xf& points, const pcl::Indices& pixels, std::uint32_t width,
+  std::uint32_t height, const std::vector<std::uint8_t>& has_depth, float focal,
+  const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& params,
+  const DepthBand* noise = nullptr, const ColourImage* colour = nullptr);
 
 } // namespace facyl

@@ -207,6 +207,10 @@ struct PointFrame {
   const pcl::Indices* indices{nullptr}; ///< the points to segment; nullptr: every point
   Eigen::Vector3f viewpoint{Eigen::Vector3f::Zero()}; ///< the sensor origin
   pcl::PCLHeader header;                              ///< given to the outputs' indices
+  /** The points' colours (blue, green, red bytes of point i at bgr + i * bgr_stride), or
+   * nullptr: none. */
+  const std::uint8_t* bgr{nullptr};
+  std::size_t bgr_stride{0};
 
   bool isOrganized() const
   {
@@ -240,6 +244,20 @@ pointFrame(const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
   f.indices = indices;
   f.viewpoint = cloud.sensor_origin_.template head<3>();
   f.header = cloud.header;
+  if constexpr (pcl::traits::has_field<PointT, pcl::fields::rgba>::value) {
+    if (!cloud.empty()) {
+      f.bgr = reinterpret_cast<const std::uint8_t*>(cloud.points.data()) +
+              pcl::traits::offset<PointT, pcl::fields::rgba>::value;
+      f.bgr_stride = sizeof(PointT);
+    }
+  }
+  else if constexpr (pcl::traits::has_field<PointT, pcl::fields::rgb>::value) {
+    if (!cloud.empty()) {
+      f.bgr = reinterpret_cast<const std::uint8_t*>(cloud.points.data()) +
+              pcl::traits::offset<PointT, pcl::fields::rgb>::value;
+      f.bgr_stride = sizeof(PointT);
+    }
+  }
   if constexpr (pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
                 pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
                 pcl::traits::offset<PointT, pcl::fields::z>::value == 8 &&
