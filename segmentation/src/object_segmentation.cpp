@@ -200,11 +200,14 @@ components(const Grid& grid, Use use, std::vector<int>& label, int next)
   return next;
 }
 
-/** The squared difference of the colours of valid pixels \a a and \a b. */
+/** The squared difference of the colours of valid pixels \a a and \a b (8-bit levels). */
 float
 colourDifference2(const Grid& grid, const ColourImage& colour, int a, int b)
 {
-  return (colour.at(grid.pixel(a)) - colour.at(grid.pixel(b))).squaredNorm();
+  const std::uint8_t* ca = colour.bgr + grid.pixel(a) * colour.stride;
+  const std::uint8_t* cb = colour.bgr + grid.pixel(b) * colour.stride;
+  const int d0 = ca[0] - cb[0], d1 = ca[1] - cb[1], d2 = ca[2] - cb[2];
+  return static_cast<float>(d0 * d0 + d1 * d1 + d2 * d2);
 }
 
 /** The pixels where colour edges cut objects apart that depth alone cannot tell (see
@@ -238,26 +241,33 @@ colourCuts(const Grid& grid, const ColourImage* colour, const std::vector<std::u
   std::nth_element(sample.begin(), mid, sample.end());
   // At least one level of an 8-bit channel: a flat colour has no edges.
   threshold2 = p.colour_edge * p.colour_edge * std::max(*mid, 1.f);
-  std::vector<std::uint8_t> near(grid.size(), 0);
-  for (int a = 0; a < n; ++a) {
-    bool edge = crease[static_cast<std::size_t>(a)] != 0;
-    if (!edge)
-      grid.forNeighbours(
-        a, [&](int b) { edge = edge || !grid.linked(a, b); }, [&] { edge = true; });
-    if (!edge)
-      continue;
+  // Whether a pixel is on an edge, found when first asked (0: not yet, 1: no, 2: yes).
+  std::vector<std::uint8_t> edge(grid.size(), 0);
+  const auto onEdge = [&](int b) {
+    std::uint8_t& e = edge[static_cast<std::size_t>(b)];
+    if (e == 0) {
+      bool yes = crease[static_cast<std::size_t>(b)] != 0;
+      if (!yes)
+        grid.forNeighbours(
+          b, [&](int c) { yes = yes || !grid.linked(b, c); }, [&] { yes = true; });
+      e = yes ? 2 : 1;
+    }
+    return e == 2;
+  };
+  const auto nearEdge = [&](int a) {
     int u, v;
     grid.position(a, u, v);
     for (int dv = -kColourReach; dv <= kColourReach; ++dv)
       for (int du = -kColourReach; du <= kColourReach; ++du) {
         const int b = grid.at(u + du, v + dv);
-        if (b >= 0)
-          near[static_cast<std::size_t>(b)] = 1;
+        if (b >= 0 && onEdge(b))
+          return true;
       }
-  }
+    return false;
+  };
   cut.assign(grid.size(), 0);
   for (int a = 0; a < n; ++a)
-    if (weak[static_cast<std::size_t>(a)] && near[static_cast<std::size_t>(a)])
+    if (weak[static_cast<std::size_t>(a)] && nearEdge(a))
       grid.forNeighbours(
         a,
         [&](int b) {
@@ -266,6 +276,52 @@ colourCuts(const Grid& grid, const ColourImage* colour, const std::vector<std::u
         },
         [] {});
   return cut;
+}
+
+/** The pixels left out of the components (\a label -1: on a crease or a colour cut) join the
+ * component that reaches them first (breadth first from all); first a colour-cut pixel
+ * (\a cut) only from a pixel of its colour (within \a threshold2: the other side's is another
+ * object), then from any that reaches it. */
+void
+joinApartPixels(const Grid& grid, const ColourImage* colour, const std::vector<std::uint8_t>& cut,
+                float threshold2, std::vector<int>& label)
+{
+  std::vector<int> queue;
+  queue.reserve(grid.size());
+  for (int a = 0; a < static_cast<int>(grid.size()); ++a)
+    if (label[static_cast<std::size_t>(a)] >= 0)
+      queue.push_back(a);
+  std::vector<int> deferred; // reached a colour-cut pixel of another colour
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int a = queue[head];
+    grid.forNeighbours(
+      a,
+      [&](int b) {
+        if (label[static_cast<std::size_t>(b)] >= 0 || !grid.linked(a, b))
+          return;
+        if (!cut.empty() && cut[static_cast<std::size_t>(b)] &&
+            colourDifference2(grid, *colour, a, b) > threshold2) {
+          deferred.push_back(a);
+          return;
+        }
+        label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
+        queue.push_back(b);
+      },
+      [] {});
+  }
+  // Then from those to the colour-cut pixels no pixel of their colour reached.
+  for (std::size_t head = 0; head < deferred.size(); ++head) {
+    const int a = deferred[head];
+    grid.forNeighbours(
+      a,
+      [&](int b) {
+        if (label[static_cast<std::size_t>(b)] < 0 && grid.linked(a, b)) {
+          label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
+          deferred.push_back(b);
+        }
+      },
+      [] {});
+  }
 }
 
 /** segmentObjectsOrganized on its grid of valid pixels. */
@@ -290,32 +346,7 @@ segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float 
   std::vector<int> label(grid.size(), -1);
   int count = components(
     grid, [&](int a) { return !apart(a); }, label, 0);
-  // Those pixels join the component that reaches them first (breadth first from all); first
-  // a colour-cut pixel only from a pixel of its colour (the other side's is another object),
-  // then from any that reaches it.
-  std::vector<int> queue;
-  queue.reserve(grid.size());
-  for (int a = 0; a < static_cast<int>(grid.size()); ++a)
-    if (label[static_cast<std::size_t>(a)] >= 0)
-      queue.push_back(a);
-  for (const bool by_colour : {true, false}) {
-    if (by_colour && cut.empty())
-      continue;
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const int a = queue[head];
-      grid.forNeighbours(
-        a,
-        [&](int b) {
-          if (label[static_cast<std::size_t>(b)] < 0 && grid.linked(a, b) &&
-              (!by_colour || !cut[static_cast<std::size_t>(b)] ||
-               colourDifference2(grid, *colour, a, b) <= threshold2)) {
-            label[static_cast<std::size_t>(b)] = label[static_cast<std::size_t>(a)];
-            queue.push_back(b);
-          }
-        },
-        [] {});
-    }
-  }
+  joinApartPixels(grid, colour, cut, threshold2, label);
   // Pixels no component reached (thin parts) are components of their own.
   count = components(
     grid, [](int) { return true; }, label, count);
