@@ -639,20 +639,33 @@ TEST(ObjectSegmentation, UnorganizedCloudsAreSplitToo)
   }
 }
 
-TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
+namespace {
+
+/** A small table (0.55 x 0.45 m, 0.5 m high, on legs) over the floor with two cans and a box on
+ * it; a wall behind it when \a wall (else as the generator's default draws). */
+facyl::TabletopScene
+smallTableScene(bool wall)
 {
-  // A small table (0.55 x 0.45 m, 0.5 m high, legs) seen from 1.6 m: the floor fills most of
-  // the frame. Then a low camera with a wall behind the table: the wall is the largest plane.
   facyl::TabletopSceneParameters small;
   small.table_width = {0.55f, 0.55f};
   small.table_depth = {0.45f, 0.45f};
   small.table_height = {0.5f, 0.5f};
   small.table_legs = true;
-  small.wall_share = 1.f;
+  small.wall_share = wall ? 1.f : small.wall_share;
   facyl::TabletopScene scene = emptyTable(small);
   scene.objects.push_back(can(0.035f, 0.12f, {-0.1f, 0.f, 0.f}));
   scene.objects.push_back(box({0.1f, 0.08f, 0.1f}, {0.1f, 0.05f, 0.f}, 0.4f));
   scene.objects.push_back(can(0.03f, 0.1f, {0.05f, -0.12f, 0.f}));
+  return scene;
+}
+
+} // namespace
+
+TEST(SupportPlanes, TheTableNotTheLargerFloorOrWall)
+{
+  // A small table (0.55 x 0.45 m, 0.5 m high, legs) seen from 1.6 m: the floor fills most of
+  // the frame. Then a low camera with a wall behind the table: the wall is the largest plane.
+  const facyl::TabletopScene scene = smallTableScene(true);
   const std::vector<std::pair<Eigen::Vector3f, const char*>> views{
     {{0.1f, -1.1f, 1.35f}, "floor bigger than the table"},
     {{0.f, -1.1f, 0.25f}, "a wall behind the table"}};
@@ -712,15 +725,7 @@ TEST(SupportPlanes, ASupportPriorKeepsItsPlaneTheTable)
   // it). With a support prior on the floor (a stream whose tracks stand on the floor; the
   // floor and the table are parallel, one family), the floor stays the table and the objects
   // are still found, on the table top. A default prior changes nothing.
-  facyl::TabletopSceneParameters small;
-  small.table_width = {0.55f, 0.55f};
-  small.table_depth = {0.45f, 0.45f};
-  small.table_height = {0.5f, 0.5f};
-  small.table_legs = true;
-  facyl::TabletopScene scene = emptyTable(small);
-  scene.objects.push_back(can(0.035f, 0.12f, {-0.1f, 0.f, 0.f}));
-  scene.objects.push_back(box({0.1f, 0.08f, 0.1f}, {0.1f, 0.05f, 0.f}, 0.4f));
-  scene.objects.push_back(can(0.03f, 0.1f, {0.05f, -0.12f, 0.f}));
+  const facyl::TabletopScene scene = smallTableScene(false);
   const facyl::RenderedScene s = render(scene, {0.1f, -1.1f, 1.35f}, {0.f, 0.f, 0.04f});
   Cloud::Ptr cloud(new Cloud(s.cloud));
   const Eigen::Vector3f n = s.table_plane.head<3>();

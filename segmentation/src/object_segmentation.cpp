@@ -200,14 +200,11 @@ components(const Grid& grid, Use use, std::vector<int>& label, int next)
   return next;
 }
 
-/** The squared difference of the colours of valid pixels \a a and \a b (8-bit levels). */
+/** The squared difference of the colours of valid pixels \a a and \a b (ColourImage::distance2). */
 float
 colourDifference2(const Grid& grid, const ColourImage& colour, int a, int b)
 {
-  const std::uint8_t* ca = colour.bgr + grid.pixel(a) * colour.stride;
-  const std::uint8_t* cb = colour.bgr + grid.pixel(b) * colour.stride;
-  const int d0 = ca[0] - cb[0], d1 = ca[1] - cb[1], d2 = ca[2] - cb[2];
-  return static_cast<float>(d0 * d0 + d1 * d1 + d2 * d2);
+  return static_cast<float>(colour.distance2(grid.pixel(a), grid.pixel(b)));
 }
 
 /** The pixels where colour edges cut objects apart that depth alone cannot tell (see
@@ -216,14 +213,14 @@ colourDifference2(const Grid& grid, const ColourImage& colour, int a, int b)
  * median of a sample: noise, texture, shading), one of them on a weak crease that continues
  * an edge (a depth discontinuity, a missing neighbour or a crease within kColourReach pixels:
  * noise alone makes weak creases everywhere on a far surface). Sets \a threshold2 to the
- * squared colour difference of an edge. Empty without \a colour. */
+ * squared colour difference of an edge. Empty without \a colour (nullptr: colour edges off). */
 std::vector<std::uint8_t>
 colourCuts(const Grid& grid, const ColourImage* colour, const std::vector<std::uint8_t>& weak,
            const std::vector<std::uint8_t>& crease, const ObjectSegmentationParameters& p,
            float& threshold2)
 {
   std::vector<std::uint8_t> cut;
-  if (!colour || !colour->bgr || !(p.colour_edge > 0.f))
+  if (!colour)
     return cut;
   const int n = static_cast<int>(grid.size());
   std::vector<float> sample;
@@ -332,10 +329,11 @@ segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float 
 {
   if (grid.size() == 0)
     return {};
-  const bool with_colour = colour && colour->bgr && p.colour_edge > 0.f;
+  if (!(colour && colour->bgr && p.colour_edge > 0.f))
+    colour = nullptr; // colour edges off
   std::vector<std::uint8_t> weak;
   const std::vector<std::uint8_t> crease =
-    creases(grid, focal, viewpoint, p, with_colour ? &weak : nullptr);
+    creases(grid, focal, viewpoint, p, colour ? &weak : nullptr);
   float threshold2 = 0.f;
   const std::vector<std::uint8_t> cut = colourCuts(grid, colour, weak, crease, p, threshold2);
   const auto apart = [&](int a) {

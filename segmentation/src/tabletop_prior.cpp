@@ -1,6 +1,7 @@
 /*
  * facyl: fast cylinder detection for PCL.
- * The support prior of a stream (SupportPrior, tabletop_steps.h): which plane of a frame is the
+ * The support prior of a stream (SupportPrior, segment_tabletop.h; the steps' functions in
+ * tabletop_steps.h): which plane of a frame is the
  * prior's, and the preference it gives its family and its plane over what the frame alone would
  * choose.
  */

@@ -62,11 +62,13 @@ struct ObjectSegmentationParameters {
 struct ColourImage {
   const std::uint8_t* bgr{nullptr};
   std::size_t stride{0};
-  Eigen::Vector3f at(std::size_t pixel) const
+  /** The squared difference of the colours of pixels \a p and \a q (8-bit levels). */
+  int distance2(std::size_t p, std::size_t q) const
   {
-    const std::uint8_t* c = bgr + pixel * stride;
-    return Eigen::Vector3f(static_cast<float>(c[2]), static_cast<float>(c[1]),
-                           static_cast<float>(c[0]));
+    const std::uint8_t* a = bgr + p * stride;
+    const std::uint8_t* b = bgr + q * stride;
+    const int d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
   }
 };
 

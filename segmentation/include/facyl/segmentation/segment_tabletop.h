@@ -244,20 +244,15 @@ pointFrame(const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
   f.indices = indices;
   f.viewpoint = cloud.sensor_origin_.template head<3>();
   f.header = cloud.header;
-  if constexpr (pcl::traits::has_field<PointT, pcl::fields::rgba>::value) {
+  // The colours: PCL's rgba or rgb field (blue, green, red, alpha bytes).
+  using RgbField = std::conditional_t<pcl::traits::has_field<PointT, pcl::fields::rgba>::value,
+                                      pcl::fields::rgba, pcl::fields::rgb>;
+  if constexpr (pcl::traits::has_field<PointT, RgbField>::value)
     if (!cloud.empty()) {
       f.bgr = reinterpret_cast<const std::uint8_t*>(cloud.points.data()) +
-              pcl::traits::offset<PointT, pcl::fields::rgba>::value;
+              pcl::traits::offset<PointT, RgbField>::value;
       f.bgr_stride = sizeof(PointT);
     }
-  }
-  else if constexpr (pcl::traits::has_field<PointT, pcl::fields::rgb>::value) {
-    if (!cloud.empty()) {
-      f.bgr = reinterpret_cast<const std::uint8_t*>(cloud.points.data()) +
-              pcl::traits::offset<PointT, pcl::fields::rgb>::value;
-      f.bgr_stride = sizeof(PointT);
-    }
-  }
   if constexpr (pcl::traits::offset<PointT, pcl::fields::x>::value == 0 &&
                 pcl::traits::offset<PointT, pcl::fields::y>::value == 4 &&
                 pcl::traits::offset<PointT, pcl::fields::z>::value == 8 &&
