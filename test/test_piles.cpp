@@ -252,6 +252,40 @@ TEST(TouchingObjects, ColourEdgesSplitWhatDepthJoins)
   }
 }
 
+TEST(TouchingObjects, ColourEdgesOnTheLattice)
+{
+  // A 1280 x 720 frame segmented on its lattice (lattice_width 640: every second pixel and
+  // row) has the colour edges too: the lattice carries the colours of its pixels. Cluttered
+  // simulated scenes at 1280 x 720, colour edges off and at their default.
+  std::size_t recovered[2] = {0, 0}, merged[2] = {0, 0}, n = 0;
+  for (std::uint64_t seed = 2000; seed < 2016; ++seed) {
+    facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+    p.seed = seed;
+    ASSERT_TRUE(facyl::parseSensorPreset("kinect", p.sensor, p.camera));
+    auto& c = p.camera; // the VGA camera at twice the pixels in width, 1.5 times in height
+    c.fx *= 2.f, c.fy *= 1.5f;
+    c.cx = (c.cx + 0.5f) * 2.f - 0.5f, c.cy = (c.cy + 0.5f) * 1.5f - 0.5f;
+    c.width = 1280, c.height = 720;
+    const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+    for (const int with : {0, 1}) {
+      facyl::TabletopSegmentationParameters params;
+      params.lattice_width = 640;
+      if (!with)
+        params.objects.colour_edge = 0.f;
+      for (const auto& o : segmentAndScore(s, params)) {
+        recovered[with] += o.recovered;
+        merged[with] += o.merged;
+        n += with;
+      }
+    }
+  }
+  std::printf("[ figures ] lattice, %zu objects: recovered %zu -> %zu, merged %zu -> %zu "
+              "(colour edges off -> on)\n",
+              n, recovered[0], recovered[1], merged[0], merged[1]);
+  EXPECT_GT(recovered[1], recovered[0]);
+  EXPECT_LT(merged[1], merged[0]);
+}
+
 TEST(TouchingObjects, AStripedCanIsOneObject)
 {
   // Stripes and checkers of strongly different colours on a smooth surface lie on no crease:

@@ -78,10 +78,12 @@ struct TabulatedBand {
 };
 
 /** Every \a step-th pixel of every \a step-th row of the image \a full, starting with the
- * first (as latticeOf), as a frame over \a buffer (four floats a point). */
+ * first (as latticeOf), as a frame over \a buffer (four floats a point) and, when \a full has
+ * colours, \a colours (three bytes a point: the colour edges of the object segmentation). */
 PointFrame
 latticeFrame(const PointFrame& full, int step,
-             std::vector<float, detail::UninitialisedAllocator<float>>& buffer)
+             std::vector<float, detail::UninitialisedAllocator<float>>& buffer,
+             std::vector<std::uint8_t, detail::UninitialisedAllocator<std::uint8_t>>& colours)
 {
   const auto w = static_cast<std::size_t>(full.width), h = static_cast<std::size_t>(full.height);
   const auto s = static_cast<std::size_t>(step);
@@ -97,6 +99,20 @@ latticeFrame(const PointFrame& full, int step,
       q[0] = p[0], q[1] = p[1], q[2] = p[2], q[3] = 1.f;
     }
   PointFrame lattice;
+  if (full.bgr) {
+    if (colours.size() < 3 * lw * lh) {
+      colours.clear();
+      colours.resize(3 * lw * lh);
+    }
+    for (std::size_t v = 0; v < lh; ++v)
+      for (std::size_t u = 0; u < lw; ++u) {
+        const std::uint8_t* c = full.bgr + (v * s * w + u * s) * full.bgr_stride;
+        std::uint8_t* d = colours.data() + 3 * (v * lw + u);
+        d[0] = c[0], d[1] = c[1], d[2] = c[2];
+      }
+    lattice.bgr = colours.data();
+    lattice.bgr_stride = 3;
+  }
   lattice.xyz = buffer.data();
   lattice.stride = 4;
   lattice.size = lw * lh;
@@ -220,7 +236,8 @@ segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace)
   const auto ms = [](Clock::time_point a) {
     return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
   };
-  const PointFrame lattice = latticeFrame(setup.frame, step, workspace.lattice);
+  const PointFrame lattice =
+    latticeFrame(setup.frame, step, workspace.lattice, workspace.lattice_colours);
   const TabletopSegmentationParameters params = latticeParameters(setup.params, step);
   const PinholeCamera camera = latticeCamera(setup.camera, step, lattice.width, lattice.height);
   const double t_lattice = ms(t0);

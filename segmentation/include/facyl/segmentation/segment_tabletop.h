@@ -322,6 +322,8 @@ struct TabletopWorkspace {
   pcl::PointCloud<pcl::Label> labels;
   /** The points of the lattice (lattice_width), four floats each; left uninitialised. */
   std::vector<float, detail::UninitialisedAllocator<float>> lattice;
+  /** The colours of the lattice's points (blue, green, red bytes), when the frame has them. */
+  std::vector<std::uint8_t, detail::UninitialisedAllocator<std::uint8_t>> lattice_colours;
 };
 
 /** \brief The supports and objects of a frame. */
