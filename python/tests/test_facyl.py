@@ -3,6 +3,7 @@ built module, FACYL_FIT and FACYL_DETECT (the tools), FACYL_DATA (the repository
 FACYL_EXAMPLE (examples/python/fit_open3d.py), FACYL_REAL_DATA (../shared/data/real; the tests
 that use it skip without it)."""
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -303,6 +304,35 @@ def test_detect_on_a_rendered_frame():
     unorganized = facyl.detect(flat[keep], camera=scene["camera"], model="none")
     assert not unorganized["organized"]
     assert sum(o["is_cylinder"] for o in unorganized["objects"]) >= 3
+
+
+def test_detect_reports_the_decisions_inputs():
+    """Each object carries what the decision is made from: "features" (evidenceFeatures, what
+    p_cylinder is computed from; fit_evidence.py fits on them) and "passes_gates" (passesGates
+    under the recognizer's decision), so that no script restates either."""
+    scene = facyl.render_tabletop_scene(seed=20, layout="cluttered")
+    out = facyl.detect(scene["points"], scene["colors"])
+    fitted = [o for o in out["objects"] if o["cylinder"] is not None]
+    assert fitted
+    for o in out["objects"]:
+        if o["cylinder"] is None:
+            assert o["features"] is None and o["passes_gates"] is False
+            continue
+        f = o["features"]
+        assert len(f) == 15 and f[0] == 1.0 and all(math.isfinite(v) for v in f)
+        assert f[1] == pytest.approx(o["surface_ratio"], abs=1e-5)
+        assert f[2] == pytest.approx(o["inlier_ratio"], abs=1e-5)
+        assert f[4] == pytest.approx(o["angular_coverage"], abs=1e-5)
+        p = min(max(o["p_network"], 1e-4), 1 - 1e-4)  # the last: the network's logit
+        assert f[14] == pytest.approx(math.log(p / (1 - p)), abs=1e-3)
+        if o["is_cylinder"]:
+            assert o["passes_gates"]
+    # The gates are the recognizer's own: a score gate at 1 lets only a whole surface through.
+    strict = facyl.detect(scene["points"], scene["colors"], min_score=1.0)
+    for o in strict["objects"]:
+        assert not o["passes_gates"] or o["surface_ratio"] >= 1.0
+    count = lambda r: sum(o["passes_gates"] for o in r["objects"])
+    assert count(strict) < count(out)
 
 
 @pytest.mark.skipif(not FACYL_DETECT or not DATA, reason="FACYL_DETECT / FACYL_DATA not given")

@@ -74,23 +74,15 @@ def training_label(kind):
 # --------------------------------------------------------------------------- features
 
 def features_of(obj):
-    """evidenceFeatures (without the network's logit) from a detect() object, as C++ makes
-    them (cylinder_evidence.cpp); None when the object was not fitted."""
-    if obj.get("cylinder") is None:
+    """The object's evidenceFeatures as the recognizer computed them (detect()'s "features":
+    C++ makes them, cylinder_evidence.cpp); None when the object was not fitted."""
+    f = obj.get("features")
+    if f is None:
         return None
-
-    def known(k, fallback):
-        v = obj.get(k)
-        return fallback if v is None or not math.isfinite(v) else float(v)
-
-    clamp = lambda v, lo, hi: min(max(v, lo), hi)
-    return [1.0, known("surface_ratio", 0.0), known("inlier_ratio", 0.0),
-            known("curvature_ratio", 1.0), known("angular_coverage", 0.0),
-            clamp(known("taper", 0.0), 0.0, 1.0), known("arc_gap", 0.0),
-            clamp(known("normal_agreement", 4.0), 0.0, 4.0), known("normal_concentration", 1.0),
-            clamp(known("profile_range", 0.0), 0.0, 1.0), clamp(known("axis_bend", 0.0), 0.0, 1.0),
-            known("inner_share", 0.0), known("outside_share", 0.0),
-            known("inner_share", 0.0) * clamp(1.0 - known("aspect", 1.0), 0.0, 1.0), 0.0]
+    if len(f) != FEATURES:
+        sys.exit("fit_evidence: the recognizer gives %d evidence features, this script expects %d "
+                 "(facyl::kEvidenceFeatures)" % (len(f), FEATURES))
+    return [float("nan") if v is None else float(v) for v in f]
 
 
 def logit(p):
@@ -98,21 +90,6 @@ def logit(p):
         return 0.0
     p = min(max(p, 1e-4), 1 - 1e-4)
     return math.log(p / (1 - p))
-
-
-def passes_gates(obj, gates):
-    """passesGates of facyl's default CylinderDecision (surface ratio as the score)."""
-    if obj.get("cylinder") is None:
-        return False
-    v = lambda k: obj.get(k)
-    bad = lambda x, limit: x is not None and math.isfinite(x) and x > limit
-    return (v("surface_ratio") >= gates["min_score"] and not bad(v("curvature_ratio"), gates["max_curvature_ratio"])
-            and v("angular_coverage") >= gates["min_angular_coverage"]
-            and not bad(v("arc_gap"), gates["max_arc_gap"]) and not bad(v("taper"), gates["max_taper"]))
-
-
-GATES = {"min_score": 0.25, "max_curvature_ratio": 0.35, "min_angular_coverage": 0.2,
-         "max_arc_gap": 0.1, "max_taper": 0.15}
 
 
 # --------------------------------------------------------------------------- sources
@@ -242,7 +219,7 @@ def prepare(row):
     o = row["obj"]
     row["x"] = features_of(o)
     row["p_network"] = o.get("p_network") if o.get("p_network") is not None else float("nan")
-    row["gates"] = passes_gates(o, GATES)
+    row["gates"] = bool(o.get("passes_gates"))  # passesGates under the recognizer's decision
     return row
 
 

@@ -8,6 +8,7 @@
 #include <facyl/tools/cylinder_json.h>
 #include <facyl/tools/json_writer.h>
 
+#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
 #include <algorithm>
@@ -18,10 +19,12 @@
 namespace facyl_cli {
 
 /** One object: id, support (index into "supports"; -1: none under it), centroid, n_points,
- * bbox (pixels; null without), the decision's evidence and "cylinder" (cylinderObject, null
- * when not fitted). */
+ * bbox (pixels; null without), the decision's evidence, "passes_gates" (facyl::passesGates
+ * under \a decision), "features" (facyl::evidenceFeatures: what p_cylinder is computed from;
+ * null when not fitted) and "cylinder" (cylinderObject, null when not fitted). */
 inline Json
-objectJson(std::size_t id, const facyl::RecognizedObject& o, int digits = 6)
+objectJson(std::size_t id, const facyl::RecognizedObject& o, const facyl::CylinderDecision& decision,
+           int digits = 6)
 {
   const auto& b = o.cluster.box;
   const auto& e = o.evidence;
@@ -47,6 +50,14 @@ objectJson(std::size_t id, const facyl::RecognizedObject& o, int digits = 6)
   j["inner_share"] = num(e.shape.inner_share);
   j["outside_share"] = num(e.shape.outside_share);
   j["aspect"] = num(e.shape.aspect);
+  j["passes_gates"] = facyl::passesGates(e, decision);
+  if (e.fitted) {
+    j["features"] = Json::array();
+    for (const float f : facyl::evidenceFeatures(e.p_network, e))
+      j["features"].push_back(num(f));
+  }
+  else
+    j["features"] = nullptr;
   j["is_cylinder"] = o.is_cylinder;
   j["cylinder"] = e.fitted ? cylinderObject(o.cylinder, false, digits) : Json(nullptr);
   return j;
@@ -92,7 +103,7 @@ sceneJson(const std::string& file, const pcl::PointCloud<PointT>& cloud,
   }
   j["objects"] = Json::array();
   for (std::size_t k = 0; k < objects.size(); ++k)
-    j["objects"].push_back(objectJson(k, objects[k], digits));
+    j["objects"].push_back(objectJson(k, objects[k], rec.getParameters().decision, digits));
   j["timing_ms"]["segmentation"] = jsonNumber(t.segmentation, digits);
   j["timing_ms"]["segmentation_planes"] = jsonNumber(t.segmentation_steps.planes, digits);
   j["timing_ms"]["segmentation_points"] = jsonNumber(t.segmentation_steps.points, digits);
