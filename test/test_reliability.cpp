@@ -73,7 +73,8 @@ fingerprint(const std::vector<facyl::RecognizedObject>& objects)
 {
   std::string s;
   for (std::size_t k = 0; k < objects.size(); ++k)
-    s += facyl_cli::dumpJson(facyl_cli::objectJson(k, objects[k], facyl::CylinderDecision{})) + "\n";
+    s +=
+      facyl_cli::dumpJson(facyl_cli::objectJson(k, objects[k], facyl::CylinderDecision{})) + "\n";
   return s;
 }
 

@@ -23,8 +23,8 @@ namespace facyl_cli {
  * under \a decision), "features" (facyl::evidenceFeatures: what p_cylinder is computed from;
  * null when not fitted) and "cylinder" (cylinderObject, null when not fitted). */
 inline Json
-objectJson(std::size_t id, const facyl::RecognizedObject& o, const facyl::CylinderDecision& decision,
-           int digits = 6)
+objectJson(std::size_t id, const facyl::RecognizedObject& o,
+           const facyl::CylinderDecision& decision, int digits = 6)
 {
   const auto& b = o.cluster.box;
   const auto& e = o.evidence;
