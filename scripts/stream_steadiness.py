@@ -14,6 +14,7 @@ Reads the JSON lines of one stream (in order) and prints, for the steps from one
 - tracks carried: for each step, the share of the track ids that a frame's objects carry that the
   next frame's objects carry too, and its mean over the steps (steps from a frame without objects
   are left out);
+- found flips: steps where "table" "found" (an object stands on a support) changes;
 - objects per frame (min, median, max), frames with an error and new scenes.
 --json prints the same as one JSON object.
 """
@@ -52,6 +53,8 @@ def steadiness(frames):
     switches = [
         k for k in range(1, len(frames)) if not same_plane(table_plane(frames[k - 1]), table_plane(frames[k]))
     ]
+    found = [bool((f.get("table") or {}).get("found")) for f in frames]
+    flips = [k for k in range(1, len(frames)) if found[k] != found[k - 1]]
     carried = []
     for a, b in zip(frames, frames[1:]):
         ids = track_ids(a)
@@ -63,6 +66,8 @@ def steadiness(frames):
         "steps": max(0, len(frames) - 1),
         "table_switches": len(switches),
         "switch_frames": [os.path.basename(frames[k].get("file", str(k))) for k in switches],
+        "found_flips": len(flips),
+        "found_flip_frames": [os.path.basename(frames[k].get("file", str(k))) for k in flips],
         "tracks_carried": statistics.mean(carried) if carried else float("nan"),
         "tracks_carried_min": min(carried) if carried else float("nan"),
         "objects_min": min(counts) if counts else 0,
@@ -84,6 +89,8 @@ def main(argv):
         return
     print(f"table switches: {s['table_switches']} in {s['steps']} steps"
           + (f" (at {', '.join(s['switch_frames'])})" if s["switch_frames"] else ""))
+    print(f"table found flips: {s['found_flips']}"
+          + (f" (at {', '.join(s['found_flip_frames'])})" if s["found_flip_frames"] else ""))
     print(f"tracks carried into the next frame: mean {s['tracks_carried']:.3f}, "
           f"lowest {s['tracks_carried_min']:.3f}")
     print(f"objects per frame: min {s['objects_min']}, median {s['objects_median']}, "

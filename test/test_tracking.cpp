@@ -4,6 +4,7 @@
  */
 #include <facyl/tools/frame_stream.h>
 
+#include <facyl/features/polygon.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 #include <facyl/segmentation/tabletop_geometry.h>
 #include <facyl/simulation/random.h>
@@ -963,6 +964,41 @@ TEST(CylinderTracker, AWallForOneFrameDoesNotReplaceTheTable)
     EXPECT_TRUE(facyl::consistentWithPrior(prior, table.supports(k + 1)[0].plane)) << k;
   }
   EXPECT_EQ(ids.size(), table.items.size());
+}
+
+TEST(CylinderTracker, ThePriorCarriesTheTablesExtentSeen)
+{
+  // Each frame sees a 0.4 m square of the table around a point that moves from frame to frame:
+  // the prior handed on carries the hull of what the last frames saw, on the table's plane, so
+  // a frame that sees less of the table (a dark top) keeps the objects over the rest of it.
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  float first_area = 0.f;
+  for (int k = 0; k < 8; ++k) {
+    auto supports = table.supports(k);
+    supports[0].polygon = {{-0.2f, -0.2f}, {0.2f, -0.2f}, {0.2f, 0.2f}, {-0.2f, 0.2f}};
+    tracker.update(supports, 0, table.objects(k));
+    ASSERT_TRUE(tracker.getFrameInfo().anchored) << k;
+    const facyl::SupportPrior prior = tracker.supportPrior();
+    ASSERT_TRUE(prior.valid()) << k;
+    ASSERT_GE(prior.extent.size(), 4u) << k;
+    // On the prior's plane; its area, in the next frame's plane coordinates.
+    const auto next = table.supports(k + 1)[0];
+    std::vector<Eigen::Vector2f> flat;
+    for (const auto& e : prior.extent) {
+      EXPECT_NEAR(prior.plane.head<3>().dot(e) + prior.plane[3], 0.f, 1e-3f) << k;
+      flat.push_back((next.frame.inverse() * e).head<2>());
+    }
+    const float area = facyl::polygonArea(facyl::convexHull2D(flat));
+    if (k == 0) {
+      first_area = area;
+      EXPECT_NEAR(area, 0.16f, 0.01f);
+    }
+    else
+      EXPECT_GE(area, first_area - 0.01f) << k; // the union of the squares seen
+  }
+  tracker.reset();
+  EXPECT_TRUE(tracker.supportPrior().extent.empty());
 }
 
 TEST(CylinderTracker, OneFrameMissKeepsTheTrack)

@@ -7,6 +7,8 @@
  */
 #include "tabletop_steps.h"
 
+#include <facyl/features/polygon.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -18,6 +20,8 @@ SupportPrior::transformed(const Eigen::Affine3f& t) const
   SupportPrior out = *this;
   out.plane = transformPlane(plane, t);
   out.centre = t * centre;
+  for (auto& e : out.extent)
+    e = t * e;
   return out;
 }
 
@@ -29,6 +33,20 @@ consistentWithPrior(const SupportPrior& prior, const Eigen::Vector4f& plane)
   const float cos_angle = prior.plane.head<3>().dot(plane.head<3>().normalized());
   return cos_angle >= std::cos(prior.max_angle) &&
          std::abs(plane.head<3>().dot(prior.centre) + plane[3]) <= prior.max_offset;
+}
+
+std::vector<Eigen::Vector2f>
+priorExtentHull(const SupportPrior& prior, const Eigen::Vector4f& plane,
+                const Eigen::Affine3f& plane_to_frame, const std::vector<Eigen::Vector2f>& polygon)
+{
+  if (prior.extent.empty() || !consistentWithPrior(prior, plane))
+    return polygon;
+  const Eigen::Affine3f to_plane = plane_to_frame.inverse();
+  std::vector<Eigen::Vector2f> points = polygon;
+  for (const auto& e : prior.extent)
+    if (e.allFinite())
+      points.push_back((to_plane * e).head<2>());
+  return convexHull2D(std::move(points));
 }
 
 namespace tabletop {

@@ -101,10 +101,12 @@ supportHull(const Setup& setup, const Eigen::Affine3f& frame, const pcl::Indices
   return convexHull2D(std::move(points));
 }
 
-/** The support of a cluster (points \a pts) among \a supports, with \a extents the hulls of
- * all of their points. */
+/** The support of a cluster (points \a pts) among \a supports, with \a regions the hulls
+ * objects are placed over (their polygons; the stream's table's with its prior extent) and
+ * \a extents the hulls of all of their points. */
 Placement
 place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<SupportPlane>& supports,
+      const std::vector<std::vector<Eigen::Vector2f>>& regions,
       const std::vector<std::vector<Eigen::Vector2f>>& extents)
 {
   const auto& p = setup.params;
@@ -117,8 +119,7 @@ place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<Support
     const Eigen::Affine3f to_plane = supports[s].frame.inverse();
     std::size_t in_hull = 0;
     for (Eigen::Index k = 0; k < pts.cols(); ++k)
-      in_hull +=
-        pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).head<2>(), supports[s].polygon);
+      in_hull += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).head<2>(), regions[s]);
     const float over = static_cast<float>(in_hull) / static_cast<float>(pts.cols());
     // The nearest support under the cluster: most of it in its band and over its hull (the
     // prism test of pcl::ExtractPolygonalPrismData, per cluster).
@@ -152,12 +153,14 @@ place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<Support
   return out;
 }
 
-/** Each cluster (\a groups) to the support under it (\a supports, \a extents: see place); the
- * table; the supports that hold objects and the table moved into \a trial. \a scale: the
- * points each point of \a groups stands for (coarse trials, which keep no clusters). */
+/** Each cluster (\a groups) to the support under it (\a supports, \a regions, \a extents: see
+ * place); the table; the supports that hold objects and the table moved into \a trial.
+ * \a scale: the points each point of \a groups stands for (coarse trials, which keep no
+ * clusters). */
 void
 assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
                std::vector<SupportPlane>& supports,
+               const std::vector<std::vector<Eigen::Vector2f>>& regions,
                const std::vector<std::vector<Eigen::Vector2f>>& extents, Trial& trial,
                std::size_t scale)
 {
@@ -170,7 +173,7 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
     Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>((group.size() + stride - 1) / stride));
     for (std::size_t k = 0, c = 0; k < group.size(); k += stride, ++c)
       pts.col(static_cast<Eigen::Index>(c)) = setup.frame.point(static_cast<std::size_t>(group[k]));
-    const Placement pl = place(setup, pts, supports, extents);
+    const Placement pl = place(setup, pts, supports, regions, extents);
     if (pl.support < 0)
       continue;
     SupportPlane& support = supports[static_cast<std::size_t>(pl.support)];
@@ -514,6 +517,7 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   auto& all = sorted.all;
   std::vector<SupportPlane> supports;
   std::vector<std::vector<Eigen::Vector2f>> extents; ///< hulls of all the supports' points
+  std::vector<std::vector<Eigen::Vector2f>> regions; ///< hulls objects are placed over
   std::uint8_t kept = 0;
   judgeElevated(setup, sorted, family);
   for (const std::size_t s : family) {
@@ -545,6 +549,11 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
                             : hull >= p.min_support_area && region >= 0.25f * p.min_support_area;
     if (support.polygon.size() < 3 || !(largest || large))
       continue;
+    // The hull objects are placed over: the stream's table adds what the last frames saw of
+    // it (its own polygon stays the frame's).
+    regions.push_back(
+      setup.prior ? priorExtentHull(*setup.prior, support.plane, support.frame, support.polygon)
+                  : support.polygon);
     kept |= static_cast<std::uint8_t>(1u << s);
     if (hulls.extent.empty())
       hulls.extent = supportHull(setup, support.frame, all[s].inliers.indices, nullptr);
@@ -567,7 +576,7 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   std::vector<pcl::Indices> groups = stride == 1
                                        ? cluster(setup, cues, band, workspace)
                                        : clusterCoarse(setup, cues, band, stride, workspace);
-  assignClusters(setup, groups, supports, extents, trial,
+  assignClusters(setup, groups, supports, regions, extents, trial,
                  static_cast<std::size_t>(stride * stride));
   PCL_DEBUG("[facyl::TabletopSegmentation] stride %d: %zu supports, %zu object points, %zu "
             "groups, %zu clusters, %zu standing\n",

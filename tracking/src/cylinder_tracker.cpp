@@ -5,6 +5,8 @@
 #include <facyl/tracking/impl/cylinder_tracker.hpp>
 #include <facyl/tracking/tracker_steps.h>
 
+#include <facyl/features/polygon.h>
+
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -233,6 +235,7 @@ CylinderTracker::reset()
   prior_unseen_ = prior_challenged_ = 0;
   plane_angle_innovations_.clear();
   plane_offset_innovations_.clear();
+  seen_extents_.clear();
   frame_to_world_ = Eigen::Affine3f::Identity();
 }
 
@@ -317,7 +320,25 @@ CylinderTracker::expectedPlane(const Eigen::Affine3f& cloud_to_world) const
   prior.centre = seen - normal * (normal.dot(seen) + prior.plane[3]);
   prior.max_angle = predictionTolerance(plane_angle_innovations_, params_.max_plane_angle);
   prior.max_offset = predictionTolerance(plane_offset_innovations_, params_.max_plane_offset);
+  // What the last frames saw of it: the corners of the hull of their regions' hulls.
+  std::vector<Eigen::Vector2f> corners;
+  for (const auto& e : seen_extents_)
+    corners.insert(corners.end(), e.begin(), e.end());
+  for (const auto& c : convexHull2D(std::move(corners)))
+    prior.extent.push_back(world_to_cloud * Eigen::Vector3f(c.x(), c.y(), 0.f));
   return prior;
+}
+
+void
+CylinderTracker::recordExtent(const SupportPlane& anchor, const Eigen::Affine3f& cloud_to_world)
+{
+  const Eigen::Affine3f to_world = cloud_to_world * anchor.frame;
+  std::vector<Eigen::Vector2f> hull;
+  for (const auto& v : anchor.polygon)
+    hull.push_back((to_world * Eigen::Vector3f(v.x(), v.y(), 0.f)).head<2>());
+  seen_extents_.push_back(std::move(hull));
+  if (seen_extents_.size() > static_cast<std::size_t>(params_.history))
+    seen_extents_.erase(seen_extents_.begin(), seen_extents_.end() - params_.history);
 }
 
 SupportPrior
@@ -410,6 +431,11 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
   else if (!has_pose_)
     world_on_support_ = false; // the world is this cloud's frame until a support is seen
   if (choice.anchor >= 0) {
+    // The world's plane is the anchor's from now on: another plane, or the same one started
+    // anew, forgets the extent seen.
+    if (!continuing || new_scene || choice.plane_jump)
+      seen_extents_.clear();
+    recordExtent(supports[static_cast<std::size_t>(choice.anchor)], pose);
     anchor_centre_ = pose * supports[static_cast<std::size_t>(choice.anchor)].frame.translation();
     // Held from the first anchored frame on; after a release, from the frame after the next.
     prior_held_ = prior_held_ || !was_held;

@@ -135,6 +135,12 @@ struct SupportPrior {
   float max_angle{0.f};
   /** m, >= 0: how far the predicted plane may be off along its normal at the centre. */
   float max_offset{0.f};
+  /** Points of the support's extent as the last frames saw it (the corners of their regions'
+   * hulls, on the plane, in the frame of the points segmented); empty: none. A support that is
+   * the prior's plane holds the objects over them too (priorExtentHull): a frame that sees less
+   * of a table (a dark or glossy top, a view that cuts it) keeps the objects the stream saw on
+   * it. */
+  std::vector<Eigen::Vector3f> extent;
 
   /** \brief True when the prior holds a plane and a usable angle (else it is ignored). */
   bool valid() const
@@ -143,7 +149,7 @@ struct SupportPrior {
            std::abs(plane.head<3>().norm() - 1.f) < 1e-3f && max_angle > 0.f &&
            max_angle <= 1.5708f && max_offset >= 0.f && std::isfinite(max_offset);
   }
-  /** \brief \a prior moved by the rigid transform \a t (its plane and centre). */
+  /** \brief \a prior moved by the rigid transform \a t (its plane, centre and extent). */
   SupportPrior transformed(const Eigen::Affine3f& t) const;
 };
 
@@ -151,6 +157,15 @@ struct SupportPrior {
  * (see SupportPrior): its normal within max_angle of the prior's, its height at the prior's
  * centre within max_offset. */
 bool consistentWithPrior(const SupportPrior& prior, const Eigen::Vector4f& plane);
+
+/** \brief The convex hull of \a polygon (a support's region hull, in the coordinates of its
+ * plane's frame \a plane_to_frame) and of \a prior's extent projected on that plane: the
+ * support's hull when it is \a prior's plane (consistentWithPrior of \a plane), else
+ * \a polygon unchanged. */
+std::vector<Eigen::Vector2f> priorExtentHull(const SupportPrior& prior,
+                                             const Eigen::Vector4f& plane,
+                                             const Eigen::Affine3f& plane_to_frame,
+                                             const std::vector<Eigen::Vector2f>& polygon);
 
 /** \brief What a segmentation made of its SupportPrior. */
 struct SupportPriorResult {

@@ -444,6 +444,9 @@ private:
   /** The prediction's error for a frame anchored on the tracks' plane: the \a expected plane
    * (expectedPlane) against the anchor's measured \a plane. */
   void recordPlaneInnovation(const SupportPrior& expected, const Eigen::Vector4f& plane);
+  /** The region hull of the frame's \a anchor (on the tracks' plane) in the world, the frame at
+   * \a cloud_to_world: one more of the extents seen (seen_extents_). */
+  void recordExtent(const SupportPlane& anchor, const Eigen::Affine3f& cloud_to_world);
   /** The frame, anchored on the support at \a plane_to_cloud that continues the tracks' plane,
    * registered against the tracks (\a pose: cloud to world). \return true when it starts a
    * new scene (the tracks ended, \a pose the support's plane). */
@@ -497,6 +500,9 @@ private:
    * predicted and measured normal, and its measured height over the predicted plane (m): the
    * support prior's tolerances (predictionTolerance). */
   std::vector<float> plane_angle_innovations_, plane_offset_innovations_;
+  /** Of the last frames (history) anchored on the tracks' plane: the hull of its region (the
+   * anchor's polygon), in the world's plane (x, y): the support prior's extent. */
+  std::vector<std::vector<Eigen::Vector2f>> seen_extents_;
   int next_id_{0};
 };
 
