@@ -1001,6 +1001,42 @@ TEST(CylinderTracker, ThePriorCarriesTheTablesExtentSeen)
   EXPECT_TRUE(tracker.supportPrior().extent.empty());
 }
 
+TEST(CylinderTracker, AnotherSupportOfTheRoomKeepsTheTracks)
+{
+  // From frame 6 on the frames find only a lower table beside the tracks' one (parallel, 0.25
+  // m below: the counter's top without depth, the wooden table in front), while the objects
+  // on the tracks' table stay in view. After support_switch_frames frames the lower table
+  // becomes the world's plane: the tracks move into its frame where the camera's pose puts
+  // them, match their objects again, and keep their ids (no new scene).
+  SyntheticTable table;
+  facyl::CylinderTracker tracker;
+  std::set<int> ids;
+  const int hold = facyl::CylinderTrackerParameters{}.support_switch_frames;
+  for (int k = 0; k < 12; ++k) {
+    auto supports = table.supports(k);
+    if (k >= 6) {
+      const Eigen::Affine3f to_camera = table.camera(k).inverse();
+      const Eigen::Vector3f n = to_camera.linear() * Eigen::Vector3f::UnitZ();
+      const Eigen::Vector3f at = to_camera * Eigen::Vector3f(0.3f, -0.4f, -0.25f);
+      supports[0].plane = Eigen::Vector4f(n.x(), n.y(), n.z(), -n.dot(at));
+      supports[0].frame = facyl::planeFrame(supports[0].plane, at);
+    }
+    tracker.update(supports, 0, table.objects(k));
+    const auto& info = tracker.getFrameInfo();
+    EXPECT_FALSE(info.new_scene) << "frame " << k;
+    EXPECT_EQ(info.scene, 0u) << "frame " << k;
+    EXPECT_EQ(info.anchored, k < 6 || k >= 6 + hold - 1) << "frame " << k;
+    for (const auto& t : tracker.getTracks()) {
+      if (k == 5)
+        ids.insert(t.id);
+      else if (k > 5) {
+        EXPECT_EQ(ids.count(t.id), 1u) << "frame " << k << ", track " << t.id;
+      }
+    }
+  }
+  EXPECT_EQ(ids.size(), table.items.size());
+}
+
 TEST(CylinderTracker, OneFrameMissKeepsTheTrack)
 {
   SyntheticTable table;

@@ -440,7 +440,8 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
     // Held from the first anchored frame on; after a release, from the frame after the next.
     prior_held_ = prior_held_ || !was_held;
   }
-  has_velocity_ = has_pose_ && info.anchored && last_anchored && !new_scene;
+  // (After a plane jump the last pose is in the old plane's world.)
+  has_velocity_ = has_pose_ && info.anchored && last_anchored && !new_scene && !choice.plane_jump;
   previous_frame_to_world_ = last_pose;
   frame_to_world_ = pose;
   has_pose_ = true;
@@ -459,10 +460,37 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
   std::vector<TrackObservation> local(objects.size());
   for (std::size_t i = 0; i < objects.size(); ++i)
     local[i] = observe(objects[i], cloud_to_plane, params_.decision_probability);
-  const PlanarRigid prior = inPlaneComponent(predicted * plane_to_cloud);
-  const PlanarRigid still = inPlaneComponent(last_pose * plane_to_cloud);
-  const PlanarRegistration reg = registerObservations(local, tracks_, prior, params_.registration,
-                                                      has_velocity_ ? &still : nullptr);
+  Eigen::Affine3f to_plane_world = Eigen::Affine3f::Identity();
+  // The tracks' plane where the predicted pose puts it, against the frame's support.
+  const Eigen::Vector3f old_up = predicted.inverse().linear() * Eigen::Vector3f::UnitZ();
+  const float tilt =
+    std::acos(std::min(1.f, std::abs(old_up.normalized().dot(plane_to_cloud.linear().col(2)))));
+  const bool parallel = tilt <= params_.max_plane_angle;
+  if (plane_jump && parallel) {
+    // Another support of the room (parallel to the tracks' plane as predicted) becomes the
+    // world's plane: the tracks move into its frame where the predicted pose puts them (their
+    // heights were over the old plane) and are registered from there. A plane that is not
+    // parallel leaves them where they were: only a registration by chance keeps the scene.
+    to_plane_world = cloud_to_plane * predicted.inverse();
+    for (auto& t : tracks_)
+      transformTrack(t, to_plane_world);
+  }
+  const Eigen::Affine3f to_world = to_plane_world * predicted, last = to_plane_world * last_pose;
+  const PlanarRigid prior = inPlaneComponent(to_world * plane_to_cloud);
+  const PlanarRigid still = inPlaneComponent(last * plane_to_cloud);
+  // Across a plane jump only the tracks of the old plane tell whether the scene goes on: those
+  // started in the frames without it (their pose predicted) would match their own objects.
+  const auto started_since = [&](const CylinderTrack& t) {
+    return t.age <= static_cast<std::size_t>(std::max(0, info.prior_unseen_frames));
+  };
+  std::vector<CylinderTrack> before;
+  if (plane_jump)
+    for (const auto& t : tracks_)
+      if (!started_since(t))
+        before.push_back(t);
+  const PlanarRegistration reg =
+    registerObservations(local, plane_jump ? before : tracks_, prior, params_.registration,
+                         has_velocity_ ? &still : nullptr);
   pose = reg.transform.asAffine() * cloud_to_plane;
   info.registration = reg.transform;
   info.registered = reg.matched_objects;
@@ -483,7 +511,18 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
   }
   if (!isNewScene(confirmed, expected, seen, reg.matched_objects, plane_jump, params_.min_overlap))
     return false;
+  // A new scene: the tracks of the old one end; those started in the frames without its plane
+  // are of the new one, and move into its frame where the predicted pose put them.
+  std::vector<CylinderTrack> young;
+  if (plane_jump)
+    for (auto& t : tracks_)
+      if (started_since(t)) {
+        if (!parallel)
+          transformTrack(t, cloud_to_plane * predicted.inverse());
+        young.push_back(std::move(t));
+      }
   endTracks();
+  tracks_ = std::move(young);
   ++info_.scene;
   pose = cloud_to_plane;
   return true;

@@ -227,6 +227,10 @@ transformTrack(CylinderTrack& t, const Eigen::Affine3f& m)
   t.centroid = m * t.centroid;
   t.centre = m * t.centre;
   t.axis = (m.linear() * t.axis).normalized();
+  for (auto& f : t.fits) { // the history too: later estimates are made from it
+    f.centre = m * f.centre;
+    f.axis = (m.linear() * f.axis).normalized();
+  }
   axisUp(t);
 }
 

@@ -97,8 +97,8 @@ TrackObservation observe(const RecognizedObject& r, const Eigen::Affine3f& cloud
 /** \brief What association compares of track \a t: its centroid and cylinder estimate. */
 AssociationGeometry associationGeometry(const CylinderTrack& t);
 
-/** \brief \a t moved by \a m (its centroid, centre and axis), its axis then turned up (world z:
- * the extent follows). */
+/** \brief \a t moved by \a m (its centroid, centre, axis and the fits of its history), its axis
+ * then turned up (world z: the extent follows). */
 void transformTrack(CylinderTrack& t, const Eigen::Affine3f& m);
 
 // ------------------------------------------------------------------------- association
