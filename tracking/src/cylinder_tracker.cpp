@@ -18,6 +18,14 @@ namespace facyl {
 
 namespace {
 
+/** True when \a rotation (the old world into the new plane's frame) keeps the old world's
+ * plane (z = 0) within \a max_angle of the new one. */
+bool
+parallelPlanes(const Eigen::Matrix3f& rotation, float max_angle)
+{
+  return std::acos(std::min(1.f, std::abs(rotation(2, 2)))) <= max_angle;
+}
+
 float
 square(float v)
 {
@@ -460,21 +468,17 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
   std::vector<TrackObservation> local(objects.size());
   for (std::size_t i = 0; i < objects.size(); ++i)
     local[i] = observe(objects[i], cloud_to_plane, params_.decision_probability);
-  Eigen::Affine3f to_plane_world = Eigen::Affine3f::Identity();
-  // The tracks' plane where the predicted pose puts it, against the frame's support.
-  const Eigen::Vector3f old_up = predicted.inverse().linear() * Eigen::Vector3f::UnitZ();
-  const float tilt =
-    std::acos(std::min(1.f, std::abs(old_up.normalized().dot(plane_to_cloud.linear().col(2)))));
-  const bool parallel = tilt <= params_.max_plane_angle;
-  if (plane_jump && parallel) {
-    // Another support of the room (parallel to the tracks' plane as predicted) becomes the
-    // world's plane: the tracks move into its frame where the predicted pose puts them (their
-    // heights were over the old plane) and are registered from there. A plane that is not
-    // parallel leaves them where they were: only a registration by chance keeps the scene.
-    to_plane_world = cloud_to_plane * predicted.inverse();
+  // On a jump, the old world (as the predicted pose puts it) into the new plane's frame.
+  const Eigen::Affine3f onto_new = cloud_to_plane * predicted.inverse();
+  // Another support of the room (parallel to the tracks' plane as predicted) becomes the
+  // world's plane: the tracks move into its frame (their heights were over the old plane) and
+  // are registered from there. A plane that is not parallel leaves them where they were: only
+  // a registration by chance keeps the scene.
+  const bool moved = plane_jump && parallelPlanes(onto_new.linear(), params_.max_plane_angle);
+  if (moved)
     for (auto& t : tracks_)
-      transformTrack(t, to_plane_world);
-  }
+      transformTrack(t, onto_new);
+  const Eigen::Affine3f to_plane_world = moved ? onto_new : Eigen::Affine3f::Identity();
   const Eigen::Affine3f to_world = to_plane_world * predicted, last = to_plane_world * last_pose;
   const PlanarRigid prior = inPlaneComponent(to_world * plane_to_cloud);
   const PlanarRigid still = inPlaneComponent(last * plane_to_cloud);
@@ -517,8 +521,8 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
   if (plane_jump)
     for (auto& t : tracks_)
       if (started_since(t)) {
-        if (!parallel)
-          transformTrack(t, cloud_to_plane * predicted.inverse());
+        if (!moved)
+          transformTrack(t, onto_new);
         young.push_back(std::move(t));
       }
   endTracks();
