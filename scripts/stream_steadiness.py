@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How steady facyl_detect --track is over a stream: switches of the table plane, tracks carried.
 
-usage: stream_steadiness.py [--json] TRACK.jsonl
+usage: stream_steadiness.py [--json] [--max-offset M] TRACK.jsonl
   e.g. build/apps/facyl_detect --track ../shared/data/real/rgbd/sevenscenes_stream/*.pcd > s.jsonl
        scripts/stream_steadiness.py s.jsonl
 Reads the JSON lines of one stream (in order) and prints, for the steps from one frame to the next:
@@ -16,7 +16,9 @@ Reads the JSON lines of one stream (in order) and prints, for the steps from one
   are left out);
 - found flips: steps where "table" "found" (an object stands on a support) changes;
 - objects per frame (min, median, max), frames with an error and new scenes.
---json prints the same as one JSON object.
+--json prints the same as one JSON object. --max-offset M: planes whose distances from the camera
+differ by more than M metres are two (default 0.1; 0.03 counts a jitter of a few centimetres,
+a counter against slabs lying on it, as a switch).
 """
 import json
 import math
@@ -38,20 +40,21 @@ def table_plane(frame):
     return c if c and len(c) == 4 else None
 
 
-def same_plane(a, b):
+def same_plane(a, b, max_offset=MAX_OFFSET):
     if a is None or b is None:
         return a is None and b is None
     dot = sum(x * y for x, y in zip(a[:3], b[:3]))
-    return math.acos(max(-1.0, min(1.0, dot))) <= MAX_ANGLE and abs(a[3] - b[3]) <= MAX_OFFSET
+    return math.acos(max(-1.0, min(1.0, dot))) <= MAX_ANGLE and abs(a[3] - b[3]) <= max_offset
 
 
 def track_ids(frame):
     return {o["track_id"] for o in frame.get("objects") or [] if o.get("track_id", -1) >= 0}
 
 
-def steadiness(frames):
+def steadiness(frames, max_offset=MAX_OFFSET):
     switches = [
-        k for k in range(1, len(frames)) if not same_plane(table_plane(frames[k - 1]), table_plane(frames[k]))
+        k for k in range(1, len(frames))
+        if not same_plane(table_plane(frames[k - 1]), table_plane(frames[k]), max_offset)
     ]
     found = [bool((f.get("table") or {}).get("found")) for f in frames]
     flips = [k for k in range(1, len(frames)) if found[k] != found[k - 1]]
@@ -80,10 +83,18 @@ def steadiness(frames):
 
 def main(argv):
     as_json = "--json" in argv
-    paths = [a for a in argv if a != "--json"]
+    argv = [a for a in argv if a != "--json"]
+    max_offset = MAX_OFFSET
+    if "--max-offset" in argv:
+        k = argv.index("--max-offset")
+        if k + 1 >= len(argv):
+            sys.exit(__doc__)
+        max_offset = float(argv[k + 1])
+        del argv[k:k + 2]
+    paths = argv
     if len(paths) != 1:
         sys.exit(__doc__)
-    s = steadiness(load(paths[0]))
+    s = steadiness(load(paths[0]), max_offset)
     if as_json:
         print(json.dumps(s))
         return

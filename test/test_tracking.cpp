@@ -449,6 +449,18 @@ TEST(TrackerSteps, ConsistentWithPriorWithinItsAngleAndOffset)
   no_angle.max_angle = 0.f;
   EXPECT_FALSE(no_angle.valid());
   EXPECT_FALSE(facyl::consistentWithPrior(no_angle, planeOf(Eigen::Affine3f::Identity())));
+  // priorMismatch: of the planes that are the prior's, the nearer has the less (a counter 3 cm
+  // off against slabs on it 6 cm off); beyond the tolerances, infinity.
+  const auto at = [&](float z) {
+    return facyl::priorMismatch(prior,
+                                planeOf(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, z))));
+  };
+  EXPECT_NEAR(at(0.03f), 0.03f / 0.15f, 1e-5f);
+  EXPECT_LT(at(0.03f), at(0.06f));
+  EXPECT_LT(at(-0.03f), at(0.06f));
+  EXPECT_NEAR(facyl::priorMismatch(prior, tilted), 0.3f / 0.35f, 1e-4f);
+  EXPECT_TRUE(std::isinf(at(0.16f)));
+  EXPECT_TRUE(std::isinf(facyl::priorMismatch(no_angle, planeOf(Eigen::Affine3f::Identity()))));
 }
 
 TEST(TrackerSteps, DecisionsHaveHysteresis)

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace facyl {
 
@@ -25,14 +26,25 @@ SupportPrior::transformed(const Eigen::Affine3f& t) const
   return out;
 }
 
+float
+priorMismatch(const SupportPrior& prior, const Eigen::Vector4f& plane)
+{
+  const float inf = std::numeric_limits<float>::infinity();
+  if (!prior.valid() || !plane.allFinite())
+    return inf;
+  const float cos_angle = prior.plane.head<3>().dot(plane.head<3>().normalized());
+  const float offset = std::abs(plane.head<3>().dot(prior.centre) + plane[3]);
+  if (!(cos_angle >= std::cos(prior.max_angle)) || !(offset <= prior.max_offset))
+    return inf;
+  const float angle = std::acos(std::min(1.f, cos_angle));
+  return std::max(angle / prior.max_angle,
+                  prior.max_offset > 0.f ? offset / prior.max_offset : 0.f);
+}
+
 bool
 consistentWithPrior(const SupportPrior& prior, const Eigen::Vector4f& plane)
 {
-  if (!prior.valid() || !plane.allFinite())
-    return false;
-  const float cos_angle = prior.plane.head<3>().dot(plane.head<3>().normalized());
-  return cos_angle >= std::cos(prior.max_angle) &&
-         std::abs(plane.head<3>().dot(prior.centre) + plane[3]) <= prior.max_offset;
+  return std::isfinite(priorMismatch(prior, plane));
 }
 
 std::vector<Eigen::Vector2f>
@@ -56,10 +68,15 @@ priorCandidate(const Setup& setup, const std::vector<Candidate>& candidates)
 {
   if (!setup.prior)
     return -1;
-  for (std::size_t k = 0; k < candidates.size(); ++k)
-    if (!candidates[k].points.empty() && consistentWithPrior(*setup.prior, candidates[k].plane))
-      return static_cast<int>(k);
-  return -1;
+  // Of several (a counter and the slabs lying on it), the nearest.
+  int best = -1;
+  float least = std::numeric_limits<float>::infinity();
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const float m = priorMismatch(*setup.prior, candidates[k].plane);
+    if (!candidates[k].points.empty() && m < least)
+      best = static_cast<int>(k), least = m;
+  }
+  return best;
 }
 
 void
@@ -119,11 +136,16 @@ tableWithPrior(const Setup& setup, const std::vector<SupportPlane>& supports, Tr
   trial.table_is_prior = false;
   if (!setup.prior)
     return table;
-  for (std::size_t s = 0; s < supports.size(); ++s)
-    if (consistentWithPrior(*setup.prior, supports[s].plane)) {
+  // Of several supports that are the prior's plane (a counter and the slabs lying on it), the
+  // nearest: the table does not jump between them from frame to frame.
+  float least = std::numeric_limits<float>::infinity();
+  for (std::size_t s = 0; s < supports.size(); ++s) {
+    const float m = priorMismatch(*setup.prior, supports[s].plane);
+    if (m < least) {
       trial.table_is_prior = true;
-      return s;
+      table = s, least = m;
     }
+  }
   return table;
 }
 

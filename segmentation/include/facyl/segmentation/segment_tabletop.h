@@ -158,6 +158,11 @@ struct SupportPrior {
  * centre within max_offset. */
 bool consistentWithPrior(const SupportPrior& prior, const Eigen::Vector4f& plane);
 
+/** \brief How far \a plane is from \a prior's: the larger of its normal's angle over max_angle
+ * and its height at the prior's centre over max_offset, in [0, 1] when consistentWithPrior,
+ * infinity when not. Of several planes that are the prior's, the nearest has the least. */
+float priorMismatch(const SupportPrior& prior, const Eigen::Vector4f& plane);
+
 /** \brief The convex hull of \a polygon (a support's region hull, in the coordinates of its
  * plane's frame \a plane_to_frame) and of \a prior's extent projected on that plane: the
  * support's hull when it is \a prior's plane (consistentWithPrior of \a plane), else
