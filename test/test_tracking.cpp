@@ -452,8 +452,7 @@ TEST(TrackerSteps, ConsistentWithPriorWithinItsAngleAndOffset)
   // priorMismatch: of the planes that are the prior's, the nearer has the less (a counter 3 cm
   // off against slabs on it 6 cm off); beyond the tolerances, infinity.
   const auto at = [&](float z) {
-    return facyl::priorMismatch(prior,
-                                planeOf(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, z))));
+    return facyl::priorMismatch(prior, planeOf(Eigen::Affine3f(Eigen::Translation3f(0.f, 0.f, z))));
   };
   EXPECT_NEAR(at(0.03f), 0.03f / 0.15f, 1e-5f);
   EXPECT_LT(at(0.03f), at(0.06f));
