@@ -32,6 +32,8 @@ validate(const TabletopRecognizerParameters& p, std::string* rule)
                           "is not in [1, 20]", rule);
   if (!(p.min_explained_share > 0.f && p.min_explained_share <= 1.f))
     return settingProblem("min_explained_share", p.min_explained_share, "is not in (0, 1]", rule);
+  if (p.max_stacked_objects < 1 || p.max_stacked_objects > 8)
+    return settingProblem("max_stacked_objects", p.max_stacked_objects, "is not in [1, 8]", rule);
   if (!(p.reject_below >= 0.f && p.reject_below <= 1.f))
     return settingProblem("reject_below", p.reject_below, "is not in [0, 1]", rule);
   if (!(p.recovery_margin >= 0.f && p.recovery_margin <= 1.f))

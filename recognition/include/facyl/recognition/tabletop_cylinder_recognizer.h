@@ -66,6 +66,11 @@ struct TabletopRecognizerParameters {
    * its own; the rest of the cluster is one more object. 1 turns the recovery off. */
   std::size_t max_cylinders_per_cluster{3};
   float min_explained_share{0.75f}; ///< in (0, 1]
+  /** Stacked objects that one cylinder was fitted across (a can on a tin: the side is two
+   * sections, findSectionStep): the cluster is cut at the step and each part recognized on its
+   * own, when one of them is a cylinder; at most this many objects in one stack. 1 turns it
+   * off; in [1, 8]. */
+  std::size_t max_stacked_objects{3};
   /** A cylinder found in a larger cluster is judged on the points within this distance (m,
    * at least; 15% of its radius beyond its surface, half its radius beyond its ends). */
   float recovery_margin{0.025f};
@@ -286,6 +291,17 @@ private:
    * objects). */
   void recognizeCluster(Fitter& fitter, TabletopCluster cluster, float p_network,
                         std::vector<RecognizedObject>& objects) const;
+  /** recognizeCluster for a cluster that may be cut into at most \a stacked stacked objects. */
+  void recognizeStack(Fitter& fitter, TabletopCluster cluster, float p_network, std::size_t stacked,
+                      std::vector<RecognizedObject>& objects) const;
+  /** When \a fit's side is two sections (findSectionStep): \a whole cut at the step, each part
+   * recognized (recognizeStack, \a stacked objects at most in all) and appended to \a objects
+   * when one of them is a cylinder. \return whether it was cut. */
+  bool splitStack(Fitter& fitter, const RecognizedObject& whole, const FitInput& input,
+                  const Fit& fit, float p_network, std::size_t stacked,
+                  std::vector<RecognizedObject>& objects) const;
+  /** A cluster of \a indices (ascending) cut from \a whole: its support, centroid and box. */
+  TabletopCluster partOf(const TabletopCluster& whole, pcl::Indices indices) const;
   /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
    * its best fit. */
   std::vector<Fit> extractCylinders(Fitter& fitter, const FitInput& input, Fit first) const;

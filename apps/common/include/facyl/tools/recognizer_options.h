@@ -150,6 +150,10 @@ recognizerOptions()
       [](auto& s) -> auto& { return s.params.max_cylinders_per_cluster; },
       "cylinders extracted from a cluster the best fit\ndoes not explain (touching, stacked "
       "objects; default {};\n1: off)"));
+    o.push_back(integerOption<S>(
+      "max-stacked", "N", [](auto& s) -> auto& { return s.params.max_stacked_objects; },
+      "objects one cluster is cut into where its side changes\nsection (stacked objects; "
+      "default {}; 1: off)"));
 
     Option<S> up;
     up.name = "up";

@@ -5,6 +5,7 @@
 
 #include <facyl/features/parallel.h>
 #include <facyl/recognition/cylinder_parts.h>
+#include <facyl/recognition/cylinder_stack.h>
 #include <facyl/recognition/impl/classifier_input.hpp>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
 
@@ -14,6 +15,7 @@
 #include <pcl/type_traits.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -482,6 +484,15 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(Fitter& fitter, TabletopClu
                                                      float p_network,
                                                      std::vector<RecognizedObject>& objects) const
 {
+  recognizeStack(fitter, std::move(cluster), p_network, params_.max_stacked_objects, objects);
+}
+
+template <typename PointT>
+void
+TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopCluster cluster,
+                                                   float p_network, std::size_t stacked,
+                                                   std::vector<RecognizedObject>& objects) const
+{
   RecognizedObject object;
   object.cluster = std::move(cluster);
   const FitInput input = prepareFit(fitter, object.cluster);
@@ -495,6 +506,9 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(Fitter& fitter, TabletopClu
     if (object.is_cylinder)
       refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
   }
+  // Objects stacked on each other, one cylinder fitted across them: each on its own.
+  if (stacked > 1 && splitStack(fitter, object, input, best, p_network, stacked, objects))
+    return;
   // Cylinder-first recovery: a cluster the best fit does not explain, or that the classifier
   // does not see as a cylinder as a whole, may hold several objects (each part is then
   // classified on its own view).
@@ -508,6 +522,63 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(Fitter& fitter, TabletopClu
     }
   }
   objects.push_back(std::move(object));
+}
+
+template <typename PointT>
+bool
+TabletopCylinderRecognizer<PointT>::splitStack(Fitter& fitter, const RecognizedObject& whole,
+                                               const FitInput& input, const Fit& fit,
+                                               float p_network, std::size_t stacked,
+                                               std::vector<RecognizedObject>& objects) const
+{
+  // The side of a cylinder (not a sphere's or a box's), seen around enough of it.
+  const CylinderEvidence& e = fit.evidence;
+  const CylinderDecision& d = params_.decision;
+  if (!e.fitted || e.curvature_ratio > d.max_curvature_ratio ||
+      e.angular_coverage < d.min_angular_coverage)
+    return false;
+  const SectionStep step = findSectionStep(fit.model, input.columns, input.normals);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] sections of r %.3f (%zu side points): sigma "
+            "smooth %.4f, step %.4f at %.3f (r %.3f / %.3f, shift %.3f, gap %.4f): %s\n",
+            fit.model.radius, step.side_points, step.sigma_smooth, step.sigma_step, step.height,
+            step.radius_below, step.radius_above, step.centre_shift, step.gap,
+            step.found ? "two" : "one");
+  if (!step.found)
+    return false;
+  const Eigen::Vector3f a = fit.model.axis.normalized();
+  std::array<pcl::Indices, 2> part;
+  for (const auto i : whole.cluster.indices.indices)
+    part[a.dot((*input_)[i].getVector3fMap() - fit.model.base) >= step.height ? 1 : 0].push_back(i);
+  const std::size_t min_size = params_.segmentation.min_cluster_size;
+  if (part[0].size() < min_size || part[1].size() < min_size)
+    return false;
+  std::vector<RecognizedObject> parts;
+  for (auto& p : part)
+    recognizeStack(fitter, partOf(whole.cluster, std::move(p)), p_network, stacked - 1, parts);
+  // Kept when a part is a cylinder (by the fit: the classifier judges each part's view later);
+  // else the whole as fitted.
+  if (std::none_of(parts.begin(), parts.end(),
+                   [](const RecognizedObject& o) { return o.is_cylinder; }))
+    return false;
+  for (auto& o : parts)
+    objects.push_back(std::move(o));
+  return true;
+}
+
+template <typename PointT>
+TabletopCluster
+TabletopCylinderRecognizer<PointT>::partOf(const TabletopCluster& whole, pcl::Indices indices) const
+{
+  TabletopCluster c;
+  c.indices.header = whole.indices.header;
+  c.support = whole.support;
+  Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(indices.size()));
+  for (std::size_t k = 0; k < indices.size(); ++k)
+    pts.col(static_cast<Eigen::Index>(k)) = (*input_)[indices[k]].getVector3fMap();
+  c.centroid = indices.empty() ? Eigen::Vector3f::Zero() : Eigen::Vector3f(pts.rowwise().mean());
+  c.box = input_->isOrganized() ? pixelBox(indices, input_->width) : projectedBox(pts, camera_);
+  c.indices.indices = std::move(indices);
+  return c;
 }
 
 template <typename PointT>
@@ -668,16 +739,7 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
       if (owner[k] == part)
         mine.push_back(idx[k]);
     RecognizedObject o;
-    o.cluster.indices.header = whole.cluster.indices.header;
-    o.cluster.support = whole.cluster.support;
-    Eigen::Matrix3Xf mp(3, static_cast<Eigen::Index>(mine.size()));
-    for (std::size_t k = 0; k < mine.size(); ++k)
-      mp.col(static_cast<Eigen::Index>(k)) = (*input_)[mine[k]].getVector3fMap();
-    o.cluster.centroid =
-      mine.empty() ? Eigen::Vector3f::Zero() : Eigen::Vector3f(mp.rowwise().mean());
-    o.cluster.box =
-      input_->isOrganized() ? pixelBox(mine, input_->width) : projectedBox(mp, camera_);
-    o.cluster.indices.indices = std::move(mine);
+    o.cluster = partOf(whole.cluster, std::move(mine));
     return o;
   };
   // What no cylinder explains is an object of its own when it is large (a box beside a

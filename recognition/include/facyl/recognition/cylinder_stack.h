@@ -1,0 +1,67 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * Where a cylinder fitted to one segment spans two objects stacked on each other (a can standing
+ * on a tin, a tube on a can): the section of the side changes at one height, abruptly, where the
+ * section of one object stays the same (a can) or changes smoothly (a cup's taper). A free
+ * function of the fitted axis and the segment's points with their normals.
+ */
+#pragma once
+
+#include <facyl/sample_consensus_alt/cylinder_model.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <limits>
+
+namespace facyl {
+
+/** \brief Settings of findSectionStep. The sizes are shares and ratios: the noise is measured
+ * on the points (the robust sigma of each model's residuals), not given. */
+struct SectionStepSettings {
+  /** Each section holds at least this share of the side points (a can's rim is no object of
+   * its own; a short tin under a tall tube holds about a sixth) ... */
+  float min_side_share{0.15f};
+  std::size_t min_side_points{30}; ///< ... and at least this many
+  /** The step explains the side better than any smooth change: the smooth model's robust sigma
+   * is at least this many times the step's. */
+  float min_improvement{1.5f};
+  /** The two sections lie apart (SectionStep::gap) by at least this many of the step's
+   * robust sigmas. */
+  float min_step_sigmas{3.f};
+};
+
+/** \brief What findSectionStep measured. */
+struct SectionStep {
+  bool found{false}; ///< the side is two sections, one above the other
+  /** Along the model's axis from its base: where the upper section starts. */
+  float height{std::numeric_limits<float>::quiet_NaN()};
+  float radius_below{std::numeric_limits<float>::quiet_NaN()}; ///< circle of the lower section
+  float radius_above{std::numeric_limits<float>::quiet_NaN()}; ///< ... of the upper one
+  float centre_shift{std::numeric_limits<float>::quiet_NaN()}; ///< between their centres
+  /** How far apart the sections are where they are seen: the larger of the two medians of a
+   * section's points' signed distances from the other section's circle, in absolute value. */
+  float gap{std::numeric_limits<float>::quiet_NaN()};
+  float sigma_step{std::numeric_limits<float>::quiet_NaN()};   ///< robust sigma, two sections
+  float sigma_smooth{std::numeric_limits<float>::quiet_NaN()}; ///< ... one smooth section
+  std::size_t side_points{0}; ///< the points used (see findSectionStep)
+};
+
+/** \brief Whether the side around \a model is two stacked sections. The side points: columns
+ * of \a points between 0.5 and 1.5 radii from the axis whose normals (unit, alongside) are
+ * within 45 degrees of perpendicular to it. Two models of their circles across the axis
+ * (x, y), against the position t along it, are fitted by algebraic (Kasa) least squares, each
+ * once more without the residuals beyond 3 robust sigmas (a handle, a neighbour's points):
+ * - smooth: centre linear in t, radius^2 quadratic in t (a cylinder, a tilted fit's drift, a
+ *   cone's taper), 7 parameters;
+ * - step: one circle below a height and another above it (3 + 3 parameters), at the height
+ *   (tried at 33 points between the quantiles min_side_share and 1 - min_side_share) whose
+ *   two circles leave the smallest median residual.
+ * Found when the smooth model's robust sigma (1.4826 x the median |residual|) is at least
+ * min_improvement times the step's and the sections lie min_step_sigmas of it apart (gap).
+ * Not found with fewer than 2 x min_side_points side points. */
+SectionStep findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                            const Eigen::Matrix3Xf& normals,
+                            const SectionStepSettings& settings = {});
+
+} // namespace facyl

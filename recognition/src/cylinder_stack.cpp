@@ -1,0 +1,270 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ * findSectionStep: two stacked sections against one smooth section of a fitted cylinder's side.
+ */
+#include <facyl/recognition/cylinder_stack.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace facyl {
+
+namespace {
+
+/** A side point: its position t along the axis and (x, y) across it, relative to the axis. */
+struct SidePoint {
+  double t, x, y;
+};
+
+/** A circle across the axis; ok false when the fit failed. */
+struct Circle {
+  Eigen::Vector2d centre{Eigen::Vector2d::Zero()};
+  double radius{0.0};
+  bool ok{false};
+};
+
+/** Kasa's algebraic circle from the sums of f f^T and f s over points (f = (x, y, 1),
+ * s = x^2 + y^2): s = a x + b y + c, centre (a, b) / 2, radius^2 = c + |centre|^2. */
+Circle
+kasaCircle(const Eigen::Matrix3d& ff, const Eigen::Vector3d& fs)
+{
+  Circle c;
+  if (!(ff(2, 2) >= 3.0))
+    return c;
+  const Eigen::Vector3d beta = ff.ldlt().solve(fs);
+  if (!beta.allFinite())
+    return c;
+  c.centre = 0.5 * beta.head<2>();
+  const double r2 = beta[2] + c.centre.squaredNorm();
+  c.ok = r2 > 0.0;
+  c.radius = c.ok ? std::sqrt(r2) : 0.0;
+  return c;
+}
+
+Eigen::Vector3d
+circleFeatures(const SidePoint& p)
+{
+  return Eigen::Vector3d(p.x, p.y, 1.0);
+}
+
+double
+circleResidual(const Circle& c, const SidePoint& p)
+{
+  return std::abs((Eigen::Vector2d(p.x, p.y) - c.centre).norm() - c.radius);
+}
+
+/** The circle of the points [begin, end) whose \a use is set. */
+Circle
+fitCircle(const std::vector<SidePoint>& pts, std::size_t begin, std::size_t end,
+          const std::vector<std::uint8_t>& use)
+{
+  Eigen::Matrix3d ff = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d fs = Eigen::Vector3d::Zero();
+  for (std::size_t k = begin; k < end; ++k)
+    if (use[k]) {
+      const Eigen::Vector3d f = circleFeatures(pts[k]);
+      ff += f * f.transpose();
+      fs += f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
+    }
+  return kasaCircle(ff, fs);
+}
+
+/** The smooth section: s = f . beta with f = (x, y, 1, t x, t y, t, t^2); centre
+ * (beta0 + beta3 t, beta1 + beta4 t) / 2, radius^2 = beta2 + beta5 t + beta6 t^2 + |centre|^2. */
+struct SmoothSection {
+  Eigen::Matrix<double, 7, 1> beta{Eigen::Matrix<double, 7, 1>::Zero()};
+  bool ok{false};
+  double residual(const SidePoint& p) const
+  {
+    const Eigen::Vector2d c =
+      0.5 * Eigen::Vector2d(beta[0] + beta[3] * p.t, beta[1] + beta[4] * p.t);
+    const double r2 = beta[2] + beta[5] * p.t + beta[6] * p.t * p.t + c.squaredNorm();
+    if (!(r2 > 0.0))
+      return std::numeric_limits<double>::infinity();
+    return std::abs((Eigen::Vector2d(p.x, p.y) - c).norm() - std::sqrt(r2));
+  }
+};
+
+SmoothSection
+fitSmooth(const std::vector<SidePoint>& pts, const std::vector<std::uint8_t>& use)
+{
+  using Vector7d = Eigen::Matrix<double, 7, 1>;
+  Eigen::Matrix<double, 7, 7> ff = Eigen::Matrix<double, 7, 7>::Zero();
+  Vector7d fs = Vector7d::Zero();
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < pts.size(); ++k)
+    if (use[k]) {
+      const SidePoint& p = pts[k];
+      Vector7d f;
+      f << p.x, p.y, 1.0, p.t * p.x, p.t * p.y, p.t, p.t * p.t;
+      ff += f * f.transpose();
+      fs += f * (p.x * p.x + p.y * p.y);
+      ++n;
+    }
+  SmoothSection s;
+  if (n < 7)
+    return s;
+  s.beta = ff.ldlt().solve(fs);
+  s.ok = s.beta.allFinite();
+  return s;
+}
+
+/** 1.4826 x the median of \a r (a robust sigma); \a r is reordered. */
+double
+robustSigma(std::vector<double>& r)
+{
+  if (r.empty())
+    return std::numeric_limits<double>::infinity();
+  const auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
+  std::nth_element(r.begin(), mid, r.end());
+  return 1.4826 * *mid;
+}
+
+/** The residuals of \a residual(k) over the points, a robust sigma of them, and \a use cleared
+ * where they exceed 3 of it. */
+template <typename Residual>
+double
+trimOutliers(std::size_t n, Residual residual, std::vector<std::uint8_t>& use)
+{
+  std::vector<double> r(n);
+  for (std::size_t k = 0; k < n; ++k)
+    r[k] = residual(k);
+  std::vector<double> sorted = r;
+  const double sigma = robustSigma(sorted);
+  for (std::size_t k = 0; k < n; ++k)
+    use[k] = r[k] <= 3.0 * sigma;
+  return sigma;
+}
+
+/** The robust sigma of \a residual(k) over the points. */
+template <typename Residual>
+double
+sigmaOf(std::size_t n, Residual residual)
+{
+  std::vector<double> r(n);
+  for (std::size_t k = 0; k < n; ++k)
+    r[k] = residual(k);
+  return robustSigma(r);
+}
+
+} // namespace
+
+SectionStep
+findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                const Eigen::Matrix3Xf& normals, const SectionStepSettings& s)
+{
+  SectionStep out;
+  const Eigen::Vector3f a = model.axis.normalized();
+  if (!(model.radius > 0.f) || !a.allFinite() || normals.cols() != points.cols())
+    return out;
+  const Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
+  std::vector<SidePoint> pts;
+  pts.reserve(static_cast<std::size_t>(points.cols()));
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f d = points.col(i) - model.base;
+    const float t = d.dot(a);
+    const Eigen::Vector3f radial = d - t * a;
+    const float rho = radial.norm();
+    if (!std::isfinite(rho) || rho < 0.5f * model.radius || rho > 1.5f * model.radius ||
+        !(std::abs(normals.col(i).dot(a)) <= 0.7071f))
+      continue;
+    pts.push_back({t, radial.dot(e1), radial.dot(e2)});
+  }
+  out.side_points = pts.size();
+  const std::size_t n = pts.size();
+  const std::size_t min_side = std::max<std::size_t>(
+    s.min_side_points,
+    static_cast<std::size_t>(std::ceil(s.min_side_share * static_cast<float>(n))));
+  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+    return out;
+  std::sort(pts.begin(), pts.end(),
+            [](const SidePoint& p, const SidePoint& q) { return p.t < q.t; });
+
+  // One smooth section, fitted twice (the second time without the outliers).
+  std::vector<std::uint8_t> use(n, 1);
+  SmoothSection smooth = fitSmooth(pts, use);
+  if (!smooth.ok)
+    return out;
+  trimOutliers(n, [&](std::size_t k) { return smooth.residual(pts[k]); }, use);
+  smooth = fitSmooth(pts, use);
+  if (!smooth.ok)
+    return out;
+  const auto smooth_residual = [&](std::size_t k) { return smooth.residual(pts[k]); };
+  const double cap = 3.0 * sigmaOf(n, smooth_residual); // 3 robust sigmas
+
+  // Two sections: the split (between sorted points) whose circles leave the smallest median
+  // residual; the sums of each side come from prefix sums.
+  std::vector<Eigen::Matrix3d> ff(n + 1, Eigen::Matrix3d::Zero());
+  std::vector<Eigen::Vector3d> fs(n + 1, Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d f = circleFeatures(pts[k]);
+    ff[k + 1] = ff[k] + f * f.transpose();
+    fs[k + 1] = fs[k] + f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
+  }
+  constexpr int kSplits = 33;
+  double best = std::numeric_limits<double>::infinity();
+  std::size_t split = 0;
+  for (int j = 0; j < kSplits; ++j) {
+    const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
+                                       static_cast<std::size_t>(kSplits - 1);
+    const Circle below = kasaCircle(ff[k], fs[k]);
+    const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
+    if (!below.ok || !above.ok)
+      continue;
+    const double sigma =
+      sigmaOf(n, [&](std::size_t i) { return circleResidual(i < k ? below : above, pts[i]); });
+    if (sigma < best) {
+      best = sigma;
+      split = k;
+    }
+  }
+  if (split == 0)
+    return out;
+  // Each section once more without its outliers.
+  std::vector<std::uint8_t> all(n, 1);
+  Circle below = fitCircle(pts, 0, split, all), above = fitCircle(pts, split, n, all);
+  if (!below.ok || !above.ok)
+    return out;
+  trimOutliers(n, [&](std::size_t i) { return circleResidual(i < split ? below : above, pts[i]); },
+               use);
+  below = fitCircle(pts, 0, split, use);
+  above = fitCircle(pts, split, n, use);
+  if (!below.ok || !above.ok)
+    return out;
+  const auto step_residual = [&](std::size_t i) {
+    return circleResidual(i < split ? below : above, pts[i]);
+  };
+  const double sigma_step = sigmaOf(n, step_residual);
+  out.sigma_step = static_cast<float>(sigma_step);
+
+  out.height = static_cast<float>(0.5 * (pts[split - 1].t + pts[split].t));
+  out.radius_below = static_cast<float>(below.radius);
+  out.radius_above = static_cast<float>(above.radius);
+  out.centre_shift = static_cast<float>((below.centre - above.centre).norm());
+  // How far apart the sections are where they are seen: each section's points from the other
+  // section's circle (signed, median; over a short arc a circle's radius and centre trade off,
+  // so the circles' own difference says little).
+  const auto apart = [&](std::size_t begin, std::size_t end, const Circle& other) {
+    std::vector<double> d;
+    for (std::size_t i = begin; i < end; ++i)
+      if (use[i])
+        d.push_back((Eigen::Vector2d(pts[i].x, pts[i].y) - other.centre).norm() - other.radius);
+    if (d.empty())
+      return 0.0;
+    const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+    std::nth_element(d.begin(), mid, d.end());
+    return std::abs(*mid);
+  };
+  const double gap = std::max(apart(0, split, above), apart(split, n, below));
+  out.gap = static_cast<float>(gap);
+  out.sigma_smooth = static_cast<float>(cap / 3.0);
+  out.found = out.sigma_smooth >= s.min_improvement * out.sigma_step &&
+              gap >= s.min_step_sigmas * sigma_step;
+  return out;
+}
+
+} // namespace facyl
