@@ -189,7 +189,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   SmoothSection smooth = fitSmooth(pts, use);
   if (!smooth.ok)
     return out;
-  trimOutliers(n, [&](std::size_t k) { return smooth.residual(pts[k]); }, use);
+  trimOutliers(
+    n, [&](std::size_t k) { return smooth.residual(pts[k]); }, use);
   smooth = fitSmooth(pts, use);
   if (!smooth.ok)
     return out;
@@ -229,8 +230,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   Circle below = fitCircle(pts, 0, split, all), above = fitCircle(pts, split, n, all);
   if (!below.ok || !above.ok)
     return out;
-  trimOutliers(n, [&](std::size_t i) { return circleResidual(i < split ? below : above, pts[i]); },
-               use);
+  trimOutliers(
+    n, [&](std::size_t i) { return circleResidual(i < split ? below : above, pts[i]); }, use);
   below = fitCircle(pts, 0, split, use);
   above = fitCircle(pts, split, n, use);
   if (!below.ok || !above.ok)
@@ -262,8 +263,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   const double gap = std::max(apart(0, split, above), apart(split, n, below));
   out.gap = static_cast<float>(gap);
   out.sigma_smooth = static_cast<float>(cap / 3.0);
-  out.found = out.sigma_smooth >= s.min_improvement * out.sigma_step &&
-              gap >= s.min_step_sigmas * sigma_step;
+  out.found =
+    out.sigma_smooth >= s.min_improvement * out.sigma_step && gap >= s.min_step_sigmas * sigma_step;
   return out;
 }
 
