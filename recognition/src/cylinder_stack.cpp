@@ -194,8 +194,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   smooth = fitSmooth(pts, use);
   if (!smooth.ok)
     return out;
-  const auto smooth_residual = [&](std::size_t k) { return smooth.residual(pts[k]); };
-  const double cap = 3.0 * sigmaOf(n, smooth_residual); // 3 robust sigmas
+  out.sigma_smooth =
+    static_cast<float>(sigmaOf(n, [&](std::size_t k) { return smooth.residual(pts[k]); }));
 
   // Two sections: the split (between sorted points) whose circles leave the smallest median
   // residual; the sums of each side come from prefix sums.
@@ -226,10 +226,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   if (split == 0)
     return out;
   // Each section once more without its outliers.
-  std::vector<std::uint8_t> all(n, 1);
-  Circle below = fitCircle(pts, 0, split, all), above = fitCircle(pts, split, n, all);
-  if (!below.ok || !above.ok)
-    return out;
+  Circle below = kasaCircle(ff[split], fs[split]);
+  Circle above = kasaCircle(ff[n] - ff[split], fs[n] - fs[split]);
   trimOutliers(
     n, [&](std::size_t i) { return circleResidual(i < split ? below : above, pts[i]); }, use);
   below = fitCircle(pts, 0, split, use);
@@ -262,7 +260,6 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   };
   const double gap = std::max(apart(0, split, above), apart(split, n, below));
   out.gap = static_cast<float>(gap);
-  out.sigma_smooth = static_cast<float>(cap / 3.0);
   out.found =
     out.sigma_smooth >= s.min_improvement * out.sigma_step && gap >= s.min_step_sigmas * sigma_step;
   return out;

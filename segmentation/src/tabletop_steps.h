@@ -154,7 +154,7 @@ Trial tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
 // --------------------------------------------------------------------- tabletop_prior.cpp
 
 /** The index of the candidate of \a candidates that is setup.prior's plane (consistentWithPrior
- * of its plane; the first, i.e. the largest, of several), -1: none or no prior. */
+ * of its plane; of several, the nearest: priorMismatch), -1: none or no prior. */
 int priorCandidate(const Setup& setup, const std::vector<Candidate>& candidates);
 
 /** With a prior: when the candidate that is the prior's plane (priorCandidate) comes after the
