@@ -151,6 +151,52 @@ TEST(ObjectSegmentation, FocalLengthAndImageDownFromTheData)
             0.99f);
 }
 
+TEST(ObjectSegmentation, ClosestPixelPairIsTheFirstOfTheClosest)
+{
+  // Against a loop over a around a loop over b that keeps strictly closer pairs, on random
+  // lists with many ties (a small image), and lists far apart.
+  facyl::Random rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    facyl::PixelList a, b;
+    const int side = trial % 2 ? 12 : 400, na = 1 + trial % 37, nb = 1 + (trial * 7) % 41;
+    const int shift = trial % 5 == 0 ? 300 : 0;
+    for (int k = 0; k < na; ++k) {
+      a.u.push_back(static_cast<int>(rng.uniform(0.f, static_cast<float>(side))));
+      a.v.push_back(static_cast<int>(rng.uniform(0.f, static_cast<float>(side))));
+    }
+    for (int k = 0; k < nb; ++k) {
+      b.u.push_back(shift + static_cast<int>(rng.uniform(0.f, static_cast<float>(side))));
+      b.v.push_back(static_cast<int>(rng.uniform(0.f, static_cast<float>(side))));
+    }
+    long best = std::numeric_limits<long>::max();
+    std::size_t ia = 0, ib = 0;
+    for (std::size_t i = 0; i < a.u.size(); ++i)
+      for (std::size_t j = 0; j < b.u.size(); ++j) {
+        const long du = a.u[i] - b.u[j], dv = a.v[i] - b.v[j];
+        if (du * du + dv * dv < best)
+          best = du * du + dv * dv, ia = i, ib = j;
+      }
+    std::size_t ka, kb;
+    ASSERT_EQ(facyl::closestPixelPair(a, b, ka, kb), best) << trial;
+    EXPECT_EQ(ka, ia) << trial;
+    EXPECT_EQ(kb, ib) << trial;
+    // Stopping at a pair within reach: one within it (the closest when none is).
+    const long got = facyl::closestPixelPair(a, b, ka, kb, 4);
+    const long du = a.u[ka] - b.u[kb], dv = a.v[ka] - b.v[kb];
+    EXPECT_EQ(got, du * du + dv * dv) << trial;
+    EXPECT_TRUE(best <= 4 ? got <= 4 : got == best) << trial;
+  }
+  facyl::PixelList empty, one{{3}, {4}};
+  std::size_t ka, kb;
+  EXPECT_EQ(facyl::closestPixelPair(empty, one, ka, kb), -1);
+  EXPECT_EQ(ka, std::numeric_limits<std::size_t>::max());
+  EXPECT_EQ(facyl::closestPixelPair(one, empty, ka, kb), -1);
+  // Coordinates too far apart for 32-bit squares take the 64-bit path.
+  facyl::PixelList far{{0, 40000}, {0, 0}};
+  EXPECT_EQ(facyl::closestPixelPair(one, far, ka, kb), 3 * 3 + 4 * 4);
+  EXPECT_EQ(kb, 0u);
+}
+
 TEST(ObjectSegmentation, CreasesAreTheValleysNotTheRidges)
 {
   // Two surfaces seen from the sensor at the origin, 1 m away: a valley (concave, where two

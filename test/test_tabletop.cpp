@@ -103,6 +103,25 @@ TEST(TabletopGeometry, BoxesAndPolygons)
   EXPECT_TRUE(facyl::pointInPolygon({0.5f, 0.5f}, square));
   EXPECT_FALSE(facyl::pointInPolygon({1.5f, 0.5f}, square));
   EXPECT_FALSE(facyl::pointInPolygon({0.5f, -0.1f}, square));
+  // Counted in a plane's coordinates: the same as the test point by point.
+  const Eigen::Affine3f to_plane =
+    Eigen::Translation3f(0.2f, -0.1f, 0.3f) * Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitZ());
+  const std::vector<Eigen::Vector2f> hexagon{{0.f, 0.f}, {1.f, 0.f}, {1.5f, 0.5f},
+                                             {1.f, 1.f}, {0.f, 1.f}, {-0.5f, 0.5f}};
+  Eigen::Matrix3Xf scattered(3, 500); // a lattice over and around both, each point its own z
+  for (Eigen::Index k = 0; k < scattered.cols(); ++k)
+    scattered.col(k) << -1.5f + 0.13f * static_cast<float>(k % 25),
+      -1.5f + 0.15f * static_cast<float>(k / 25), 0.01f * static_cast<float>(k % 7);
+  for (const auto* polygon : {&square, &hexagon}) {
+    std::size_t expected = 0;
+    for (Eigen::Index k = 0; k < scattered.cols(); ++k)
+      expected +=
+        facyl::pointInPolygon((to_plane * Eigen::Vector3f(scattered.col(k))).head<2>(), *polygon);
+    EXPECT_GT(expected, 0u);
+    EXPECT_LT(expected, 500u);
+    EXPECT_EQ(facyl::pointsInPolygon(scattered, to_plane, *polygon), expected);
+  }
+  EXPECT_EQ(facyl::pointsInPolygon(scattered, to_plane, {}), 0u);
   facyl::PinholeCamera cam{500.f, 500.f, 320.f, 240.f, 640, 480};
   Eigen::Matrix3Xf pts(3, 3);
   pts << 0.f, 0.1f, 5.f, //

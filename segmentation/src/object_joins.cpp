@@ -108,9 +108,16 @@ Segments::bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size
     if (const int k = slot[static_cast<std::size_t>(root[i])]; k >= 0)
       pixels[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
   std::vector<std::vector<int>> borders(groups.size());
+  std::vector<PixelList> border_pixels(groups.size());
   std::vector<Eigen::AlignedBox3f> boxes(groups.size());
   for (std::size_t k = 0; k < groups.size(); ++k) {
     borders[k] = border(pixels[k], groups[k], root);
+    for (const int i : borders[k]) {
+      int u, v;
+      grid_.position(i, u, v);
+      border_pixels[k].u.push_back(u);
+      border_pixels[k].v.push_back(v);
+    }
     for (const int i : pixels[k])
       boxes[k].extend(grid_.point(i));
   }
@@ -119,7 +126,8 @@ Segments::bridgeOcclusions(const std::vector<std::uint8_t>& has_depth, std::size
       const int g = find(groups[a]), h = find(groups[b]);
       if (g == h || boxes[a].exteriorDistance(boxes[b]) > p.bridge_max_gap)
         continue;
-      if (sameSurfaceBehind(pixels[a], pixels[b], borders[a], borders[b], g, h, has_depth, p))
+      if (sameSurfaceBehind(pixels[a], pixels[b], borders[a], borders[b], border_pixels[a],
+                            border_pixels[b], g, h, has_depth, p))
         group_[static_cast<std::size_t>(std::max(g, h))] = std::min(g, h);
     }
 }
@@ -233,26 +241,18 @@ Segments::localPlane(const std::vector<int>& px, const Eigen::Vector3f& centre, 
 
 bool
 Segments::sameSurfaceBehind(const std::vector<int>& pa, const std::vector<int>& pb,
-                            const std::vector<int>& ba, const std::vector<int>& bb, int g, int h,
+                            const std::vector<int>& ba, const std::vector<int>& bb,
+                            const PixelList& at_a, const PixelList& at_b, int g, int h,
                             const std::vector<std::uint8_t>& has_depth,
                             const ObjectSegmentationParameters& p) const
 {
   // The closest border pixels of the two parts, in the image.
-  int ia = -1, ib = -1;
-  long best = std::numeric_limits<long>::max();
-  for (const int i : ba) {
-    int ui, vi;
-    grid_.position(i, ui, vi);
-    for (const int j : bb) {
-      int uj, vj;
-      grid_.position(j, uj, vj);
-      const long du = ui - uj, dv = vi - vj;
-      if (du * du + dv * dv < best)
-        best = du * du + dv * dv, ia = i, ib = j;
-    }
-  }
-  if (ia < 0 || best <= 4)
+  constexpr long kAdjacent = 4; // squared pixels: neighbours, or one pixel between them
+  std::size_t ka, kb;
+  const long best = closestPixelPair(at_a, at_b, ka, kb, kAdjacent);
+  if (best < 0 || best <= kAdjacent)
     return false; // adjacent: split on purpose (a crease or a jump), not seen through a gap
+  const int ia = ba[ka], ib = bb[kb];
   const Eigen::Vector3f xa = grid_.point(ia), xb = grid_.point(ib);
   if ((xa - xb).norm() > p.bridge_max_gap)
     return false;

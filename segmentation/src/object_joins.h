@@ -80,10 +80,12 @@ private:
   bool localPlane(const std::vector<int>& px, const Eigen::Vector3f& centre, float radius,
                   Eigen::Vector3f& centroid, Eigen::Vector3f& normal) const;
 
-  /** Whether the parts \a pa and \a pb (groups \a g and \a h, borders \a ba and \a bb) are one
-   * surface seen on both sides of a nearer occluder. */
+  /** Whether the parts \a pa and \a pb (groups \a g and \a h, borders \a ba and \a bb, at
+   * the image positions \a at_a and \a at_b) are one surface seen on both sides of a nearer
+   * occluder. */
   bool sameSurfaceBehind(const std::vector<int>& pa, const std::vector<int>& pb,
-                         const std::vector<int>& ba, const std::vector<int>& bb, int g, int h,
+                         const std::vector<int>& ba, const std::vector<int>& bb,
+                         const PixelList& at_a, const PixelList& at_b, int g, int h,
                          const std::vector<std::uint8_t>& has_depth,
                          const ObjectSegmentationParameters& p) const;
 

@@ -429,6 +429,63 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
   return out;
 }
 
+long
+closestPixelPair(const PixelList& a, const PixelList& b, std::size_t& ka, std::size_t& kb,
+                 long enough)
+{
+  ka = kb = std::numeric_limits<std::size_t>::max();
+  const std::size_t na = std::min(a.u.size(), a.v.size()), nb = std::min(b.u.size(), b.v.size());
+  if (na == 0 || nb == 0)
+    return -1;
+  // b's bounding box bounds each pixel's distance to b from below.
+  const auto bu = std::minmax_element(b.u.begin(), b.u.begin() + static_cast<std::ptrdiff_t>(nb));
+  const auto bv = std::minmax_element(b.v.begin(), b.v.begin() + static_cast<std::ptrdiff_t>(nb));
+  const std::int64_t u0 = *bu.first, u1 = *bu.second, v0 = *bv.first, v1 = *bv.second;
+  // Differences below 2^15 (b's box and a pixel's distance to it below 2^14 a side) have
+  // squared distances within 32 bits: the reduction then runs 4 or 8 wide.
+  const bool narrow = u1 - u0 < 16384 && v1 - v0 < 16384;
+  const int* ub = b.u.data();
+  const int* vb = b.v.data();
+  std::int64_t best = std::numeric_limits<std::int64_t>::max();
+  for (std::size_t i = 0; i < na; ++i) {
+    const std::int64_t ui = a.u[i], vi = a.v[i];
+    const std::int64_t du = std::max({u0 - ui, ui - u1, std::int64_t{0}});
+    const std::int64_t dv = std::max({v0 - vi, vi - v1, std::int64_t{0}});
+    if (du * du + dv * dv >= best)
+      continue; // no pair of this pixel is strictly closer
+    // Its closest distance first (a plain reduction), then the first pair at it.
+    std::int64_t nearest = std::numeric_limits<std::int64_t>::max();
+    if (narrow && du < 16384 && dv < 16384) {
+      const int x0 = static_cast<int>(ui), y0 = static_cast<int>(vi);
+      int m = std::numeric_limits<int>::max();
+      for (std::size_t j = 0; j < nb; ++j) {
+        const int x = ub[j] - x0, y = vb[j] - y0;
+        m = std::min(m, x * x + y * y);
+      }
+      nearest = m;
+    }
+    else
+      for (std::size_t j = 0; j < nb; ++j) {
+        const std::int64_t x = ub[j] - ui, y = vb[j] - vi;
+        nearest = std::min(nearest, x * x + y * y);
+      }
+    if (nearest >= best)
+      continue;
+    best = nearest;
+    ka = i;
+    for (std::size_t j = 0; j < nb; ++j) {
+      const std::int64_t x = ub[j] - ui, y = vb[j] - vi;
+      if (x * x + y * y == nearest) {
+        kb = j;
+        break;
+      }
+    }
+    if (best <= enough)
+      break;
+  }
+  return static_cast<long>(best);
+}
+
 bool
 strictlyAscending(const pcl::Indices& indices)
 {

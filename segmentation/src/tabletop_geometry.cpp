@@ -70,6 +70,27 @@ pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& pol
   return inside;
 }
 
+std::size_t
+pointsInPolygon(const Eigen::Matrix3Xf& pts, const Eigen::Affine3f& to_plane,
+                const std::vector<Eigen::Vector2f>& polygon)
+{
+  if (polygon.empty())
+    return 0;
+  // Outside the box by a millimetre (float rounding of the edges' crossings), the even-odd
+  // test is false: no edge straddles the point's row, or each that does lies on one side.
+  Eigen::AlignedBox2f box;
+  for (const auto& v : polygon)
+    box.extend(v);
+  box.min().array() -= 1e-3f;
+  box.max().array() += 1e-3f;
+  std::size_t in = 0;
+  for (Eigen::Index k = 0; k < pts.cols(); ++k) {
+    const Eigen::Vector2f p = (to_plane * Eigen::Vector3f(pts.col(k))).head<2>();
+    in += box.contains(p) && pointInPolygon(p, polygon);
+  }
+  return in;
+}
+
 PixelBox
 pixelBox(const pcl::Indices& indices, std::uint32_t width)
 {

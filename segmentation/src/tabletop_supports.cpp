@@ -52,8 +52,19 @@ supportHull(const Setup& setup, const Eigen::Affine3f& frame, const pcl::Indices
   // image row can be a vertex.
   const std::vector<Eigen::Vector2f> region = convexHull2D(points); // none: every point
   constexpr float grow = 0.05f;
+  // The region's box grown by as much and a millimetre (float rounding): nothing outside it is
+  // near the region, which most of an infinite plane's points are not.
+  Eigen::AlignedBox2f reach;
+  for (const auto& v : region)
+    reach.extend(v);
+  reach.min().array() -= grow + 1e-3f;
+  reach.max().array() += grow + 1e-3f;
   const auto near_region = [&](const Eigen::Vector2f& p) {
-    if (!c || region.size() < 3 || pointInPolygon(p, region))
+    if (!c || region.size() < 3)
+      return true;
+    if (!reach.contains(p))
+      return false;
+    if (pointInPolygon(p, region))
       return true;
     for (std::size_t e = 0; e < region.size(); ++e) {
       const Eigen::Vector2f a = region[e], b = region[(e + 1) % region.size()];
@@ -116,10 +127,7 @@ place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<Support
   for (std::size_t s = 0; s < supports.size(); ++s) {
     profiles[s] = heightProfile(pts, supports[s].plane, supports[s].band, viewpoint, p.min_height,
                                 p.max_height);
-    const Eigen::Affine3f to_plane = supports[s].frame.inverse();
-    std::size_t in_hull = 0;
-    for (Eigen::Index k = 0; k < pts.cols(); ++k)
-      in_hull += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).head<2>(), regions[s]);
+    const std::size_t in_hull = pointsInPolygon(pts, supports[s].frame.inverse(), regions[s]);
     const float over = static_cast<float>(in_hull) / static_cast<float>(pts.cols());
     // The nearest support under the cluster: most of it in its band and over its hull (the
     // prism test of pcl::ExtractPolygonalPrismData, per cluster).
@@ -136,10 +144,7 @@ place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<Support
   for (std::size_t s = 0; s < supports.size(); ++s) {
     if (static_cast<int>(s) == out.support || !(profiles[s].top < 0.f))
       continue;
-    const Eigen::Affine3f to_plane = supports[s].frame.inverse();
-    std::size_t under = 0;
-    for (Eigen::Index k = 0; k < pts.cols(); ++k)
-      under += pointInPolygon((to_plane * Eigen::Vector3f(pts.col(k))).head<2>(), extents[s]);
+    const std::size_t under = pointsInPolygon(pts, supports[s].frame.inverse(), extents[s]);
     if (2 * under >= static_cast<std::size_t>(pts.cols())) {
       out.support = -1;
       return out;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -122,6 +123,20 @@ std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::Poi
                                                   const ObjectSegmentationParameters& params,
                                                   const DepthBand* noise = nullptr,
                                                   const pcl::Indices* finite = nullptr);
+
+/** \brief Pixels of two image regions: columns \a u and rows \a v, one entry per pixel. */
+struct PixelList {
+  std::vector<int> u, v;
+};
+
+/** \brief The closest pair of pixels of \a a and \a b (squared distance in pixels), and in
+ * \a ka, \a kb their places in the lists: of several closest pairs, the first in \a a's order,
+ * then in \a b's (as a loop over \a a around a loop over \a b that keeps strictly closer pairs
+ * finds). With \a enough >= 0, the search stops at the first pixel of \a a whose closest pair
+ * is within it (squared pixels): that pair, which need not be the closest. -1 and places
+ * SIZE_MAX when either list is empty. */
+long closestPixelPair(const PixelList& a, const PixelList& b, std::size_t& ka, std::size_t& kb,
+                      long enough = -1);
 
 /** \brief Whether \a indices ascend strictly (no repeat): the image order that
  * segmentObjectsOrganized's pixel lists keep. */

@@ -115,6 +115,12 @@ Eigen::Affine3f planeFrame(const Eigen::Vector4f& plane, const Eigen::Vector3f& 
 /** \brief Even-odd test of \a p against a simple polygon (vertices in order). */
 bool pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon);
 
+/** \brief How many of the points \a pts (3 x n), taken into a plane's coordinates by
+ * \a to_plane, lie in \a polygon (pointInPolygon of their x and y). Points well outside the
+ * polygon's box are counted out without the test. */
+std::size_t pointsInPolygon(const Eigen::Matrix3Xf& pts, const Eigen::Affine3f& to_plane,
+                            const std::vector<Eigen::Vector2f>& polygon);
+
 /** \brief Bounding box of organized-cloud indices in an image \a width pixels wide. */
 PixelBox pixelBox(const pcl::Indices& indices, std::uint32_t width);
 
