@@ -267,6 +267,14 @@ TEST(ObjectSegmentation, ObjectPointsAloneSplitAsTheirMaskedFrame)
   EXPECT_GE(alone.size(), 3u);
   EXPECT_EQ(alone, scanned);
   EXPECT_EQ(alone, listed);
+  // On several threads (the crease test in blocks of 8192 pixels, two here): the same
+  // segments.
+  ASSERT_GT(pixels.size(), 8192u);
+  EXPECT_EQ(facyl::segmentObjectsOrganized(points, pixels, s.cloud.width, s.cloud.height, has_depth,
+                                           525.f, origin, p, &noise, nullptr, 3),
+            alone);
+  EXPECT_EQ(facyl::segmentObjectsOrganized(masked, has_depth, 525.f, origin, p, &noise, &pixels, 2),
+            alone);
   // Invalid input: no segments.
   pcl::Indices reversed(pixels.rbegin(), pixels.rend());
   EXPECT_TRUE(facyl::segmentObjectsOrganized(points, reversed, s.cloud.width, s.cloud.height,

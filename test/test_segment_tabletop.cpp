@@ -110,6 +110,8 @@ TEST(SegmentTabletop, AWorkspaceUsedBeforeGivesWhatANewOneGives)
   // lattice of a 1280 x 720 frame, VGA again), for both clusterings: each result equals that
   // of a new workspace. The buffers grow, shrink and keep what earlier frames wrote (two VGA
   // frames in a row leave the Euclidean clustering's masked copy the other frame's points).
+  // The used workspace runs on 1 or 3 threads, the new ones on the default (the hardware's):
+  // the same segments.
   const Cloud::Ptr vga = frame(21), qvga = frame(22, 320, 240), big = frame(23, 1280, 720),
                    other = frame(24);
   const Cloud::Ptr points = finitePoints(*frame(25));
@@ -131,6 +133,7 @@ TEST(SegmentTabletop, AWorkspaceUsedBeforeGivesWhatANewOneGives)
   facyl::TabletopWorkspace used;
   for (std::size_t r = 0; r < runs.size(); ++r) {
     SCOPED_TRACE("run " + std::to_string(r));
+    used.threads = r % 2 ? 1 : 3;
     const facyl::PointFrame f = facyl::pointFrame(*runs[r].cloud, nullptr, none);
     const facyl::TabletopSegments again =
       facyl::segmentTabletop(f, runs[r].camera, Eigen::Vector3f::Zero(), runs[r].params, used);
@@ -315,6 +318,11 @@ TEST(SegmentTabletop, RejectsWhatItCannotSegment)
   facyl::TabletopWorkspace w;
   facyl::TabletopSegmentationParameters bad;
   bad.max_planes = 0;
+  facyl::TabletopSegmentation<pcl::PointXYZ> seg;
+  EXPECT_EQ(seg.getNumberOfThreads(), 0u);
+  seg.setNumberOfThreads(2);
+  EXPECT_EQ(seg.getNumberOfThreads(), 2u);
+  EXPECT_THROW(seg.setNumberOfThreads(65), std::invalid_argument);
   EXPECT_THROW(facyl::segmentTabletop(f, {}, Eigen::Vector3f::Zero(), bad, w),
                std::invalid_argument);
   const facyl::TabletopSegmentationParameters p;

@@ -8,6 +8,8 @@
 #include "object_grid.h"
 #include "object_joins.h"
 
+#include <facyl/features/parallel.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -77,37 +79,43 @@ private:
   std::vector<int> parent_;
 };
 
+/** The valid pixels a block of a per-pixel pass takes (blocks run on several threads). */
+constexpr std::size_t kPixelBlock = 8192;
+
 /** Per valid pixel: the mean of the valid points among the 5 pixels centred on it across a
- * test direction (vertical for horizontal tests), when at least 3 are valid. */
+ * test direction (vertical for horizontal tests), when at least 3 are valid; on \a threads
+ * threads (each pixel alone: the same means on any number). */
 struct AcrossMeans {
   std::vector<Eigen::Vector3f> mean;
   std::vector<std::uint8_t> ok;
 };
 
 AcrossMeans
-acrossMeans(const Grid& grid, bool horizontal)
+acrossMeans(const Grid& grid, bool horizontal, int threads)
 {
   AcrossMeans m;
   m.mean.resize(grid.size());
   m.ok.assign(grid.size(), 0);
-  for (std::size_t c = 0; c < grid.size(); ++c) {
-    int u, v;
-    grid.position(static_cast<int>(c), u, v);
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    int n = 0;
-    int line[5]; // across the test direction: a column for horizontal tests
-    grid.across(u, v, horizontal, line);
-    for (const int b : line) {
-      if (b >= 0) {
-        sum += grid.point(b);
-        ++n;
+  parallelFor(grid.size(), threads, kPixelBlock, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      int u, v;
+      grid.position(static_cast<int>(c), u, v);
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      int n = 0;
+      int line[5]; // across the test direction: a column for horizontal tests
+      grid.across(u, v, horizontal, line);
+      for (const int b : line) {
+        if (b >= 0) {
+          sum += grid.point(b);
+          ++n;
+        }
+      }
+      if (n >= 3) {
+        m.mean[c] = sum / static_cast<float>(n);
+        m.ok[c] = 1;
       }
     }
-    if (n >= 3) {
-      m.mean[c] = sum / static_cast<float>(n);
-      m.ok[c] = 1;
-    }
-  }
+  });
   return m;
 }
 
@@ -124,10 +132,11 @@ roundHalfAway(float x)
 }
 
 /** Per valid pixel: 1 on a concave crease (see concaveCreases); with \a weak, also 1 in it
- * where the surface turns by half the crease angle (kWeakCrease), in the same pass. */
+ * where the surface turns by half the crease angle (kWeakCrease), in the same pass; on
+ * \a threads threads (each pixel alone: the same answer on any number). */
 std::vector<std::uint8_t>
 creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
-        const ObjectSegmentationParameters& p, std::vector<std::uint8_t>* weak = nullptr)
+        const ObjectSegmentationParameters& p, std::vector<std::uint8_t>* weak, int threads)
 {
   std::vector<std::uint8_t> crease(grid.size(), 0);
   if (weak)
@@ -136,39 +145,42 @@ creases(const Grid& grid, float focal, const Eigen::Vector3f& viewpoint,
     return crease;
   const float cos_max = std::cos(p.crease_angle);
   const float cos_weak = weak ? std::cos(kWeakCrease * p.crease_angle) : cos_max;
-  const AcrossMeans across[2] = {acrossMeans(grid, true), acrossMeans(grid, false)};
-  for (std::size_t c = 0; c < grid.size(); ++c) {
-    const float range = grid.range(static_cast<int>(c));
-    const float span = std::max(p.crease_span, p.crease_span_z2 * range * range);
-    const int k = std::clamp(static_cast<int>(roundHalfAway(span * focal / range)), 2, 24);
-    int u, v;
-    grid.position(static_cast<int>(c), u, v);
-    for (int dir = 0; dir < 2 && !crease[c]; ++dir) {
-      const AcrossMeans& m = across[dir];
-      const int a = dir == 0 ? grid.at(u - k, v) : grid.at(u, v - k);
-      const int z = dir == 0 ? grid.at(u + k, v) : grid.at(u, v + k);
-      if (a < 0 || z < 0 || !m.ok[c] || !m.ok[static_cast<std::size_t>(a)] ||
-          !m.ok[static_cast<std::size_t>(z)])
-        continue;
-      const Eigen::Vector3f& pa = m.mean[static_cast<std::size_t>(a)];
-      const Eigen::Vector3f& pb = m.mean[c];
-      const Eigen::Vector3f& pc = m.mean[static_cast<std::size_t>(z)];
-      const Eigen::Vector3f e1 = pb - pa, e2 = pc - pb;
-      const float l1 = e1.norm(), l2 = e2.norm();
-      // Much longer than the span: a depth jump, which the connection test handles.
-      if (!(l1 > 0.f && l2 > 0.f) || l1 > 8.f * span || l2 > 8.f * span)
-        continue;
-      const float turn = e1.dot(e2);
-      if (turn > cos_weak * l1 * l2)
-        continue;
-      // Concave seen from the sensor: the middle lies behind the chord.
-      if ((pb - 0.5f * (pa + pc)).dot(pb - viewpoint) <= 0.f)
-        continue;
-      if (weak)
-        (*weak)[c] = 1;
-      crease[c] = turn <= cos_max * l1 * l2;
+  const AcrossMeans across[2] = {acrossMeans(grid, true, threads),
+                                 acrossMeans(grid, false, threads)};
+  parallelFor(grid.size(), threads, kPixelBlock, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const float range = grid.range(static_cast<int>(c));
+      const float span = std::max(p.crease_span, p.crease_span_z2 * range * range);
+      const int k = std::clamp(static_cast<int>(roundHalfAway(span * focal / range)), 2, 24);
+      int u, v;
+      grid.position(static_cast<int>(c), u, v);
+      for (int dir = 0; dir < 2 && !crease[c]; ++dir) {
+        const AcrossMeans& m = across[dir];
+        const int a = dir == 0 ? grid.at(u - k, v) : grid.at(u, v - k);
+        const int z = dir == 0 ? grid.at(u + k, v) : grid.at(u, v + k);
+        if (a < 0 || z < 0 || !m.ok[c] || !m.ok[static_cast<std::size_t>(a)] ||
+            !m.ok[static_cast<std::size_t>(z)])
+          continue;
+        const Eigen::Vector3f& pa = m.mean[static_cast<std::size_t>(a)];
+        const Eigen::Vector3f& pb = m.mean[c];
+        const Eigen::Vector3f& pc = m.mean[static_cast<std::size_t>(z)];
+        const Eigen::Vector3f e1 = pb - pa, e2 = pc - pb;
+        const float l1 = e1.norm(), l2 = e2.norm();
+        // Much longer than the span: a depth jump, which the connection test handles.
+        if (!(l1 > 0.f && l2 > 0.f) || l1 > 8.f * span || l2 > 8.f * span)
+          continue;
+        const float turn = e1.dot(e2);
+        if (turn > cos_weak * l1 * l2)
+          continue;
+        // Concave seen from the sensor: the middle lies behind the chord.
+        if ((pb - 0.5f * (pa + pc)).dot(pb - viewpoint) <= 0.f)
+          continue;
+        if (weak)
+          (*weak)[c] = 1;
+        crease[c] = turn <= cos_max * l1 * l2;
+      }
     }
-  }
+  });
   return crease;
 }
 
@@ -325,7 +337,7 @@ joinApartPixels(const Grid& grid, const ColourImage* colour, const std::vector<s
 std::vector<pcl::Indices>
 segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float focal,
             const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-            const ColourImage* colour = nullptr)
+            const ColourImage* colour, int threads)
 {
   if (grid.size() == 0)
     return {};
@@ -333,7 +345,7 @@ segmentGrid(const Grid& grid, const std::vector<std::uint8_t>& has_depth, float 
     colour = nullptr; // colour edges off
   std::vector<std::uint8_t> weak;
   const std::vector<std::uint8_t> crease =
-    creases(grid, focal, viewpoint, p, colour ? &weak : nullptr);
+    creases(grid, focal, viewpoint, p, colour ? &weak : nullptr, threads);
   float threshold2 = 0.f;
   const std::vector<std::uint8_t> cut = colourCuts(grid, colour, weak, crease, p, threshold2);
   const auto apart = [&](int a) {
@@ -423,7 +435,8 @@ concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& cloud, float focal,
   if (!cloud.isOrganized() || !(focal > 0.f))
     return out;
   const edge_aware::Grid grid(cloud, focal, viewpoint, p);
-  const std::vector<std::uint8_t> crease = edge_aware::creases(grid, focal, viewpoint, p);
+  const std::vector<std::uint8_t> crease =
+    edge_aware::creases(grid, focal, viewpoint, p, nullptr, 1);
   for (std::size_t c = 0; c < grid.size(); ++c)
     out[grid.pixel(static_cast<int>(c))] = crease[c];
   return out;
@@ -497,14 +510,14 @@ std::vector<pcl::Indices>
 segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                         const std::vector<std::uint8_t>& has_depth, float focal,
                         const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-                        const DepthBand* noise, const pcl::Indices* finite)
+                        const DepthBand* noise, const pcl::Indices* finite, int threads)
 {
   if (!cloud.isOrganized() || !(focal > 0.f) || has_depth.size() != cloud.size())
     return {};
   if (finite && !strictlyAscending(*finite))
     finite = nullptr; // not strictly ascending: the grid's order is the image's, so scan
   return edge_aware::segmentGrid(edge_aware::Grid(cloud, focal, viewpoint, p, noise, finite),
-                                 has_depth, focal, viewpoint, p);
+                                 has_depth, focal, viewpoint, p, nullptr, threads);
 }
 
 std::vector<pcl::Indices>
@@ -512,7 +525,7 @@ segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixe
                         std::uint32_t width, std::uint32_t height,
                         const std::vector<std::uint8_t>& has_depth, float focal,
                         const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& p,
-                        const DepthBand* noise, const ColourImage* colour)
+                        const DepthBand* noise, const ColourImage* colour, int threads)
 {
   const std::size_t size = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (width == 0 || height < 2 || !(focal > 0.f) || has_depth.size() != size ||
@@ -522,7 +535,7 @@ segmentObjectsOrganized(const Eigen::Matrix3Xf& points, const pcl::Indices& pixe
   return edge_aware::segmentGrid(edge_aware::Grid(points, pixels, static_cast<int>(width),
                                                   static_cast<int>(height), focal, viewpoint, p,
                                                   noise),
-                                 has_depth, focal, viewpoint, p, colour);
+                                 has_depth, focal, viewpoint, p, colour, threads);
 }
 
 } // namespace facyl

@@ -88,7 +88,8 @@ struct TabletopRecognizerParameters {
   float reject_below{0.f};
   int neighbours{kDefaultNeighbours}; ///< k of the normal/curvature estimation, in [5, 200]
   /** Clusters fitted at once, each thread with a cue estimation and estimators of its own;
-   * threads that no cluster takes help with a cluster's cues and retries. 0 (default) the
+   * threads that no cluster takes help with a cluster's cues and retries; the segmentation's
+   * crease test runs on as many (TabletopSegmentation::setNumberOfThreads). 0 (default) the
    * hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting threads sleep
    * (parallelFor), and the results do not depend on it. */
   int threads{0};

@@ -116,13 +116,13 @@ std::vector<std::uint8_t> concaveCreases(const pcl::PointCloud<pcl::PointXYZ>& c
  *        surfaces do not shatter into fragments.
  * \param finite the indices of the finite points of \a cloud, ascending, when the caller knows
  *        them (nullptr: the cloud is scanned for them); a VGA frame is then not read whole.
+ * \param threads threads for the per-pixel crease test (threadCount: 0 the hardware's
+ *        concurrency); the segments are the same on any number. Waiting threads sleep.
  * \return the segments' point indices, ascending, in no particular order of segments. */
-std::vector<pcl::Indices> segmentObjectsOrganized(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                                                  const std::vector<std::uint8_t>& has_depth,
-                                                  float focal, const Eigen::Vector3f& viewpoint,
-                                                  const ObjectSegmentationParameters& params,
-                                                  const DepthBand* noise = nullptr,
-                                                  const pcl::Indices* finite = nullptr);
+std::vector<pcl::Indices> segmentObjectsOrganized(
+  const pcl::PointCloud<pcl::PointXYZ>& cloud, const std::vector<std::uint8_t>& has_depth,
+  float focal, const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& params,
+  const DepthBand* noise = nullptr, const pcl::Indices* finite = nullptr, int threads = 1);
 
 /** \brief Pixels of two image regions: columns \a u and rows \a v, one entry per pixel. */
 struct PixelList {
@@ -146,11 +146,11 @@ bool strictlyAscending(const pcl::Indices& indices);
  * columns are left out) at the pixels \a pixels (strictly ascending indices into a \a width x
  * \a height image). The same segments as the cloud version on a cloud that holds these points
  * and NaN elsewhere, without an image-sized cloud to fill. Empty on invalid input (sizes that
- * disagree, pixels out of the image or not ascending, focal <= 0). */
+ * disagree, pixels out of the image or not ascending, focal <= 0); \a threads as there. */
 std::vector<pcl::Indices> segmentObjectsOrganized(
   const Eigen::Matrix3Xf& points, const pcl::Indices& pixels, std::uint32_t width,
   std::uint32_t height, const std::vector<std::uint8_t>& has_depth, float focal,
   const Eigen::Vector3f& viewpoint, const ObjectSegmentationParameters& params,
-  const DepthBand* noise = nullptr, const ColourImage* colour = nullptr);
+  const DepthBand* noise = nullptr, const ColourImage* colour = nullptr, int threads = 1);
 
 } // namespace facyl

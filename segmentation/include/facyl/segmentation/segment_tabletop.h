@@ -321,9 +321,13 @@ template <typename T> struct UninitialisedAllocator : std::allocator<T> {
  * used by two calls at a time. */
 struct TabletopWorkspace {
   TabletopWorkspace() = default;
-  TabletopWorkspace(const TabletopWorkspace&) {}
-  TabletopWorkspace& operator=(const TabletopWorkspace&)
+  TabletopWorkspace(const TabletopWorkspace& other)
+      : threads(other.threads)
   {
+  }
+  TabletopWorkspace& operator=(const TabletopWorkspace& other)
+  {
+    threads = other.threads;
     return *this;
   }
   TabletopWorkspace(TabletopWorkspace&&) = default;
@@ -344,6 +348,10 @@ struct TabletopWorkspace {
   std::vector<float, detail::UninitialisedAllocator<float>> lattice;
   /** The colours of the lattice's points (blue, green, red bytes), when the frame has them. */
   std::vector<std::uint8_t, detail::UninitialisedAllocator<std::uint8_t>> lattice_colours;
+  /** Threads for the per-pixel passes that run on several (the object segmentation's crease
+   * test: segmentObjectsOrganized's threads): 0 the hardware's concurrency, 1 the caller's
+   * alone; the segments are the same on any number. Kept by copies, unlike the buffers. */
+  int threads{0};
 };
 
 /** \brief The supports and objects of a frame. */

@@ -19,6 +19,7 @@
 
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -185,6 +186,21 @@ public:
   const Eigen::Vector3f& getUpDirection() const
   {
     return up_;
+  }
+  /** \brief Threads for the per-pixel passes that run on several (the object segmentation's
+   * crease test), as PCL's setNumberOfThreads: 0 (default) the hardware's concurrency, 1 the
+   * caller's thread alone; at most 64 (std::invalid_argument beyond). The results are the same
+   * on any number; waiting threads sleep, never spin. */
+  void setNumberOfThreads(unsigned int threads = 0)
+  {
+    if (threads > 64)
+      throw std::invalid_argument("facyl::TabletopSegmentation::setNumberOfThreads: " +
+                                  std::to_string(threads) + " threads is not in [0, 64]");
+    workspace_.threads = static_cast<int>(threads);
+  }
+  unsigned int getNumberOfThreads() const
+  {
+    return static_cast<unsigned int>(workspace_.threads);
   }
 
   /** \brief Where the support of the last frames of a stream is expected in this cloud (in the

@@ -182,6 +182,7 @@ TabletopCylinderRecognizer<PointT>::recognizeInSensorFrame(std::vector<Recognize
   segmentation_.setCamera(camera_);
   segmentation_.setUpDirection(up_);
   segmentation_.setSupportPrior(prior_);
+  segmentation_.setNumberOfThreads(static_cast<unsigned int>(fitters_.size()));
   // The cloud is in the sensor's frame, its far points gone (recognize() saw to it).
   const bool segmented = segmentation_.segmentInSensorFrame(clusters);
   timing_.segmentation = ms(t0, Clock::now());
