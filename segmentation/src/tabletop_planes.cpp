@@ -5,6 +5,7 @@
  */
 #include "tabletop_steps.h"
 
+#include <facyl/features/parallel.h>
 #include <facyl/features/polygon.h>
 
 #include <pcl/common/point_tests.h>
@@ -39,10 +40,10 @@ regionSettings(const TabletopSegmentationParameters& params)
 /** The grid of blocks of \a step pixels: each cell the mean of the pixels of its block with
  * depth near the first one's, its normal, and its first pixel; with \a twice, also the grid of
  * 2 \a step pixels, from the same pass over the image; with \a has_depth, also which pixels
- * have depth (the object segmentation's occlusion test). */
+ * have depth (the object segmentation's occlusion test); on \a threads threads. */
 void
 planeGrid(const Setup& setup, int step, PlaneGrid& grid, PlaneGrid* twice,
-          std::vector<std::uint8_t>* has_depth)
+          std::vector<std::uint8_t>* has_depth, int threads)
 {
   const PointFrame& frame = setup.frame;
   const int w = static_cast<int>(frame.width), h = static_cast<int>(frame.height);
@@ -70,24 +71,30 @@ planeGrid(const Setup& setup, int step, PlaneGrid& grid, PlaneGrid* twice,
   const float* const xyz = frame.xyz;
   const std::size_t stride = frame.stride;
   std::uint8_t* const depth = has_depth ? has_depth->data() : nullptr;
-  for (int v = 0; v < h; ++v) {
-    const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
-    const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
-    const float* p = xyz + base * stride;
-    for (int u = 0; u < w; ++u, p += stride) {
-      const std::size_t idx = base + static_cast<std::size_t>(u);
-      const bool finite = std::isfinite(p[2]) && std::isfinite(p[0]) && std::isfinite(p[1]);
-      if (depth)
-        depth[idx] = finite;
-      if (!finite || !(every || allowed[idx]))
-        continue;
-      const auto uu = static_cast<std::size_t>(u);
-      const Eigen::Map<const Eigen::Vector3f> q(p);
-      fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx), q);
-      if (coarse)
-        coarse->addTo(coarse_row + coarse->column_block[uu], static_cast<pcl::index_t>(idx), q);
+  // Bands of whole rows of the largest blocks on the workspace's threads: each block is
+  // filled by one thread, in row order, so the means are the same on any number.
+  const int band = twice ? 2 * step : step;
+  const auto bands = static_cast<std::size_t>((h + band - 1) / band);
+  parallelFor(bands, threads, 8, [&](std::size_t b0, std::size_t b1) {
+    for (int v = static_cast<int>(b0) * band; v < std::min(h, static_cast<int>(b1) * band); ++v) {
+      const std::size_t base = static_cast<std::size_t>(v) * static_cast<std::size_t>(w);
+      const std::size_t fine_row = fine.rowBase(v), coarse_row = coarse ? coarse->rowBase(v) : 0;
+      const float* p = xyz + base * stride;
+      for (int u = 0; u < w; ++u, p += stride) {
+        const std::size_t idx = base + static_cast<std::size_t>(u);
+        const bool finite = std::isfinite(p[2]) && std::isfinite(p[0]) && std::isfinite(p[1]);
+        if (depth)
+          depth[idx] = finite;
+        if (!finite || !(every || allowed[idx]))
+          continue;
+        const auto uu = static_cast<std::size_t>(u);
+        const Eigen::Map<const Eigen::Vector3f> q(p);
+        fine.addTo(fine_row + fine.column_block[uu], static_cast<pcl::index_t>(idx), q);
+        if (coarse)
+          coarse->addTo(coarse_row + coarse->column_block[uu], static_cast<pcl::index_t>(idx), q);
+      }
     }
-  }
+  });
   finishPlaneGrid(fine, w, grid);
   if (twice)
     finishPlaneGrid(*coarse, w, *twice);
@@ -208,13 +215,14 @@ findPlanesOrganized(const Setup& setup, FrameCues& cues, TabletopWorkspace& work
   for (int step = first; step <= 16; step *= 2) {
     if (step == first) {
       // The first pass also records which pixels have depth.
-      planeGrid(setup, step, grid, two_grids ? &twice : nullptr, &workspace.has_depth);
+      planeGrid(setup, step, grid, two_grids ? &twice : nullptr, &workspace.has_depth,
+                workspace.threads);
       cues.has_depth = &workspace.has_depth;
     }
     else if (step == 2 * first && two_grids)
       grid = twice;
     else
-      planeGrid(setup, step, grid, nullptr, nullptr);
+      planeGrid(setup, step, grid, nullptr, nullptr, workspace.threads);
     if (step == first) {
       cues.focal = setup.camera.valid()
                      ? setup.camera.fx
