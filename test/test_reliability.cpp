@@ -358,6 +358,33 @@ TEST(Reliability, TheTableIsFoundAtHighResolutionAndWithMissingPixels)
 
 // ------------------------------------------------------------------------ parallel loop
 
+TEST(Reliability, ShortLoopsTakeHelpersOnlyWhereCoresAreIdle)
+{
+  EXPECT_EQ(facyl::threadsForIdleCores(1), 1);
+  const int all = facyl::threadCount(0);
+  const int now = facyl::threadsForIdleCores(2);
+  EXPECT_TRUE(now == 1 || now == 2);
+  // Every core busy (a spinning thread each, this one waiting beside them): no helper.
+  if (facyl::runnableTasks() < 0)
+    GTEST_SKIP() << "no count of runnable tasks here";
+  std::atomic<bool> stop{false};
+  std::atomic<int> spinning{0};
+  std::vector<std::thread> busy;
+  for (int k = 0; k < all; ++k)
+    busy.emplace_back([&] {
+      ++spinning;
+      while (!stop.load())
+        ;
+    });
+  while (spinning.load() < all)
+    std::this_thread::yield();
+  EXPECT_GE(facyl::runnableTasks(), all);
+  EXPECT_EQ(facyl::threadsForIdleCores(2), 1);
+  stop = true;
+  for (auto& t : busy)
+    t.join();
+}
+
 TEST(Reliability, ParallelForCoversEveryItemOnceAndRethrows)
 {
   for (const int threads : {0, 1, 2, 8}) {

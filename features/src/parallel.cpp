@@ -6,6 +6,7 @@
 
 #include <pthread.h>
 
+#include <cstdio>
 #include <deque>
 #include <system_error>
 
@@ -117,4 +118,30 @@ withdraw(HelperJob& job)
 }
 
 } // namespace detail
+
+int
+runnableTasks()
+{
+  // "0.52 0.58 0.59 3/812 12345": the fourth field is runnable / all tasks.
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  if (!f)
+    return -1;
+  double a, b, c;
+  int running = -1, all = 0;
+  const int read = std::fscanf(f, "%lf %lf %lf %d/%d", &a, &b, &c, &running, &all);
+  std::fclose(f);
+  return read == 5 && running > 0 ? running : -1;
+}
+
+int
+threadsForIdleCores(int threads)
+{
+  const int t = threadCount(threads);
+  if (t <= 1)
+    return 1;
+  const int running = runnableTasks();
+  const int cores = threadCount(0);
+  return running < 0 || running + (t - 1) <= cores ? t : 1;
+}
+
 } // namespace facyl

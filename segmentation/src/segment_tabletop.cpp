@@ -5,6 +5,8 @@
  */
 #include "tabletop_steps.h"
 
+#include <facyl/features/parallel.h>
+
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -162,7 +164,8 @@ searchedAsImage(const PointFrame& frame, const TabletopSegmentationParameters& p
 
 Setup
 makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
-          const PinholeCamera& camera, const Eigen::Vector3f& up, const SupportPrior* prior)
+          const PinholeCamera& camera, const Eigen::Vector3f& up, const SupportPrior* prior,
+          int threads)
 {
   // The prior guides the choice among the planes objects stand on (ObjectsStanding).
   const bool use_prior = prior && prior->valid() &&
@@ -173,7 +176,8 @@ makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
                up,
                planeStep(frame, params),
                searchedAsImage(frame, params),
-               use_prior ? prior : nullptr};
+               use_prior ? prior : nullptr,
+               threads};
 }
 
 void
@@ -249,7 +253,8 @@ segmentTabletop(const PointFrame& frame, const PinholeCamera& camera, const Eige
   if ((frame.size > 0 && !frame.xyz) || frame.stride < 3)
     throw std::invalid_argument("facyl::segmentTabletop: a frame needs its points' memory and "
                                 "a stride of at least 3 floats");
-  const tabletop::Setup setup = tabletop::makeSetup(frame, params, camera, up, prior);
+  const tabletop::Setup setup =
+    tabletop::makeSetup(frame, params, camera, up, prior, threadsForIdleCores(workspace.threads));
   const int step = latticeStep(frame, params);
   TabletopSegments out;
   if (step > 1)

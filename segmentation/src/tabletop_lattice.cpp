@@ -242,8 +242,8 @@ segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace)
   const PinholeCamera camera = latticeCamera(setup.camera, step, lattice.width, lattice.height);
   const double t_lattice = ms(t0);
   FrameCues cues;
-  TabletopSegments out =
-    segmentFrame(makeSetup(lattice, params, camera, setup.up, setup.prior), cues, workspace);
+  TabletopSegments out = segmentFrame(
+    makeSetup(lattice, params, camera, setup.up, setup.prior, setup.threads), cues, workspace);
   const auto t1 = Clock::now();
   out.clusters = clustersAtFullResolution(setup, cues, out.clusters, out.supports, lattice, step);
   supportsAtFullResolution(setup.frame, step, out.supports);

@@ -48,7 +48,7 @@ clusterOrganized(const Setup& setup, const FrameCues& cues, const pcl::Indices& 
     const ColourImage colour{frame.bgr, frame.bgr_stride};
     return segmentObjectsOrganized(points, pixels, frame.width, frame.height, *has_depth,
                                    cues.focal, frame.viewpoint, params.objects, cues.noiseBand(),
-                                   frame.bgr ? &colour : nullptr, workspace.threads);
+                                   frame.bgr ? &colour : nullptr, setup.threads);
   }
   // A sparse copy with only the object points finite: the components then never visit the
   // rest of the image. (Buffers kept between calls: fresh VGA-sized allocations cost more in

@@ -216,13 +216,13 @@ findPlanesOrganized(const Setup& setup, FrameCues& cues, TabletopWorkspace& work
     if (step == first) {
       // The first pass also records which pixels have depth.
       planeGrid(setup, step, grid, two_grids ? &twice : nullptr, &workspace.has_depth,
-                workspace.threads);
+                setup.threads);
       cues.has_depth = &workspace.has_depth;
     }
     else if (step == 2 * first && two_grids)
       grid = twice;
     else
-      planeGrid(setup, step, grid, nullptr, nullptr, workspace.threads);
+      planeGrid(setup, step, grid, nullptr, nullptr, setup.threads);
     if (step == first) {
       cues.focal = setup.camera.valid()
                      ? setup.camera.fx

@@ -31,6 +31,9 @@ struct Setup {
   bool as_image;  ///< searched as an image (see searchedAsImage), else as a point set
   /** Where the last frames' support is expected (a valid SupportPrior), nullptr: none. */
   const SupportPrior* prior{nullptr};
+  /** Threads of the per-pixel passes: the workspace's while the helpers find idle cores
+   * (threadsForIdleCores), else 1. */
+  int threads{1};
 };
 
 /** The block size of the plane search on organized frames: plane_step, or width / 160. */
@@ -44,7 +47,7 @@ bool searchedAsImage(const PointFrame& frame, const TabletopSegmentationParamete
 /** The Setup of a run; \a prior is kept only when valid (SupportPrior::valid). */
 Setup makeSetup(const PointFrame& frame, const TabletopSegmentationParameters& params,
                 const PinholeCamera& camera, const Eigen::Vector3f& up,
-                const SupportPrior* prior = nullptr);
+                const SupportPrior* prior = nullptr, int threads = 1);
 
 /** Calls \a f with each index of the points to segment (the frame's indices, else all). */
 template <typename F>

@@ -41,6 +41,17 @@ parallelWorkers(std::size_t n, int threads, std::size_t grain)
     std::max<std::size_t>(1, std::min<std::size_t>(blocks, static_cast<std::size_t>(t))));
 }
 
+/** \brief Tasks ready to run on the machine now, this thread included (the kernel's count of
+ * runnable tasks, /proc/loadavg); -1 where the system does not tell. */
+int runnableTasks();
+
+/** \brief The threads for short loops that a sleeping helper would stall when it is preempted
+ * (a loop waits for its slowest block): threadCount(\a threads) while the helpers it adds find
+ * idle cores (runnableTasks() plus the helpers at most the hardware's concurrency, or the count
+ * unknown), else 1. Beside busy processes a helper gets a share of a core, and the loop then
+ * waits for a time slice of the scheduler rather than for its work. */
+int threadsForIdleCores(int threads);
+
 namespace detail {
 
 /** \brief A parallel loop's work offered to the helper threads: each helper that takes it calls

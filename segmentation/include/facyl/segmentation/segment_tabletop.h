@@ -348,9 +348,11 @@ struct TabletopWorkspace {
   std::vector<float, detail::UninitialisedAllocator<float>> lattice;
   /** The colours of the lattice's points (blue, green, red bytes), when the frame has them. */
   std::vector<std::uint8_t, detail::UninitialisedAllocator<std::uint8_t>> lattice_colours;
-  /** Threads for the per-pixel passes that run on several (the object segmentation's crease
-   * test: segmentObjectsOrganized's threads): 0 the hardware's concurrency, 1 the caller's
-   * alone; the segments are the same on any number. Kept by copies, unlike the buffers. */
+  /** Threads for the per-pixel passes that run on several (the plane grid's pass, the object
+   * segmentation's crease test): 0 the hardware's concurrency, 1 the caller's alone; more than
+   * one only while the helpers find idle cores (threadsForIdleCores: beside busy processes a
+   * preempted helper would stall the pass). The segments are the same on any number. Kept by
+   * copies, unlike the buffers. */
   int threads{0};
 };
 

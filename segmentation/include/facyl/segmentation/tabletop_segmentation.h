@@ -187,10 +187,11 @@ public:
   {
     return up_;
   }
-  /** \brief Threads for the per-pixel passes that run on several (the object segmentation's
-   * crease test), as PCL's setNumberOfThreads: 0 (default) the hardware's concurrency, 1 the
-   * caller's thread alone; at most 64 (std::invalid_argument beyond). The results are the same
-   * on any number; waiting threads sleep, never spin. */
+  /** \brief Threads for the per-pixel passes that run on several (the plane grid's pass, the
+   * object segmentation's crease test), as PCL's setNumberOfThreads: 0 (default) the
+   * hardware's concurrency, 1 the caller's thread alone; at most 64 (std::invalid_argument
+   * beyond). More than one only while the helpers find idle cores (threadsForIdleCores). The
+   * results are the same on any number; waiting threads sleep, never spin. */
   void setNumberOfThreads(unsigned int threads = 0)
   {
     if (threads > 64)
