@@ -134,14 +134,17 @@ runnableTasks()
 }
 
 int
-threadsForIdleCores(int threads)
+threadsForIdleCores(int threads, int running, int cores)
 {
   const int t = threadCount(threads);
-  if (t <= 1)
-    return 1;
-  const int running = runnableTasks();
-  const int cores = threadCount(0);
-  return running < 0 || running + (t - 1) <= cores ? t : 1;
+  return t > 1 && (running < 0 || running + (t - 1) <= cores) ? t : 1;
+}
+
+int
+threadsForIdleCores(int threads)
+{
+  return threadCount(threads) > 1 ? threadsForIdleCores(threads, runnableTasks(), threadCount(0))
+                                  : 1;
 }
 
 } // namespace facyl

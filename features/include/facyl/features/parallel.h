@@ -52,6 +52,11 @@ int runnableTasks();
  * waits for a time slice of the scheduler rather than for its work. */
 int threadsForIdleCores(int threads);
 
+/** \brief threadsForIdleCores's rule on given counts: threadCount(\a threads) when \a running
+ * (runnable tasks, the caller included; negative: unknown) plus the helpers is at most
+ * \a cores, else 1. */
+int threadsForIdleCores(int threads, int running, int cores);
+
 namespace detail {
 
 /** \brief A parallel loop's work offered to the helper threads: each helper that takes it calls
