@@ -70,19 +70,28 @@ pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& pol
   return inside;
 }
 
+Eigen::AlignedBox2f
+polygonReach(const std::vector<Eigen::Vector2f>& polygon, float distance)
+{
+  Eigen::AlignedBox2f box;
+  for (const auto& v : polygon)
+    box.extend(v);
+  if (!box.isEmpty()) {
+    box.min().array() -= distance + 1e-3f;
+    box.max().array() += distance + 1e-3f;
+  }
+  return box;
+}
+
 std::size_t
 pointsInPolygon(const Eigen::Matrix3Xf& pts, const Eigen::Affine3f& to_plane,
                 const std::vector<Eigen::Vector2f>& polygon)
 {
   if (polygon.empty())
     return 0;
-  // Outside the box by a millimetre (float rounding of the edges' crossings), the even-odd
-  // test is false: no edge straddles the point's row, or each that does lies on one side.
-  Eigen::AlignedBox2f box;
-  for (const auto& v : polygon)
-    box.extend(v);
-  box.min().array() -= 1e-3f;
-  box.max().array() += 1e-3f;
+  // Outside the polygon's reach the even-odd test is false: no edge straddles the point's
+  // row, or each that does lies on one side.
+  const Eigen::AlignedBox2f box = polygonReach(polygon, 0.f);
   std::size_t in = 0;
   for (Eigen::Index k = 0; k < pts.cols(); ++k) {
     const Eigen::Vector2f p = (to_plane * Eigen::Vector3f(pts.col(k))).head<2>();

@@ -52,13 +52,9 @@ supportHull(const Setup& setup, const Eigen::Affine3f& frame, const pcl::Indices
   // image row can be a vertex.
   const std::vector<Eigen::Vector2f> region = convexHull2D(points); // none: every point
   constexpr float grow = 0.05f;
-  // The region's box grown by as much and a millimetre (float rounding): nothing outside it is
-  // near the region, which most of an infinite plane's points are not.
-  Eigen::AlignedBox2f reach;
-  for (const auto& v : region)
-    reach.extend(v);
-  reach.min().array() -= grow + 1e-3f;
-  reach.max().array() += grow + 1e-3f;
+  // Nothing outside the region's reach is near it, which most of an infinite plane's points
+  // are not.
+  const Eigen::AlignedBox2f reach = polygonReach(region, grow);
   const auto near_region = [&](const Eigen::Vector2f& p) {
     if (!c || region.size() < 3)
       return true;

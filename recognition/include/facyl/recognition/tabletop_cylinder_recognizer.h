@@ -68,8 +68,9 @@ struct TabletopRecognizerParameters {
   float min_explained_share{0.75f}; ///< in (0, 1]
   /** Stacked objects that one cylinder was fitted across (a can on a tin: the side is two
    * sections, findSectionStep): the cluster is cut at the step and each part recognized on its
-   * own, when one of them is a cylinder; at most this many objects in one stack. 1 turns it
-   * off; in [1, 8]. */
+   * own, when one of them is a cylinder; a part may be cut again, up to this many levels of
+   * a stack (N - 1 cuts deep: 2 one cut, 3 a part of a cut cut once more). 1 turns it off;
+   * in [1, 8]. */
   std::size_t max_stacked_objects{3};
   /** A cylinder found in a larger cluster is judged on the points within this distance (m,
    * at least; 15% of its radius beyond its surface, half its radius beyond its ends). */
@@ -89,7 +90,8 @@ struct TabletopRecognizerParameters {
   int neighbours{kDefaultNeighbours}; ///< k of the normal/curvature estimation, in [5, 200]
   /** Clusters fitted at once, each thread with a cue estimation and estimators of its own;
    * threads that no cluster takes help with a cluster's cues and retries; the segmentation's
-   * crease test runs on as many (TabletopSegmentation::setNumberOfThreads). 0 (default) the
+   * per-pixel passes run on as many while cores are idle (TabletopSegmentation::
+   * setNumberOfThreads). 0 (default) the
    * hardware's concurrency, 1 the caller's thread alone; in [0, 64]. Waiting threads sleep
    * (parallelFor), and the results do not depend on it. */
   int threads{0};
@@ -292,11 +294,11 @@ private:
    * objects). */
   void recognizeCluster(Fitter& fitter, TabletopCluster cluster, float p_network,
                         std::vector<RecognizedObject>& objects) const;
-  /** recognizeCluster for a cluster that may be cut into at most \a stacked stacked objects. */
+  /** recognizeCluster for a cluster that may be cut \a stacked - 1 levels deep (splitStack). */
   void recognizeStack(Fitter& fitter, TabletopCluster cluster, float p_network, std::size_t stacked,
                       std::vector<RecognizedObject>& objects) const;
   /** When \a fit's side is two sections (findSectionStep): \a whole cut at the step, each part
-   * recognized (recognizeStack, \a stacked objects at most in all) and appended to \a objects
+   * recognized (recognizeStack, \a stacked - 1 levels) and appended to \a objects
    * when one of them is a cylinder. \return whether it was cut. */
   bool splitStack(Fitter& fitter, const RecognizedObject& whole, const FitInput& input,
                   const Fit& fit, float p_network, std::size_t stacked,

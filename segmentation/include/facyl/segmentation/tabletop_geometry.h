@@ -115,6 +115,10 @@ Eigen::Affine3f planeFrame(const Eigen::Vector4f& plane, const Eigen::Vector3f& 
 /** \brief Even-odd test of \a p against a simple polygon (vertices in order). */
 bool pointInPolygon(const Eigen::Vector2f& p, const std::vector<Eigen::Vector2f>& polygon);
 
+/** \brief The box of \a polygon grown by \a distance and a millimetre (float rounding): no
+ * point outside it lies in the polygon or within \a distance of it. Empty for no vertex. */
+Eigen::AlignedBox2f polygonReach(const std::vector<Eigen::Vector2f>& polygon, float distance);
+
 /** \brief How many of the points \a pts (3 x n), taken into a plane's coordinates by
  * \a to_plane, lie in \a polygon (pointInPolygon of their x and y). Points well outside the
  * polygon's box are counted out without the test. */

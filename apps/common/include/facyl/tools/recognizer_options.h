@@ -152,8 +152,8 @@ recognizerOptions()
       "objects; default {};\n1: off)"));
     o.push_back(integerOption<S>(
       "max-stacked", "N", [](auto& s) -> auto& { return s.params.max_stacked_objects; },
-      "objects one cluster is cut into where its side changes\nsection (stacked objects; "
-      "default {}; 1: off)"));
+      "levels a cluster is cut into where its side changes\nsection (stacked objects; a part "
+      "may be cut again;\ndefault {}; 1: off)"));
 
     Option<S> up;
     up.name = "up";
