@@ -881,14 +881,7 @@ TEST(SupportPlanes, PiecesOfAnotherFamilysSurfaceAreNotObjects)
   // that surface: the table's family is chosen.
   facyl::TabletopSceneParameters p = facyl::realisticSceneParameters();
   ASSERT_TRUE(facyl::parseSensorPreset("stereo", p.sensor, p.camera));
-  auto& c = p.camera; // 1280 x 720, the field of view kept (facyl_synth --resolution)
-  const float su = 1280.f / static_cast<float>(c.width), sv = 720.f / static_cast<float>(c.height);
-  c.fx *= su;
-  c.fy *= sv;
-  c.cx = (c.cx + 0.5f) * su - 0.5f;
-  c.cy = (c.cy + 0.5f) * sv - 0.5f;
-  c.width = 1280;
-  c.height = 720;
+  p.camera = facyl::resizedCamera(p.camera, 1280, 720); // as facyl_synth --resolution
   p.seed = 708;
   const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
   Cloud::Ptr cloud(new Cloud(s.cloud));

@@ -262,10 +262,7 @@ TEST(TouchingObjects, ColourEdgesOnTheLattice)
     facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
     p.seed = seed;
     ASSERT_TRUE(facyl::parseSensorPreset("kinect", p.sensor, p.camera));
-    auto& c = p.camera; // the VGA camera at twice the pixels in width, 1.5 times in height
-    c.fx *= 2.f, c.fy *= 1.5f;
-    c.cx = (c.cx + 0.5f) * 2.f - 0.5f, c.cy = (c.cy + 0.5f) * 1.5f - 0.5f;
-    c.width = 1280, c.height = 720;
+    p.camera = facyl::resizedCamera(p.camera, 1280, 720); // the VGA camera's field of view
     const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
     for (const int with : {0, 1}) {
       facyl::TabletopSegmentationParameters params;

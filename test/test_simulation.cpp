@@ -202,6 +202,27 @@ missingOnTable(const facyl::RenderedScene& r)
 
 } // namespace
 
+TEST(PlaneSimulation, ResizedCameraKeepsTheFieldOfView)
+{
+  // VGA to 1280 x 720: the focal lengths scale with the sides, and the corners' pixel edges
+  // and the centre stay where the same rays meet the image.
+  const facyl::CameraIntrinsics vga;
+  const facyl::CameraIntrinsics c = facyl::resizedCamera(vga, 1280, 720);
+  EXPECT_EQ(c.width, 1280);
+  EXPECT_EQ(c.height, 720);
+  EXPECT_FLOAT_EQ(c.fx, 1050.f);
+  EXPECT_FLOAT_EQ(c.fy, 787.5f);
+  EXPECT_FLOAT_EQ(c.cx, 639.5f);
+  EXPECT_FLOAT_EQ(c.cy, 359.5f);
+  for (const float u : {-0.5f, 100.f, 639.5f}) { // ray x / z of a pixel position
+    const float ray = (u - vga.cx) / vga.fx;
+    EXPECT_NEAR(c.fx * ray + c.cx, (u + 0.5f) * 2.f - 0.5f, 1e-3f);
+  }
+  const facyl::CameraIntrinsics back = facyl::resizedCamera(c, vga.width, vga.height);
+  EXPECT_FLOAT_EQ(back.fx, vga.fx);
+  EXPECT_FLOAT_EQ(back.cy, vga.cy);
+}
+
 TEST(RealSensorArtefacts, ExistingPresetsRenderTheirFramesOfBefore)
 {
   // Fingerprints of frames rendered before the artefacts were added: finite pixels, table

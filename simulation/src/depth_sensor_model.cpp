@@ -39,6 +39,21 @@ DepthSensorModel::activeStereo()
   return s;
 }
 
+CameraIntrinsics
+resizedCamera(const CameraIntrinsics& camera, int width, int height)
+{
+  CameraIntrinsics c = camera;
+  const float su = static_cast<float>(width) / static_cast<float>(camera.width);
+  const float sv = static_cast<float>(height) / static_cast<float>(camera.height);
+  c.fx *= su;
+  c.fy *= sv;
+  c.cx = (camera.cx + 0.5f) * su - 0.5f;
+  c.cy = (camera.cy + 0.5f) * sv - 0.5f;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
 bool
 parseSensorPreset(const std::string& name, DepthSensorModel& sensor, CameraIntrinsics& camera)
 {

@@ -97,6 +97,11 @@ struct CameraIntrinsics {
   float fx{525.f}, fy{525.f}, cx{319.5f}, cy{239.5f};
 };
 
+/** \brief \a camera with a \a width x \a height image of the same field of view: focal
+ * lengths scaled with the image's sides, the principal point with them (pixel centres at
+ * half-integers). */
+CameraIntrinsics resizedCamera(const CameraIntrinsics& camera, int width, int height);
+
 /** \brief Depth sensor model. The defaults are a structured-light sensor (Kinect-like);
  * activeStereo() gives a RealSense D4xx-like one. The systematic errors, time-of-flight noise
  * and flying pixels are off by default; the response to materials acts only on surfaces that

@@ -47,15 +47,7 @@ applySceneImageOptions(const Arguments& args, facyl::TabletopSceneParameters& p)
         h < 64 || w > 4096 || h > 4096)
       throw std::invalid_argument("--resolution: expected WxH with 64 <= W, H <= 4096, got '" +
                                   text + "'");
-    auto& c = p.camera;
-    const float su = static_cast<float>(w) / static_cast<float>(c.width);
-    const float sv = static_cast<float>(h) / static_cast<float>(c.height);
-    c.fx *= su;
-    c.fy *= sv;
-    c.cx = (c.cx + 0.5f) * su - 0.5f;
-    c.cy = (c.cy + 0.5f) * sv - 0.5f;
-    c.width = w;
-    c.height = h;
+    p.camera = facyl::resizedCamera(p.camera, w, h);
   }
   if (p.sensor.randomize && args.has("--dropout"))
     throw std::invalid_argument("--dropout cannot be combined with --sensor random (its "
