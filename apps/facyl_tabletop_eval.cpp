@@ -87,16 +87,22 @@ truthVector(const Cloud& cloud, LabelOf label_of)
   return truth;
 }
 
+/** Output objects on scenery (simulated far furniture and robots), and those of them called
+ * cylinders (a robot's links are cylinder-like). */
+struct SceneryCount {
+  std::size_t objects{0}, cylinders{0};
+};
+
 /** Maps each output object to the ground-truth label most of its points carry and fills the
  * rows' detection fields; output objects matching no row go to \a stray, except those with at
  * least half their points on scenery (like unlabelled far objects in real data, they are
- * neither true nor false detections). \return the number of those ignored. */
-std::size_t
+ * neither true nor false detections). \return those ignored. */
+SceneryCount
 matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vector<int>& truth,
              std::map<int, Row>& rows, std::vector<Stray>& stray)
 {
   std::map<int, std::size_t> best_size;
-  std::size_t on_scenery = 0;
+  SceneryCount on_scenery;
   for (std::size_t k = 0; k < objects.size(); ++k) {
     const auto& o = objects[k];
     std::map<int, std::size_t> votes;
@@ -104,7 +110,8 @@ matchObjects(const std::vector<facyl::RecognizedObject>& objects, const std::vec
       ++votes[truth[static_cast<std::size_t>(i)]];
     const auto scenery = votes.find(kSceneryLabel);
     if (scenery != votes.end() && 2 * scenery->second >= o.cluster.indices.indices.size()) {
-      ++on_scenery;
+      ++on_scenery.objects;
+      on_scenery.cylinders += o.is_cylinder;
       continue;
     }
     int label = -1;
@@ -317,7 +324,7 @@ simulatedRows(const facyl::RenderedScene& scene, std::uint64_t seed, std::size_t
 
 void
 reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray, const Options& opt,
-                std::size_t failures, std::size_t wrong_plane, std::size_t on_scenery)
+                std::size_t failures, std::size_t wrong_plane, const SceneryCount& on_scenery)
 {
   std::size_t cylinders = 0, touching = 0;
   for (const Row& r : all)
@@ -332,8 +339,10 @@ reportSimulated(const std::vector<Row>& all, const std::vector<Stray>& stray, co
               opt.scene.camera.height, dropout, static_cast<unsigned long long>(opt.seed),
               static_cast<unsigned long long>(opt.seed + opt.sim - 1), all.size(),
               opt.params.segmentation.min_cluster_size, cylinders, touching, failures, wrong_plane);
-  if (on_scenery > 0)
-    std::printf("Output objects on scenery (far furniture, robots), not scored: %zu\n", on_scenery);
+  if (on_scenery.objects > 0)
+    std::printf("Output objects on scenery (far furniture, robots), not scored: %zu (%zu called "
+                "cylinders)\n",
+                on_scenery.objects, on_scenery.cylinders);
   segmentationHeader("Segmentation (output objects as segments):");
   segmentationLine(all, "all", [](const Row&) { return true; });
   segmentationLine(all, "touching another", [](const Row& r) { return r.touching; });
@@ -401,7 +410,8 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
   std::vector<Stray> stray;
   std::vector<facyl::RecognitionTiming> timing;
   std::vector<double> object_counts;
-  std::size_t failures = 0, wrong_plane = 0, on_scenery = 0;
+  std::size_t failures = 0, wrong_plane = 0;
+  SceneryCount on_scenery;
   facyl_cli::Progress progress("facyl_tabletop_eval", opt.sim, true);
   for (std::size_t k = 0; k < opt.sim; ++k) {
     progress.step(k > 0); // the scene before this one is done
@@ -449,7 +459,9 @@ evaluateSimulated(const Options& opt, Recognizer& rec, CsvWriter& csv)
         return kSceneryLabel;
       return scene.object_id[i] >= 2 ? static_cast<int>(scene.object_id[i]) : 0;
     });
-    on_scenery += matchObjects(objects, truth, rows, stray);
+    const SceneryCount scenery = matchObjects(objects, truth, rows, stray);
+    on_scenery.objects += scenery.objects;
+    on_scenery.cylinders += scenery.cylinders;
     scoreRows(objects, truth, rows);
     for (auto& [id, r] : rows) {
       if (r.positive && r.evidence.fitted) {
