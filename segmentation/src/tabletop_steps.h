@@ -115,6 +115,24 @@ struct CandidateHulls {
   bool judged{false}, elevated{false}, elevated_support{false};
 };
 
+/** On an image: the cells of twice the plane grid's block (a candidate region's cells are of
+ * the grid or of the twice coarser one) and, per cell, the bits of the candidates whose
+ * regions hold it. */
+struct RegionCells {
+  RegionCells() = default;
+  RegionCells(const Setup& setup, const std::vector<Candidate>& candidates);
+  /** The cell of pixel \a i. */
+  std::size_t cellOf(pcl::index_t i) const
+  {
+    const pcl::index_t v = i / width;
+    return row[static_cast<std::size_t>(v)] + column[static_cast<std::size_t>(i - v * width)];
+  }
+  pcl::index_t width{0};
+  std::vector<std::size_t> row;      ///< per image row: its first cell
+  std::vector<std::uint32_t> column; ///< per image column: its cell in the row
+  std::vector<std::uint8_t> bits;    ///< per cell: candidate bits
+};
+
 /** The candidates of a frame and the pixel sort's result, which every trial reads. */
 struct SortedFrame {
   std::vector<Candidate> candidates;
@@ -124,6 +142,8 @@ struct SortedFrame {
   std::vector<CandidateHulls> hulls;
   /** The points above some candidate (the workspace's list). */
   const std::vector<PointOverPlanes>* above{nullptr};
+  /** On images: the candidates' regions (built by the first trial that has other families). */
+  RegionCells regions;
 };
 
 /** One pass over the points (the pixel sort): \a candidates with their inliers, frames and

@@ -154,90 +154,60 @@ place(const Setup& setup, const Eigen::Matrix3Xf& pts, const std::vector<Support
   return out;
 }
 
-/** The object points of a trial that lie on candidates of other families: within a
- * candidate's band and on its region (not anywhere on its infinite plane), for pieceOfSurface. */
-struct ForeignSurfaces {
-  /** Point index and the bits of those candidates, ascending by index. */
-  std::vector<std::pair<pcl::index_t, std::uint8_t>> on;
-  std::array<std::size_t, 8> inliers{}; ///< per candidate: the points it stands for
-};
-
-/** The candidates of other families than a trial's (a candidate is in one family only) and,
- * on images, their regions: cells of twice the plane grid's block (a region's cells are of the
- * grid or of the twice coarser one). */
-class OtherFamilies {
-public:
-  OtherFamilies(const Setup& setup, const std::vector<Candidate>& candidates,
+/** The candidates of other families than a trial's (a candidate is in one family only), for
+ * pieceOfSurface: their bits, planes, bands and regions (on images). */
+struct OtherFamilies {
+  OtherFamilies(const Setup& setup, const SortedFrame& sorted,
                 const std::vector<std::size_t>& family)
-      : w_(static_cast<pcl::index_t>(setup.frame.width))
-      , cell_(2 * std::max(1, setup.plane_step))
-      , cw_((w_ + cell_ - 1) / cell_)
+      : sorted(sorted)
   {
-    if (!setup.as_image)
+    if (!setup.as_image || sorted.regions.bits.empty())
       return;
-    cells_.assign(static_cast<std::size_t>(cw_) *
-                    static_cast<std::size_t>((setup.frame.height + cell_ - 1) / cell_),
-                  0);
-    for (std::size_t s = 0; s < candidates.size() && s < inliers.size(); ++s) {
-      inliers[s] = candidates[s].support;
-      if (std::find(family.begin(), family.end(), s) != family.end())
-        continue;
-      mask_ |= static_cast<std::uint8_t>(1u << s);
-      for (const auto i : candidates[s].points)
-        cells_[cellOf(i)] |= static_cast<std::uint8_t>(1u << s);
-    }
+    for (std::size_t s = 0; s < sorted.candidates.size() && s < 8; ++s)
+      if (std::find(family.begin(), family.end(), s) == family.end())
+        mask |= static_cast<std::uint8_t>(1u << s);
   }
-  /** Of the candidates whose bands point \a index lies in (bits \a on), those of other
-   * families on whose regions it lies. */
-  std::uint8_t onRegions(pcl::index_t index, std::uint8_t on) const
-  {
-    return on & mask_ ? static_cast<std::uint8_t>(on & mask_ & cells_[cellOf(index)]) : 0;
-  }
-  std::array<std::size_t, 8> inliers{}; ///< per candidate: the points it stands for
-
-private:
-  std::size_t cellOf(pcl::index_t i) const
-  {
-    return static_cast<std::size_t>((i / w_) / cell_ * cw_ + (i % w_) / cell_);
-  }
-  pcl::index_t w_;
-  int cell_;
-  pcl::index_t cw_;
-  std::uint8_t mask_{0};
-  std::vector<std::uint8_t> cells_;
+  const SortedFrame& sorted;
+  std::uint8_t mask{0};
 };
 
 /** Whether a \a group (every \a stride-th point tested; \a size: the points it stands for)
- * lies mostly (half of its points) on one candidate of another family that stands for at
- * least four times its points: a piece of that larger surface, not an object. E.g. patches of
- * the table top in front of two cans, whose camera-facing sides pass as one plane: a family of
- * its own whose "objects" are the table (simulated 1280 x 720 room, seed 708); or a strip of
- * the room's wall within the table's object band (seed 706). */
+ * lies mostly (half of its points) on one candidate of \a others, within its band and on its
+ * region (not anywhere on its infinite plane), that stands for at least four times its points:
+ * a piece of that larger surface, not an object. E.g. patches of the table top in front of two
+ * cans, whose camera-facing sides pass as one plane: a family of its own whose "objects" are
+ * the table (simulated 1280 x 720 room, seed 708); or a strip of the room's wall within the
+ * table's object band (seed 706). */
 bool
-pieceOfSurface(const ForeignSurfaces& foreign, const pcl::Indices& group, std::size_t stride,
-               std::size_t size)
+pieceOfSurface(const Setup& setup, const OtherFamilies& others, const pcl::Indices& group,
+               std::size_t stride, std::size_t size)
 {
-  if (foreign.on.empty())
+  if (!others.mask)
     return false;
+  const SortedFrame& sorted = others.sorted;
   std::array<std::size_t, 8> count{};
   std::size_t sampled = 0;
   for (std::size_t k = 0; k < group.size(); k += stride, ++sampled) {
-    const auto it = std::lower_bound(
-      foreign.on.begin(), foreign.on.end(), group[k],
-      [](const std::pair<pcl::index_t, std::uint8_t>& e, pcl::index_t i) { return e.first < i; });
-    if (it == foreign.on.end() || it->first != group[k])
+    const std::uint8_t bits = others.mask & sorted.regions.bits[sorted.regions.cellOf(group[k])];
+    if (!bits)
       continue;
-    for (std::size_t c = 0; c < 8; ++c)
-      count[c] += (it->second >> c) & 1u;
+    const Eigen::Vector3f p = setup.frame.point(static_cast<std::size_t>(group[k]));
+    const float range = (p - setup.frame.viewpoint).norm();
+    for (std::size_t c = 0; c < 8; ++c) {
+      const SupportPlane& s = sorted.all[c];
+      if ((bits >> c) & 1u &&
+          std::abs(s.plane.head<3>().dot(p) + s.plane[3]) <= s.band.halfWidth(range))
+        ++count[c];
+    }
   }
   for (std::size_t c = 0; c < 8; ++c)
-    if (2 * count[c] >= sampled && sampled > 0 && foreign.inliers[c] >= 4 * size)
+    if (sampled > 0 && 2 * count[c] >= sampled && sorted.candidates[c].support >= 4 * size)
       return true;
   return false;
 }
 
 /** Each cluster (\a groups) to the support under it (\a supports, \a regions, \a extents: see
- * place), except the pieces of other families' surfaces (\a foreign: pieceOfSurface); the
+ * place), except the pieces of other families' surfaces (\a others: pieceOfSurface); the
  * table; the supports that hold objects and the table moved into \a trial. \a scale: the
  * points each point of \a groups stands for (coarse trials, which keep no clusters). */
 void
@@ -245,7 +215,7 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
                std::vector<SupportPlane>& supports,
                const std::vector<std::vector<Eigen::Vector2f>>& regions,
                const std::vector<std::vector<Eigen::Vector2f>>& extents,
-               const ForeignSurfaces& foreign, Trial& trial, std::size_t scale)
+               const OtherFamilies& others, Trial& trial, std::size_t scale)
 {
   const auto& p = setup.params;
   for (auto& group : groups) {
@@ -253,7 +223,7 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
       continue;
     // At most 400 of its points, evenly: enough for the height and hull tests.
     const std::size_t stride = std::max<std::size_t>(1, group.size() / 400);
-    if (pieceOfSurface(foreign, group, stride, group.size() * scale)) {
+    if (pieceOfSurface(setup, others, group, stride, group.size() * scale)) {
       PCL_DEBUG("[facyl::TabletopSegmentation] a group of %zu points lies on a larger plane of "
                 "another family: not an object\n",
                 group.size() * scale);
@@ -595,6 +565,25 @@ rankFamilies(const Setup& setup, const FrameCues& cues, const SortedFrame& sorte
   return rankSupportFamilies(planes, points, !setup.up.isZero(), cues.image_down);
 }
 
+RegionCells::RegionCells(const Setup& setup, const std::vector<Candidate>& candidates)
+    : width(static_cast<pcl::index_t>(setup.frame.width))
+{
+  if (!setup.as_image || width <= 0)
+    return;
+  const auto cell = static_cast<std::size_t>(2 * std::max(1, setup.plane_step));
+  const std::size_t cw = (setup.frame.width + cell - 1) / cell;
+  row.resize(setup.frame.height);
+  for (std::size_t v = 0; v < row.size(); ++v)
+    row[v] = v / cell * cw;
+  column.resize(setup.frame.width);
+  for (std::size_t u = 0; u < column.size(); ++u)
+    column[u] = static_cast<std::uint32_t>(u / cell);
+  bits.assign(cw * ((setup.frame.height + cell - 1) / cell), 0);
+  for (std::size_t s = 0; s < candidates.size() && s < 8; ++s)
+    for (const auto i : candidates[s].points)
+      bits[cellOf(i)] |= static_cast<std::uint8_t>(1u << s);
+}
+
 Trial
 tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
           const std::vector<std::size_t>& family, int stride, bool final,
@@ -656,23 +645,20 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   Trial trial;
   if (supports.empty())
     return trial;
-  const OtherFamilies others(setup, candidates, family);
-  ForeignSurfaces foreign;
-  foreign.inliers = others.inliers;
+  // The candidates' regions, once a frame, when there are other families.
+  if (setup.as_image && sorted.regions.bits.empty() && family.size() < candidates.size())
+    sorted.regions = RegionCells(setup, candidates);
+  const OtherFamilies others(setup, sorted, family);
   pcl::Indices band;
   const auto w = static_cast<pcl::index_t>(setup.frame.width);
   for (const PointOverPlanes& a : *sorted.above)
     if ((a.above & kept) && !(a.on & kept) &&
-        (stride == 1 || ((a.index % w) % stride == 0 && (a.index / w) % stride == 0))) {
+        (stride == 1 || ((a.index % w) % stride == 0 && (a.index / w) % stride == 0)))
       band.push_back(a.index);
-      if (const std::uint8_t on = others.onRegions(a.index, a.on))
-        foreign.on.emplace_back(a.index, on);
-    }
-  std::sort(foreign.on.begin(), foreign.on.end());
   std::vector<pcl::Indices> groups = stride == 1
                                        ? cluster(setup, cues, band, workspace)
                                        : clusterCoarse(setup, cues, band, stride, workspace);
-  assignClusters(setup, groups, supports, regions, extents, foreign, trial,
+  assignClusters(setup, groups, supports, regions, extents, others, trial,
                  static_cast<std::size_t>(stride * stride));
   PCL_DEBUG("[facyl::TabletopSegmentation] stride %d: %zu supports, %zu object points, %zu "
             "groups, %zu clusters, %zu standing\n",
