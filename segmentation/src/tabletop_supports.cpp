@@ -185,6 +185,7 @@ pieceOfSurface(const Setup& setup, const OtherFamilies& others, const pcl::Indic
   if (!others.mask)
     return false;
   const SortedFrame& sorted = others.sorted;
+  const std::size_t n = std::min<std::size_t>(8, sorted.candidates.size());
   std::array<std::size_t, 8> count{};
   std::size_t sampled = 0;
   for (std::size_t k = 0; k < group.size(); k += stride, ++sampled) {
@@ -193,14 +194,14 @@ pieceOfSurface(const Setup& setup, const OtherFamilies& others, const pcl::Indic
       continue;
     const Eigen::Vector3f p = setup.frame.point(static_cast<std::size_t>(group[k]));
     const float range = (p - setup.frame.viewpoint).norm();
-    for (std::size_t c = 0; c < 8; ++c) {
+    for (std::size_t c = 0; c < n; ++c) {
       const SupportPlane& s = sorted.all[c];
       if ((bits >> c) & 1u &&
           std::abs(s.plane.head<3>().dot(p) + s.plane[3]) <= s.band.halfWidth(range))
         ++count[c];
     }
   }
-  for (std::size_t c = 0; c < 8; ++c)
+  for (std::size_t c = 0; c < n; ++c)
     if (sampled > 0 && 2 * count[c] >= sampled && sorted.candidates[c].support >= 4 * size)
       return true;
   return false;
