@@ -9,6 +9,7 @@ Each tool runs with a 60 s timeout and a 3 GiB address-space limit (none under A
 """
 import json
 import os
+import random
 import resource
 import struct
 import subprocess
@@ -111,7 +112,11 @@ with tempfile.TemporaryDirectory() as tmp:
     expect_file_error("all_nan.pcd", header() + b"nan nan nan\n" * 10, "no finite point")
     expect_file_error("mismatched.pcd", header(size="4 4") + b"0 0 0\n" * 10,
                       "do not have the same length")
-    expect_file_error("garbage.pcd", os.urandom(2000), "not a PCD file")
+    expect_file_error("garbage.pcd", random.Random(11).randbytes(2000), "not a PCD file")
+    # A header line of bytes that text tools take for line breaks (NEL, FS, VT, U+2028) and of
+    # invalid UTF-8 is quoted byte by byte: one line of valid JSON.
+    expect_file_error("line_breaks.pcd", b"\x85\x1c\x0b\xe2\x80\xa8\xff\rVERSION\n" * 3,
+                      "unknown header line '\\x85\\x1c\\x0b\\xe2\\x80\\xa8\\xff\\x0dVERSION'")
 
     # Points that hold no plane: one line on standard error (before: 1,003 lines of PCL's
     # "Sample points too similar or collinear!" and exit 0).

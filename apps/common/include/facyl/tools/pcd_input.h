@@ -34,6 +34,27 @@ hasField(const pcl::PCLPointCloud2& blob, const std::string& name)
   return false;
 }
 
+/** \a text (from a file) as a message quotes it: at most \a max bytes, each byte that is not
+ * printable ASCII written as \\xNN, so that a binary file's header gives a readable one-line,
+ * valid-UTF-8 message. */
+inline std::string
+quotedFileText(const std::string& text, std::size_t max = 40)
+{
+  static const char hex[] = "0123456789abcdef";
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f)
+      out += static_cast<char>(c);
+    else {
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
 /** What a PCD header says (the part the checks need). */
 struct PcdHeader {
   std::vector<std::string> fields;
@@ -130,7 +151,7 @@ parsePcdHeader(std::istream& in, PcdHeader& h)
       break;
     }
     else
-      return "not a PCD file (unknown header line '" + line.substr(0, 40) + "')";
+      return "not a PCD file (unknown header line '" + quotedFileText(line) + "')";
   }
   if (h.data.empty())
     return "not a PCD file (no DATA line in the header)";
@@ -145,7 +166,7 @@ parsePcdHeader(std::istream& in, PcdHeader& h)
     if ((h.size[i] != 1 && h.size[i] != 2 && h.size[i] != 4 && h.size[i] != 8) ||
         (h.type[i] != 'F' && h.type[i] != 'I' && h.type[i] != 'U') || h.count[i] == 0 ||
         h.count[i] > 4096)
-      return "the PCD header describes field '" + h.fields[i] +
+      return "the PCD header describes field '" + quotedFileText(h.fields[i]) +
              "' with an invalid SIZE, TYPE or COUNT";
   if (!h.has_points)
     h.points = h.width * h.height;
@@ -194,7 +215,8 @@ checkPcdSize(std::istream& in, const PcdHeader& h, std::uint64_t file_size)
              " compressed bytes cannot hold " + std::to_string(sizes[1]);
   }
   else
-    return "the PCD header's DATA '" + h.data + "' is not ascii, binary or binary_compressed";
+    return "the PCD header's DATA '" + quotedFileText(h.data) +
+           "' is not ascii, binary or binary_compressed";
   return {};
 }
 
