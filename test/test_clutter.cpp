@@ -1001,6 +1001,79 @@ TEST(SupportPlanes, ThePriorsExtentKeepsTheObjectsOverADarkPartOfTheTable)
   EXPECT_EQ(placed[1], 3u);
 }
 
+TEST(SupportPlanes, APriorsPlaneWithoutDepthInTheFrameStaysTheTable)
+{
+  // The top of the small table gives depth on one pixel in 64 (black granite, as on the
+  // 7-Scenes counter): no candidate is its plane, and alone the frame loses its objects. With the
+  // stream's prior the table is the prior's plane moved to the few points near it
+  // (SupportPriorResult::predicted) and the three objects stand on it. A prior whose plane the
+  // image refutes (15 cm above the intact table: its rays see the top beyond it) is no
+  // candidate: the table found is the frame's own.
+  const facyl::TabletopScene scene = smallTableScene(false);
+  const facyl::RenderedScene s = render(scene, {0.1f, -1.1f, 1.35f}, {0.f, 0.f, 0.04f});
+  const Eigen::Vector3f n = s.table_plane.head<3>();
+  Cloud::Ptr dark(new Cloud(s.cloud));
+  facyl::SupportPrior prior;
+  prior.plane = s.table_plane;
+  prior.max_angle = 0.1f;
+  prior.max_offset = 0.05f;
+  std::size_t top = 0;
+  for (std::size_t i = 0; i < dark->size(); ++i) {
+    auto& q = (*dark)[i];
+    if (s.object_id[i] != 1 || !pcl::isFinite(q) ||
+        std::abs(n.dot(q.getVector3fMap()) + s.table_plane[3]) >= 0.05f)
+      continue;
+    prior.centre += q.getVector3fMap();
+    if (++top % 20 == 0)
+      prior.extent.push_back(q.getVector3fMap());
+    if (i % dark->width % 8 != 0 || i / dark->width % 8 != 0) // one pixel in 64 has depth
+      q.x = q.y = q.z = std::numeric_limits<float>::quiet_NaN();
+  }
+  ASSERT_GT(top, 2000u);
+  prior.centre /= static_cast<float>(top);
+  ASSERT_TRUE(prior.valid());
+  const auto truth = truthOf(s);
+  const auto onTable = [&](const Cloud::Ptr& cloud, const facyl::SupportPrior* p, float& table_d,
+                           bool& predicted) {
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setInputCloud(cloud);
+    if (p)
+      seg.setSupportPrior(*p);
+    std::vector<facyl::TabletopCluster> clusters;
+    EXPECT_TRUE(seg.segment(clusters));
+    table_d = seg.tableFound() ? seg.getTableCoefficients().values[3] : 0.f;
+    predicted = seg.getSupportPriorResult().predicted;
+    std::vector<pcl::PointIndices> segments;
+    for (const auto& k : clusters)
+      segments.push_back(k.indices);
+    std::size_t placed = 0;
+    for (const auto& o : facyl::scoreSegments(truth, segments, 300))
+      placed += seg.tableFound() && o.recovered &&
+                clusters[static_cast<std::size_t>(o.best_segment)].support ==
+                  static_cast<int>(seg.getTableIndex());
+    return placed;
+  };
+  float d = 0.f;
+  bool predicted = false;
+  const std::size_t alone = onTable(dark, nullptr, d, predicted);
+  EXPECT_LT(alone, 3u);
+  EXPECT_EQ(onTable(dark, &prior, d, predicted), 3u);
+  EXPECT_TRUE(predicted);
+  EXPECT_NEAR(d, s.table_plane[3], 0.01f);
+  // Refuted: 15 cm above the intact table.
+  facyl::SupportPrior above = prior;
+  above.plane[3] -= 0.15f;
+  above.centre += 0.15f * n;
+  for (auto& e : above.extent)
+    e += 0.15f * n;
+  Cloud::Ptr intact(new Cloud(s.cloud));
+  EXPECT_EQ(onTable(intact, &above, d, predicted), 3u);
+  EXPECT_FALSE(predicted);
+  EXPECT_NEAR(d, s.table_plane[3], 0.01f);
+  std::printf("[ figures ] objects on the table without depth: %zu alone, 3 with the prior\n",
+              alone);
+}
+
 TEST(SupportPlanes, ThePriorsExtentWidensItsPlanesHull)
 {
   // priorExtentHull: the hull of the polygon and of the extent projected on the plane, for the

@@ -130,6 +130,7 @@ adoptTrial(const Setup& setup, const FrameCues& cues, Trial trial, TabletopSegme
   out.table_found = std::any_of(out.supports.begin(), out.supports.end(),
                                 [](const SupportPlane& s) { return s.standing_points > 0; });
   out.prior.support = trial.table_is_prior ? static_cast<int>(out.table) : -1;
+  out.prior.predicted = trial.table_is_prior && trial.from_prior == static_cast<int>(out.table);
   out.clusters = std::move(trial.clusters);
   if (out.table_found)
     return;
@@ -201,8 +202,11 @@ segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace)
               setup.prior->plane[3], setup.prior->max_angle, setup.prior->max_offset);
   // 1. The support candidates; 2. every point sorted onto and above them.
   std::vector<Candidate> candidates = findCandidates(setup, cues, workspace);
+  if (auto prior_plane = priorPlaneCandidate(setup, cues, candidates))
+    candidates.push_back(std::move(*prior_plane));
   const double t_planes = msSince(t0);
   SortedFrame sorted = classifyPoints(setup, std::move(candidates), workspace);
+  adoptPriorRegion(setup, sorted);
   const double t_points = msSince(t0);
   // 3. The family of supports that objects stand on, and its objects at full resolution.
   const auto families = rankFamilies(setup, cues, sorted);

@@ -9,9 +9,12 @@
 
 #include <facyl/features/polygon.h>
 
+#include <pcl/console/print.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace facyl {
 
@@ -77,6 +80,187 @@ priorCandidate(const Setup& setup, const std::vector<Candidate>& candidates)
       best = static_cast<int>(k), least = m;
   }
   return best;
+}
+
+namespace {
+
+/** \a plane moved along its normal to the densest slab of the distances of \a points from it
+ * (one band of \a band wide, its median; \a o the sensor): a top's few pixels with depth, among
+ * the points of the objects on it and of what stands behind; \a plane unchanged when that slab
+ * holds fewer than \a min_points or is no peak (no more points than the slabs as wide on
+ * either side of it). */
+Eigen::Vector4f
+toDensestSlab(const PointFrame& frame, const pcl::Indices& points, Eigen::Vector4f plane,
+              const DepthBand& band, const Eigen::Vector3f& o, std::size_t min_points)
+{
+  if (points.empty())
+    return plane;
+  std::vector<std::pair<float, float>> d; // distance, half-width
+  for (const auto i : points) {
+    const Eigen::Vector3f p = frame.point(static_cast<std::size_t>(i));
+    d.emplace_back(plane.head<3>().dot(p) + plane[3], band.halfWidth((p - o).norm()));
+  }
+  std::sort(d.begin(), d.end());
+  std::size_t best = 0, most = 0;
+  for (std::size_t a = 0, b = 0; a < d.size(); ++a) {
+    b = std::max(b, a);
+    while (b < d.size() && d[b].first <= d[a].first + 2.f * d[a].second)
+      ++b;
+    if (b - a > most)
+      most = b - a, best = a;
+  }
+  // A surface is a peak of the distances: more points in its slab than in the slabs on
+  // either side together (the walls of the objects on it spread evenly).
+  const float lo = d[best].first, hi = d[best + most - 1].first, width = hi - lo;
+  std::size_t beside = 0;
+  for (const auto& x : d)
+    beside += (x.first >= lo - width && x.first < lo) || (x.first > hi && x.first <= hi + width);
+  if (most > beside && most >= min_points)
+    plane[3] -= d[best + most / 2].first;
+  return plane;
+}
+
+/** The prior's normal, or that of the largest of \a candidates within its max_angle of it (a
+ * frame's parallel planes, a table beside the counter, tell it better than a prediction). */
+Eigen::Vector4f
+priorPlaneAligned(const SupportPrior& prior, const std::vector<Candidate>& candidates)
+{
+  const float cos_max = std::cos(prior.max_angle);
+  Eigen::Vector4f plane = prior.plane;
+  std::size_t most = 0;
+  for (const auto& c : candidates)
+    if (c.support > most && c.plane.head<3>().dot(prior.plane.head<3>()) >= cos_max) {
+      most = c.support;
+      plane.head<3>() = c.plane.head<3>();
+    }
+  plane[3] = -plane.head<3>().dot(prior.centre);
+  return plane;
+}
+
+/** The rays of every plane_step-th pixel and row that meet \a plane (n towards the sensor)
+ * inside \a extent (its coordinates in planeFrame(plane, prior centre)). */
+struct ExtentInView {
+  bool valid{false};       ///< the sensor above the plane
+  std::size_t in_view{0};  ///< rays that meet it there
+  pcl::Indices seen, near; ///< their finite points; those within the prior's offset of it
+};
+
+ExtentInView
+extentInView(const Setup& setup, const FrameCues& cues, const Eigen::Vector4f& plane,
+             const std::vector<Eigen::Vector2f>& extent)
+{
+  const PointFrame& frame = setup.frame;
+  const SupportPrior& prior = *setup.prior;
+  const Eigen::Affine3f to_plane = planeFrame(plane, prior.centre).inverse();
+  // The camera's rays: its intrinsics, else the estimated focal length about the centre.
+  const bool given = setup.camera.valid() && setup.camera.width == static_cast<int>(frame.width);
+  const float fx = given ? setup.camera.fx : cues.focal, fy = given ? setup.camera.fy : cues.focal;
+  const float cx = given ? setup.camera.cx : 0.5f * static_cast<float>(frame.width - 1);
+  const float cy = given ? setup.camera.cy : 0.5f * static_cast<float>(frame.height - 1);
+  const Eigen::Vector3f n = plane.head<3>(), o = frame.viewpoint;
+  const float height = n.dot(o) + plane[3];
+  ExtentInView out;
+  out.valid = height > 0.f;
+  if (!out.valid)
+    return out;
+  const auto step = static_cast<std::uint32_t>(std::max(1, setup.plane_step));
+  for (std::uint32_t v = 0; v < frame.height; v += step)
+    for (std::uint32_t u = 0; u < frame.width; u += step) {
+      const Eigen::Vector3f ray((static_cast<float>(u) - cx) / fx,
+                                (static_cast<float>(v) - cy) / fy, 1.f);
+      const float towards = n.dot(ray);
+      if (!(towards < 0.f)) // the ray does not meet the plane's upper side
+        continue;
+      const Eigen::Vector3f hit = o + (-height / towards) * ray;
+      if (!pointInPolygon((to_plane * hit).head<2>(), extent))
+        continue;
+      ++out.in_view;
+      const std::size_t i = static_cast<std::size_t>(v) * frame.width + u;
+      if (!frame.finite(i))
+        continue;
+      out.seen.push_back(static_cast<pcl::index_t>(i));
+      const Eigen::Vector3f p = frame.point(i);
+      if (std::abs(n.dot(p) + plane[3]) <=
+          std::max(prior.max_offset, cues.noise->halfWidth((p - o).norm())))
+        out.near.push_back(static_cast<pcl::index_t>(i));
+    }
+  return out;
+}
+
+} // namespace
+
+std::optional<Candidate>
+priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
+                    const std::vector<Candidate>& candidates)
+{
+  const PointFrame& frame = setup.frame;
+  if (!setup.prior || !setup.as_image || setup.prior->extent.size() < 3 || !cues.noise ||
+      !(cues.focal > 0.f) || candidates.size() >= 8 || priorCandidate(setup, candidates) >= 0)
+    return std::nullopt;
+  const SupportPrior& prior = *setup.prior;
+  const Eigen::Vector4f aligned = priorPlaneAligned(prior, candidates);
+  const Eigen::Affine3f to_plane = planeFrame(aligned, prior.centre).inverse();
+  std::vector<Eigen::Vector2f> corners;
+  for (const auto& e : prior.extent)
+    corners.push_back((to_plane * e).head<2>());
+  const std::vector<Eigen::Vector2f> extent = convexHull2D(std::move(corners));
+  if (extent.size() < 3)
+    return std::nullopt;
+  const ExtentInView view = extentInView(setup, cues, aligned, extent);
+  if (!view.valid)
+    return std::nullopt;
+  const int step = std::max(1, setup.plane_step);
+  const auto cell = static_cast<std::size_t>(step * step);
+  const Eigen::Vector3f o = frame.viewpoint;
+  // The plane where the points near the prediction are densest (the top's few pixels with
+  // depth; as many as a plane needs to be found), when it is still the prior's.
+  Eigen::Vector4f plane = toDensestSlab(frame, view.near, aligned, *cues.noise, o,
+                                        (setup.params.min_plane_points + cell - 1) / cell);
+  if (!consistentWithPrior(prior, plane))
+    plane = aligned;
+  // Most rays that meet it in view must not see through it,
+  Candidate out;
+  std::size_t beyond = 0;
+  for (const auto i : view.seen) {
+    const Eigen::Vector3f p = frame.point(static_cast<std::size_t>(i));
+    const float d = plane.head<3>().dot(p) + plane[3], half = cues.noise->halfWidth((p - o).norm());
+    if (d < -half)
+      ++beyond;
+    else if (d <= half)
+      out.points.push_back(i);
+  }
+  // And some of it is seen (as many points as a plane needs): a plane hidden behind what is
+  // in front of it everywhere (another table) is no candidate.
+  const bool there =
+    out.points.size() * cell >= setup.params.min_plane_points && 2 * beyond < view.in_view;
+  PCL_DEBUG("[facyl::TabletopSegmentation] the support prior's plane, not found: %zu cells of "
+            "its extent in view, %zu on (%.3f %.3f %.3f) d %.3f, %zu beyond it: %s\n",
+            view.in_view, out.points.size(), plane[0], plane[1], plane[2], plane[3], beyond,
+            there ? "a candidate" : "not there");
+  if (!there)
+    return std::nullopt;
+  out.plane = plane;
+  out.band = *cues.noise;
+  out.support = out.points.size() * cell;
+  out.from_prior = true;
+  return out;
+}
+
+void
+adoptPriorRegion(const Setup& setup, SortedFrame& sorted)
+{
+  for (std::size_t s = 0; s < sorted.candidates.size(); ++s) {
+    if (!sorted.candidates[s].from_prior || !setup.prior)
+      continue;
+    SupportPlane& a = sorted.all[s];
+    a.frame = planeFrame(a.plane, setup.prior->centre);
+    CandidateHulls& hulls = sorted.hulls[s];
+    hulls.polygon = priorExtentHull(*setup.prior, a.plane, a.frame, {});
+    hulls.extent = hulls.polygon;
+    hulls.region = polygonArea(hulls.polygon);
+    hulls.known = hulls.judged = true;
+    hulls.elevated = hulls.elevated_support = false;
+  }
 }
 
 void

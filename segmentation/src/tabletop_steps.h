@@ -87,6 +87,9 @@ struct Candidate {
   DepthBand band;
   pcl::Indices points;    ///< frame indices, one per cell of the region (grid or sample)
   std::size_t support{0}; ///< full-resolution points it stands for
+  /** The stream's support prior's plane, which the frame did not find (priorPlaneCandidate):
+   * its region is the prior's extent. */
+  bool from_prior{false};
 };
 
 /** The support candidates of the frame, largest first: seeds of the plane grid (images) or of
@@ -164,6 +167,7 @@ struct Trial {
   std::size_t standing{0};         ///< object points standing on the supports
   std::size_t standing_objects{0}; ///< objects standing on them
   bool table_is_prior{false};      ///< the table is the prior's plane (tableWithPrior)
+  int from_prior{-1};              ///< the support of a Candidate::from_prior, -1: none
 };
 
 /** The supports of \a family (large enough, see min_support_area) and the objects on them, on
@@ -184,6 +188,22 @@ int priorCandidate(const Setup& setup, const std::vector<Candidate>& candidates)
  * first \a kept of \a candidates (which are cut there), it takes the last of those places, so
  * that the cut keeps it. */
 void keepPriorCandidate(const Setup& setup, std::vector<Candidate>& candidates, std::size_t kept);
+
+/** With a prior whose plane no candidate is (a dark or glossy top without depth in this
+ * frame, in view between frames that found it): the prior's plane as a candidate
+ * (Candidate::from_prior), when the image does not refute it. Of the rays of every
+ * plane_step-th pixel and row that meet the plane inside the prior's extent (which must cover
+ * min_plane_points pixels of the image), most must not see through it: a point beyond its band
+ * (\a cues.noise) is a ray that passed where the plane would be. Its band is cues.noise, its
+ * points those rays' points on the plane. Images only; none without a prior with an extent, a
+ * focal length or a noise band, or when the frame has 8 candidates. */
+std::optional<Candidate> priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
+                                             const std::vector<Candidate>& candidates);
+
+/** For the candidate of \a sorted that is the prior's plane without a region of its own
+ * (Candidate::from_prior): its frame at the prior's centre, its hulls the prior's extent, and
+ * no elevated plane (it was the tracks' support). */
+void adoptPriorRegion(const Setup& setup, SortedFrame& sorted);
 
 /** The family of \a families (rankFamilies') that holds setup.prior's plane (a candidate of
  * \a sorted consistent with it), else one parallel to it (normals within its max_angle); -1:

@@ -255,6 +255,8 @@ assignClusters(const Setup& setup, std::vector<pcl::Indices>& groups,
       trial.supports.push_back(std::move(supports[s]));
     }
   trial.table = static_cast<std::size_t>(new_index[table]);
+  if (trial.from_prior >= 0)
+    trial.from_prior = new_index[static_cast<std::size_t>(trial.from_prior)];
   for (auto& c : trial.clusters)
     c.support = new_index[static_cast<std::size_t>(c.support)];
 }
@@ -598,6 +600,7 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   std::vector<std::vector<Eigen::Vector2f>> extents; ///< hulls of all the supports' points
   std::vector<std::vector<Eigen::Vector2f>> regions; ///< hulls objects are placed over
   std::uint8_t kept = 0;
+  int from_prior = -1; // the support of a Candidate::from_prior
   judgeElevated(setup, sorted, family);
   for (const std::size_t s : family) {
     SupportPlane support;
@@ -634,6 +637,8 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
       setup.prior ? priorExtentHull(*setup.prior, support.plane, support.frame, support.polygon)
                   : support.polygon);
     kept |= static_cast<std::uint8_t>(1u << s);
+    if (candidates[s].from_prior)
+      from_prior = static_cast<int>(supports.size());
     if (hulls.extent.empty())
       hulls.extent = supportHull(setup, support.frame, all[s].inliers.indices, nullptr);
     extents.push_back(hulls.extent);
@@ -646,6 +651,7 @@ tryFamily(const Setup& setup, const FrameCues& cues, SortedFrame& sorted,
   Trial trial;
   if (supports.empty())
     return trial;
+  trial.from_prior = from_prior;
   // The candidates' regions, once a frame, when there are other families.
   if (setup.as_image && sorted.regions.bits.empty() && family.size() < candidates.size())
     sorted.regions = RegionCells(setup, candidates);

@@ -237,7 +237,7 @@ CylinderTracker::reset()
   tracks_.clear();
   assignments_.clear();
   has_pose_ = false;
-  has_velocity_ = false;
+  has_velocity_ = velocity_in_plane_ = false;
   world_on_support_ = false;
   prior_held_ = false;
   prior_unseen_ = prior_challenged_ = 0;
@@ -308,9 +308,13 @@ CylinderTracker::predictedPose() const
 {
   // The camera keeps its motion between two frames (constant velocity) when the last two
   // frames were anchored one after the other; else it stays where it was.
-  return has_velocity_ ? Eigen::Affine3f(frame_to_world_ *
-                                         (previous_frame_to_world_.inverse() * frame_to_world_))
-                       : frame_to_world_;
+  if (!has_velocity_)
+    return frame_to_world_;
+  // The last motion in the world; after a frame anchored on the prior's plane itself
+  // (SupportPriorResult::predicted) only its motion along the plane: a tilt or a height it
+  // cannot have measured would go on frame after frame.
+  const Eigen::Affine3f motion = frame_to_world_ * previous_frame_to_world_.inverse();
+  return (velocity_in_plane_ ? inPlaneComponent(motion).asAffine() : motion) * frame_to_world_;
 }
 
 SupportPrior
@@ -414,7 +418,12 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
     chooseAnchor(supports, table, objects, expected.valid() ? &expected : nullptr);
   const bool was_held = prior_held_;
   keepTracksPlane(supports, prior, choice, info);
-  if (expected.valid() && choice.anchor >= 0 && !choice.plane_jump)
+  // An anchor that is the prior's plane moved to the few points near it (a top without depth,
+  // SupportPriorResult::predicted) tells neither the plane's innovation nor the camera's motion
+  // off the plane.
+  const bool predicted_anchor =
+    prior.predicted && choice.anchor >= 0 && choice.anchor == prior.support;
+  if (expected.valid() && choice.anchor >= 0 && !choice.plane_jump && !predicted_anchor)
     recordPlaneInnovation(expected, supports[static_cast<std::size_t>(choice.anchor)].plane);
 
   Eigen::Affine3f pose = has_pose_ ? predicted : Eigen::Affine3f::Identity();
@@ -433,7 +442,7 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
     }
     else
       new_scene = registerFrame(objects, view, plane_to_cloud, cloud_to_plane, predicted, last_pose,
-                                choice.plane_jump, pose, info);
+                                choice.plane_jump, !predicted_anchor, pose, info);
     info.anchored = true;
   }
   else if (!has_pose_)
@@ -450,6 +459,7 @@ CylinderTracker::locateFrame(const std::vector<SupportPlane>& supports, int tabl
   }
   // (After a plane jump the last pose is in the old plane's world.)
   has_velocity_ = has_pose_ && info.anchored && last_anchored && !new_scene && !choice.plane_jump;
+  velocity_in_plane_ = predicted_anchor;
   previous_frame_to_world_ = last_pose;
   frame_to_world_ = pose;
   has_pose_ = true;
@@ -463,7 +473,8 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
                                const TrackerView& view, const Eigen::Affine3f& plane_to_cloud,
                                const Eigen::Affine3f& cloud_to_plane,
                                const Eigen::Affine3f& predicted, const Eigen::Affine3f& last_pose,
-                               bool plane_jump, Eigen::Affine3f& pose, TrackerFrameInfo& info)
+                               bool plane_jump, bool may_be_new, Eigen::Affine3f& pose,
+                               TrackerFrameInfo& info)
 {
   std::vector<TrackObservation> local(objects.size());
   for (std::size_t i = 0; i < objects.size(); ++i)
@@ -513,7 +524,8 @@ CylinderTracker::registerFrame(const std::vector<RecognizedObject>& objects,
       viewStatus(t, world_to_cloud, TrackerView{view.camera, view.sensor_pose, {}}, {}, inside);
     expected += s != TrackStatus::OutOfView;
   }
-  if (!isNewScene(confirmed, expected, seen, reg.matched_objects, plane_jump, params_.min_overlap))
+  if (!may_be_new ||
+      !isNewScene(confirmed, expected, seen, reg.matched_objects, plane_jump, params_.min_overlap))
     return false;
   // A new scene: the tracks of the old one end; those started in the frames without its plane
   // are of the new one, and move into its frame where the predicted pose put them.

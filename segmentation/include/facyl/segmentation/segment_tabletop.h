@@ -181,6 +181,10 @@ struct SupportPriorResult {
    * standing on it than the prior's (of parallel supports, the prior's stays the table while it
    * is in view: its objects are found on every one of them alike). */
   bool challenged{false};
+  /** The prior's plane was none of the frame's planes (a dark or glossy top without depth in
+   * this frame): \a support is the prior's plane moved to the few points near it, which the
+   * image did not refute. A tracker takes no motion from it. */
+  bool predicted{false};
 };
 
 /** \brief Wall-clock time per step of a segmentation (ms). */

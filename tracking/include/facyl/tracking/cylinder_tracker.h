@@ -449,11 +449,13 @@ private:
   void recordExtent(const SupportPlane& anchor, const Eigen::Affine3f& cloud_to_world);
   /** The frame, anchored on the support at \a plane_to_cloud that continues the tracks' plane,
    * registered against the tracks (\a pose: cloud to world). \return true when it starts a
-   * new scene (the tracks ended, \a pose the support's plane). */
+   * new scene (the tracks ended, \a pose the support's plane); never without \a may_be_new
+   * (an anchor that is the prior's plane itself, SupportPriorResult::predicted). */
   bool registerFrame(const std::vector<RecognizedObject>& objects, const TrackerView& view,
                      const Eigen::Affine3f& plane_to_cloud, const Eigen::Affine3f& cloud_to_plane,
                      const Eigen::Affine3f& predicted, const Eigen::Affine3f& last_pose,
-                     bool plane_jump, Eigen::Affine3f& pose, TrackerFrameInfo& info);
+                     bool plane_jump, bool may_be_new, Eigen::Affine3f& pose,
+                     TrackerFrameInfo& info);
   /** The tracks matched (\a match) corrected by their objects, counting with \a weight.
    * \return a flag per track: matched. */
   std::vector<char> correctMatched(const std::vector<RecognizedObject>& objects,
@@ -487,6 +489,9 @@ private:
    * the next pose (constant velocity), when both were anchored and consecutive. */
   Eigen::Affine3f previous_frame_to_world_{Eigen::Affine3f::Identity()};
   bool has_velocity_{false};
+  /** The last frame was anchored on the prior's plane itself: its motion off the plane is not
+   * carried on (predictedPose). */
+  bool velocity_in_plane_{false};
   bool has_pose_{false};         ///< frame_to_world_ holds a pose
   bool world_on_support_{false}; ///< the world frame is a support's plane
   /** The tracks' plane is the table to keep (handed on by supportPrior): from the first frame
