@@ -229,10 +229,12 @@ priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
     else if (d <= half)
       out.points.push_back(i);
   }
-  // And some of it is seen (as many points as a plane needs): a plane hidden behind what is
-  // in front of it everywhere (another table) is no candidate.
+  // And some of it is seen (as many points as a plane needs), or most of it gives no depth: a
+  // plane hidden behind what is in front of it everywhere (another table) is no candidate.
+  const std::size_t missing = view.in_view - view.seen.size();
   const bool there =
-    out.points.size() * cell >= setup.params.min_plane_points && 2 * beyond < view.in_view;
+    (out.points.size() * cell >= setup.params.min_plane_points || 2 * missing > view.in_view) &&
+    2 * beyond < view.in_view;
   PCL_DEBUG("[facyl::TabletopSegmentation] the support prior's plane, not found: %zu cells of "
             "its extent in view, %zu on (%.3f %.3f %.3f) d %.3f, %zu beyond it: %s\n",
             view.in_view, out.points.size(), plane[0], plane[1], plane[2], plane[3], beyond,
