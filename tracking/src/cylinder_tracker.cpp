@@ -382,6 +382,7 @@ CylinderTracker::keepTracksPlane(const std::vector<SupportPlane>& supports,
   info.prior_held = prior_held_;
   info.prior_given = prior.given;
   info.prior_challenged = prior.challenged;
+  info.prior_predicted = prior.predicted;
   if (!prior_held_ || supports.empty()) // nothing to keep, or a frame that cannot tell
     return;
   prior_unseen_ = choice.plane_jump ? prior_unseen_ + 1 : 0;

@@ -249,6 +249,9 @@ struct TrackerFrameInfo {
   /** The recognizer reported that the frame alone would have chosen another support
    * (SupportPriorResult::challenged). */
   bool prior_challenged{false};
+  /** The frame's table was the prior's plane where the frame found none (a top without depth:
+   * SupportPriorResult::predicted); the frame took no motion off the plane from it. */
+  bool prior_predicted{false};
   /** Frames in a row, this one included, whose supports did not continue the tracks' plane
    * (see support_switch_frames), and frames in a row the recognizer reported challenged; 0 when
    * this one did, or held no support. */

@@ -112,6 +112,7 @@ addStreamFields(Json& frame, const facyl::CylinderTracker& tracker,
   prior["held"] = info.prior_held;
   prior["given"] = info.prior_given;
   prior["challenged"] = info.prior_challenged;
+  prior["predicted"] = info.prior_predicted;
   prior["unseen_frames"] = info.prior_unseen_frames;
   prior["challenged_frames"] = info.prior_challenged_frames;
   Json& tracks = frame["tracks"] = Json::array();
