@@ -1060,6 +1060,12 @@ TEST(SupportPlanes, APriorsPlaneWithoutDepthInTheFrameStaysTheTable)
   EXPECT_EQ(onTable(dark, &prior, d, predicted), 3u);
   EXPECT_TRUE(predicted);
   EXPECT_NEAR(d, s.table_plane[3], 0.01f);
+  // A caller's extent with points that are not finite: they are left out.
+  facyl::SupportPrior odd = prior;
+  odd.extent.emplace_back(std::numeric_limits<float>::quiet_NaN(), 0.f, 1.f);
+  odd.extent.emplace_back(std::numeric_limits<float>::infinity(), 0.f, 1.f);
+  EXPECT_EQ(onTable(dark, &odd, d, predicted), 3u);
+  EXPECT_TRUE(predicted);
   // Refuted: 15 cm above the intact table.
   facyl::SupportPrior above = prior;
   above.plane[3] -= 0.15f;

@@ -202,7 +202,8 @@ priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
   const Eigen::Affine3f to_plane = planeFrame(aligned, prior.centre).inverse();
   std::vector<Eigen::Vector2f> corners;
   for (const auto& e : prior.extent)
-    corners.push_back((to_plane * e).head<2>());
+    if (e.allFinite())
+      corners.push_back((to_plane * e).head<2>());
   const std::vector<Eigen::Vector2f> extent = convexHull2D(std::move(corners));
   if (extent.size() < 3)
     return std::nullopt;
