@@ -989,9 +989,13 @@ competeSeeds(const CylinderCues& cues, const std::vector<int>& active,
   std::vector<AxisSeed> seeds;
   for (const auto& acc : accumulators)
     addVotePeaks(acc, voting, params.voting_mode, params, params.orientation_candidates, seeds);
-  if (curvature)
-    addPlanarNormalsSeed(voting, accumulators.front().cellRadius(), seeds);
-  addElongationSeeds(cues, active, accumulators.front().cellRadius(), seeds);
+  // An axis held fixed (no refinement: an axis given, like the support's normal) is the only
+  // one asked about: seeds of other axes would answer another question.
+  if (params.refine) {
+    if (curvature)
+      addPlanarNormalsSeed(voting, accumulators.front().cellRadius(), seeds);
+    addElongationSeeds(cues, active, accumulators.front().cellRadius(), seeds);
+  }
 
   SeedCompetition competition(cues, active, refining, params);
   competition.run(seeds);

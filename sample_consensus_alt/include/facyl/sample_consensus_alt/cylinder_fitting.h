@@ -233,7 +233,7 @@ struct HoughCylinderParameters {
   float distance_threshold{0.f};         ///< > 0, or 0: estimated from the residuals
   float normal_angle_threshold{0.6f};    ///< rad, in (0, pi/2]: normal vs surface normal
   std::size_t orientation_candidates{1}; ///< peaks per accumulator that are fitted
-  bool refine{true};                     ///< sub-cell axis + 5-dof least squares
+  bool refine{true}; ///< sub-cell axis + 5-dof least squares; false: the accumulators' peaks alone
   /** With refine: how many candidates (the best by their normals' score) are refined on the
    * points (refineCylinderRobust) and then compared on the points they explain at one scale
    * (pointSupport), per unit of their own robust scale (a fit that bends to take in a table

@@ -286,7 +286,8 @@ public:
     return params_.kernel_exponent;
   }
   /** \brief Sub-cell axis and least-squares refinement (default true; false reproduces the
-   * paper's cell-quantised axis). */
+   * paper's cell-quantised axis: the accumulators' peaks alone are the axes tried, as given,
+   * e.g. one fixed axis). */
   void setRefine(bool refine)
   {
     params_.refine = refine;
