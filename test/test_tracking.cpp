@@ -779,6 +779,18 @@ TEST(TrackerSteps, TwoTracksOfOneObjectBecomeTheOlder)
   auto far = younger;
   far.centre.x() += 0.05f;
   EXPECT_FALSE(facyl::areOneObject(older, far, params.association));
+  // Each holding the other's centre, their axes 20 degrees apart (the older one's fits off by
+  // a tilt): one object; beside each other, touching (centres 2 r apart), two.
+  auto tilted = older;
+  tilted.axis = Eigen::Vector3f(std::sin(0.35f), 0.f, std::cos(0.35f));
+  EXPECT_GT(facyl::associationCost(facyl::associationGeometry(tilted),
+                                   facyl::associationGeometry(younger), params.association),
+            1.f);
+  EXPECT_TRUE(facyl::areOneObject(tilted, younger, params.association));
+  auto beside = older;
+  beside.centre.x() -= 0.08f;
+  beside.axis = tilted.axis;
+  EXPECT_FALSE(facyl::areOneObject(beside, younger, params.association));
   younger.confirmed = false;
   EXPECT_FALSE(facyl::areOneObject(older, younger, params.association));
   younger.confirmed = true;

@@ -548,6 +548,20 @@ viewStatus(const CylinderTrack& t, const Eigen::Affine3f& world_to_cloud, const 
   return TrackStatus::Missed;
 }
 
+namespace {
+
+/** Whether the centre of \a a's cylinder lies inside \b's: within its radius of its axis and
+ * within its extent along it. */
+bool
+centreInside(const CylinderTrack& a, const CylinderTrack& b)
+{
+  const Eigen::Vector3f d = a.centre - b.centre;
+  const float along = d.dot(b.axis);
+  return along >= b.lo && along <= b.hi && (d - along * b.axis).norm() < b.radius;
+}
+
+} // namespace
+
 bool
 areOneObject(const CylinderTrack& older, const CylinderTrack& younger,
              const AssociationSettings& settings)
@@ -556,6 +570,11 @@ areOneObject(const CylinderTrack& older, const CylinderTrack& younger,
       !younger.confirmed ||
       (older.status == TrackStatus::Seen && younger.status == TrackStatus::Seen))
     return false;
+  // Two solid cylinders each holding the other's centre are one object, whatever their axes
+  // (one track's fits off by a tilt).
+  if (older.has_cylinder && younger.has_cylinder && centreInside(older, younger) &&
+      centreInside(younger, older))
+    return true;
   return associationCost(associationGeometry(older), associationGeometry(younger), settings) < 1.f;
 }
 

@@ -172,7 +172,9 @@ TrackStatus viewStatus(const CylinderTrack& t, const Eigen::Affine3f& world_to_c
                        int& inside);
 
 /** \brief True when \a younger (a confirmed track) and \a older (a smaller id) are one object:
- * not both seen in this frame, neither ending, and within one sigma (associationCost < 1). */
+ * not both seen in this frame, neither ending, and within one sigma (associationCost < 1) or,
+ * both cylinders, each holding the other's centre (within its radius of its axis and its
+ * extent along it: two solid objects do not overlap, whatever their axes). */
 bool areOneObject(const CylinderTrack& older, const CylinderTrack& younger,
                   const AssociationSettings& settings);
 
