@@ -138,7 +138,7 @@ priorPlaneAligned(const SupportPrior& prior, const std::vector<Candidate>& candi
 }
 
 /** The rays of every plane_step-th pixel and row that meet \a plane (n towards the sensor)
- * inside \a extent (its coordinates in planeFrame(plane, prior centre)). */
+ * inside \a extent (in the plane's coordinates, \a to_plane: frame to them). */
 struct ExtentInView {
   bool valid{false};       ///< the sensor above the plane
   std::size_t in_view{0};  ///< rays that meet it there
@@ -147,11 +147,10 @@ struct ExtentInView {
 
 ExtentInView
 extentInView(const Setup& setup, const FrameCues& cues, const Eigen::Vector4f& plane,
-             const std::vector<Eigen::Vector2f>& extent)
+             const Eigen::Affine3f& to_plane, const std::vector<Eigen::Vector2f>& extent)
 {
   const PointFrame& frame = setup.frame;
   const SupportPrior& prior = *setup.prior;
-  const Eigen::Affine3f to_plane = planeFrame(plane, prior.centre).inverse();
   // The camera's rays: its intrinsics, else the estimated focal length about the centre.
   const bool given = setup.camera.valid() && setup.camera.width == static_cast<int>(frame.width);
   const float fx = given ? setup.camera.fx : cues.focal, fy = given ? setup.camera.fy : cues.focal;
@@ -199,15 +198,11 @@ priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
     return std::nullopt;
   const SupportPrior& prior = *setup.prior;
   const Eigen::Vector4f aligned = priorPlaneAligned(prior, candidates);
-  const Eigen::Affine3f to_plane = planeFrame(aligned, prior.centre).inverse();
-  std::vector<Eigen::Vector2f> corners;
-  for (const auto& e : prior.extent)
-    if (e.allFinite())
-      corners.push_back((to_plane * e).head<2>());
-  const std::vector<Eigen::Vector2f> extent = convexHull2D(std::move(corners));
+  const Eigen::Affine3f plane_to_frame = planeFrame(aligned, prior.centre);
+  const std::vector<Eigen::Vector2f> extent = priorExtentHull(prior, aligned, plane_to_frame, {});
   if (extent.size() < 3)
     return std::nullopt;
-  const ExtentInView view = extentInView(setup, cues, aligned, extent);
+  const ExtentInView view = extentInView(setup, cues, aligned, plane_to_frame.inverse(), extent);
   if (!view.valid)
     return std::nullopt;
   const int step = std::max(1, setup.plane_step);
