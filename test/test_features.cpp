@@ -255,26 +255,31 @@ TEST(NeighbourSearch, ImageNeighboursAreTheWindowsNearest)
                                           0.006f * static_cast<float>(v), 1.f + noise(rng));
   std::vector<int> queries(static_cast<std::size_t>(pixels.cols()));
   std::iota(queries.begin(), queries.end(), 0);
-  const facyl::Neighbourhoods nb = facyl::nearestInImage(pixels, width, queries, k, 2);
-  ASSERT_EQ(nb.size(), queries.size());
-  for (const int q : queries) {
-    const auto i = static_cast<std::size_t>(q);
-    if (!pixels.col(q).allFinite()) {
-      EXPECT_EQ(nb.count(i), 0u);
-      continue;
+  // The default window (radius 0: imageWindowRadius(k)) and a wider one.
+  for (const int radius : {0, 5}) {
+    const int r_used = radius > 0 ? radius : r;
+    const facyl::Neighbourhoods nb = facyl::nearestInImage(pixels, width, queries, k, 2, radius);
+    ASSERT_EQ(nb.size(), queries.size());
+    for (const int q : queries) {
+      const auto i = static_cast<std::size_t>(q);
+      if (!pixels.col(q).allFinite()) {
+        EXPECT_EQ(nb.count(i), 0u);
+        continue;
+      }
+      std::vector<std::pair<float, int>> window;
+      const int u = q % width, v = q / width;
+      for (int y = std::max(0, v - r_used); y <= std::min(height - 1, v + r_used); ++y)
+        for (int x = std::max(0, u - r_used); x <= std::min(width - 1, u + r_used); ++x)
+          if (pixels.col(y * width + x).allFinite())
+            window.emplace_back((pixels.col(y * width + x) - pixels.col(q)).squaredNorm(),
+                                y * width + x);
+      std::sort(window.begin(), window.end());
+      ASSERT_EQ(nb.count(i), std::min<std::size_t>(k, window.size())) << "pixel " << q;
+      EXPECT_EQ(nb.begin(i)[0], q); // the query first
+      for (std::size_t j = 0; j < nb.count(i); ++j)
+        EXPECT_EQ(nb.begin(i)[j], window[j].second)
+          << "pixel " << q << ", neighbour " << j << ", radius " << radius;
     }
-    std::vector<std::pair<float, int>> window;
-    const int u = q % width, v = q / width;
-    for (int y = std::max(0, v - r); y <= std::min(height - 1, v + r); ++y)
-      for (int x = std::max(0, u - r); x <= std::min(width - 1, u + r); ++x)
-        if (pixels.col(y * width + x).allFinite())
-          window.emplace_back((pixels.col(y * width + x) - pixels.col(q)).squaredNorm(),
-                              y * width + x);
-    std::sort(window.begin(), window.end());
-    ASSERT_EQ(nb.count(i), std::min<std::size_t>(k, window.size())) << "pixel " << q;
-    EXPECT_EQ(nb.begin(i)[0], q); // the query first
-    for (std::size_t j = 0; j < nb.count(i); ++j)
-      EXPECT_EQ(nb.begin(i)[j], window[j].second) << "pixel " << q << ", neighbour " << j;
   }
   // Lists written into a reused Neighbourhoods (which held more queries, then fewer) are the
   // lists of a fresh one.
@@ -289,7 +294,67 @@ TEST(NeighbourSearch, ImageNeighboursAreTheWindowsNearest)
   EXPECT_THROW(facyl::nearestInImage(pixels, width, queries, 0), std::invalid_argument);
   EXPECT_THROW(facyl::nearestInImage(pixels, 22, queries, k), std::invalid_argument);
   EXPECT_THROW(facyl::nearestInImage(pixels, width, {width * height}, k), std::invalid_argument);
+  EXPECT_THROW(facyl::nearestInImage(pixels, width, queries, k, 1, -1), std::invalid_argument);
   EXPECT_THROW(facyl::imageWindowRadius(0), std::invalid_argument);
+}
+
+TEST(NeighbourSearch, AWindowForAnInclinationHoldsTheNearestInSpace)
+{
+  // The window's radius for k neighbours on a surface inclined by up to a given angle
+  // (imageWindowRadius(k, angle)): on an evenly sampled plane inclined by 75 degrees it holds
+  // the k-d tree's k nearest of every pixel away from the border; the window for k alone
+  // (radius 3, enough up to about 55 degrees) does not.
+  constexpr float kDeg = static_cast<float>(M_PI) / 180.f;
+  const int k = 16;
+  EXPECT_EQ(facyl::imageWindowRadius(k, 0.f), 3);
+  EXPECT_EQ(facyl::imageWindowRadius(k, 55.f * kDeg), 3);
+  EXPECT_EQ(facyl::imageWindowRadius(k, 78.f * kDeg), 5);
+  EXPECT_EQ(facyl::imageWindowRadius(1, 0.f), 1);
+  EXPECT_THROW(facyl::imageWindowRadius(0, 0.f), std::invalid_argument);
+  EXPECT_THROW(facyl::imageWindowRadius(k, -0.1f), std::invalid_argument);
+  EXPECT_THROW(facyl::imageWindowRadius(k, 0.5f * static_cast<float>(M_PI)), std::invalid_argument);
+  EXPECT_THROW(facyl::imageWindowRadius(k, std::numeric_limits<float>::quiet_NaN()),
+               std::invalid_argument);
+
+  // Pixels 1 mm apart across, 1 / cos 75 = 3.9 mm apart along the inclination (rows), with
+  // a little noise so that no two distances tie.
+  const int width = 31, height = 31;
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.f, 1e-5f);
+  Eigen::Matrix3Xf pixels(3, width * height);
+  const float along = 0.001f / std::cos(75.f * kDeg);
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u)
+      pixels.col(v * width + u) = Eigen::Vector3f(0.001f * static_cast<float>(u) + noise(rng),
+                                                  along * static_cast<float>(v) + noise(rng), 1.f);
+  std::vector<int> inside;
+  for (int v = 8; v < height - 8; ++v)
+    for (int u = 8; u < width - 8; ++u)
+      inside.push_back(v * width + u);
+  const facyl::NeighbourSearch tree(pixels);
+  Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(inside.size()));
+  for (std::size_t i = 0; i < inside.size(); ++i)
+    queries.col(static_cast<Eigen::Index>(i)) = pixels.col(inside[i]);
+  const facyl::Neighbourhoods nearest = tree.nearest(queries, k, 1);
+  const auto sameAsTree = [&](int radius) {
+    const facyl::Neighbourhoods window = facyl::nearestInImage(pixels, width, inside, k, 1, radius);
+    for (std::size_t i = 0; i < inside.size(); ++i) {
+      std::vector<int> a(window.begin(i), window.begin(i) + window.count(i));
+      std::vector<int> b(nearest.begin(i), nearest.begin(i) + nearest.count(i));
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      if (a != b)
+        return false;
+    }
+    return true;
+  };
+  EXPECT_TRUE(sameAsTree(facyl::imageWindowRadius(k, 78.f * kDeg)));
+  EXPECT_FALSE(sameAsTree(facyl::imageWindowRadius(k)));
+  facyl::NormalCurvatureEstimation<pcl::PointXYZ, facyl::NormalCurvature> cues;
+  EXPECT_EQ(cues.getImageWindowRadius(), 0);
+  EXPECT_THROW(cues.setImageWindowRadius(-1), std::invalid_argument);
+  cues.setImageWindowRadius(5);
+  EXPECT_EQ(cues.getImageWindowRadius(), 5);
 }
 
 TEST(NormalCurvatureEstimation, OrganizedInputTakesTheImagesNeighbours)

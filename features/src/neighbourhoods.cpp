@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -350,6 +351,19 @@ imageWindowRadius(int k)
   return r;
 }
 
+int
+imageWindowRadius(int k, float inclination)
+{
+  if (k < 1)
+    throw std::invalid_argument("facyl::imageWindowRadius: k must be at least 1");
+  if (!(inclination >= 0.f && inclination < 0.5f * static_cast<float>(M_PI)))
+    throw std::invalid_argument("facyl::imageWindowRadius: the inclination " +
+                                std::to_string(inclination) + " rad is not in [0, pi/2)");
+  const double semi_axis =
+    std::sqrt(static_cast<double>(k) / (M_PI * std::cos(static_cast<double>(inclination))));
+  return std::max(1, static_cast<int>(std::ceil(semi_axis - 1e-9)));
+}
+
 namespace {
 
 /** The window of nearestInImage on an image \a width pixels wide: its offsets, nearest the
@@ -397,13 +411,21 @@ windowDistances(const Eigen::Matrix3Xf& surface, int width, int height, const Im
   }
 }
 
+/** Candidates beyond which smallestInWindow selects by keys instead of counting ranks: the rank
+ * count is quadratic in the candidates, the selection linear (a wide window on a surface seen
+ * at an angle holds many candidates within the first k's reach). */
+constexpr std::size_t kRankCountLimit = 32;
+
 /** The places in the window of the \a k smallest of \a d2 that are finite, smallest first
  * (ties to the earlier place), in \a nearest (resized to their count). The k smallest are no
  * larger than the largest of the first k finite ones, so only those within it compete; each
- * one's rank among them, counted without a branch, is its place in the answer. */
+ * one's rank among them, counted without a branch, is its place in the answer. Many
+ * candidates are selected by a key instead (distance bits above place: the same order, as a
+ * finite distance's bits order like the distance), in \a keys. */
 void
 smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>& near_d2,
-                 std::vector<std::uint32_t>& near_at, std::vector<std::uint32_t>& nearest)
+                 std::vector<std::uint32_t>& near_at, std::vector<std::uint64_t>& keys,
+                 std::vector<std::uint32_t>& nearest)
 {
   const float far = std::numeric_limits<float>::infinity();
   float reach = far, furthest = 0.f;
@@ -422,6 +444,20 @@ smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>
       near_at[c++] = static_cast<std::uint32_t>(o);
     }
   nearest.resize(std::min(k, c));
+  if (c > kRankCountLimit) {
+    keys.resize(c);
+    for (std::size_t a = 0; a < c; ++a) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &near_d2[a], sizeof bits); // >= 0: the bits order as the value
+      keys[a] = (static_cast<std::uint64_t>(bits) << 32) | near_at[a];
+    }
+    const auto kth = keys.begin() + static_cast<std::ptrdiff_t>(nearest.size());
+    std::nth_element(keys.begin(), kth - 1, keys.end());
+    std::sort(keys.begin(), kth);
+    for (std::size_t j = 0; j < nearest.size(); ++j)
+      nearest[j] = static_cast<std::uint32_t>(keys[j] & 0xffffffffu);
+    return;
+  }
   const float* nd = near_d2.data();
   for (std::size_t a = 0; a < c; ++a) {
     const float da = nd[a];
@@ -439,10 +475,13 @@ smallestInWindow(const std::vector<float>& d2, std::size_t k, std::vector<float>
 
 void
 nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries, int k,
-               Neighbourhoods& out, int threads)
+               Neighbourhoods& out, int threads, int radius)
 {
   if (k < 1)
     throw std::invalid_argument("facyl::nearestInImage: k must be at least 1");
+  if (radius < 0)
+    throw std::invalid_argument("facyl::nearestInImage: the window's radius " +
+                                std::to_string(radius) + " is negative");
   if (width < 1 || surface.cols() % width != 0)
     throw std::invalid_argument("facyl::nearestInImage: " + std::to_string(surface.cols()) +
                                 " pixels are not rows of width " + std::to_string(width));
@@ -450,7 +489,7 @@ nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int
   if (std::any_of(queries.begin(), queries.end(), [&](int q) { return q < 0 || q >= pixels; }))
     throw std::invalid_argument("facyl::nearestInImage: a query is not a pixel of the surface");
   const int height = static_cast<int>(pixels / width);
-  const ImageWindow window(imageWindowRadius(k), width);
+  const ImageWindow window(radius > 0 ? radius : imageWindowRadius(k), width);
   const std::size_t n = queries.size(), size = window.steps.size();
   const auto kk = static_cast<std::size_t>(k);
   // Query i's neighbours first go to indices[i * k ...] and its count to offsets[i + 1]; the
@@ -461,12 +500,13 @@ nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int
   parallelFor(n, threads, kQueryGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<float> d2(size), near_d2(size);
     std::vector<std::uint32_t> near_at(size), nearest;
+    std::vector<std::uint64_t> keys;
     for (std::size_t i = begin; i < end; ++i) {
       const int q = queries[i];
       if (!surface.col(q).allFinite())
         continue;
       windowDistances(surface, width, height, window, q, q % width, q / width, d2);
-      smallestInWindow(d2, kk, near_d2, near_at, nearest);
+      smallestInWindow(d2, kk, near_d2, near_at, keys, nearest);
       for (std::size_t j = 0; j < nearest.size(); ++j)
         out.indices[i * kk + j] = q + window.steps[nearest[j]];
       out.offsets[i + 1] = nearest.size();
@@ -483,10 +523,10 @@ nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int
 
 Neighbourhoods
 nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries, int k,
-               int threads)
+               int threads, int radius)
 {
   Neighbourhoods out;
-  nearestInImage(surface, width, queries, k, out, threads);
+  nearestInImage(surface, width, queries, k, out, threads, radius);
   return out;
 }
 

@@ -105,10 +105,18 @@ Neighbourhoods nearestOnGrid(const Eigen::Matrix3Xf& surface, const Eigen::Matri
  * \throws std::invalid_argument if k < 1. */
 int imageWindowRadius(int k);
 
+/** \brief Half-width of the image window that holds the \a k nearest points of a surface
+ * inclined by up to \a inclination (rad, in [0, pi/2)) to the line of sight, its pixels evenly
+ * spaced: the k nearest fill a disc on the surface whose image is an ellipse of semi-axes
+ * sqrt(k / (pi cos(inclination))) and cos(inclination) times that pixels, so the radius is the
+ * ceiling of the first (k = 16: 3 up to 55 degrees, 5 up to 78 degrees).
+ * \throws std::invalid_argument if k < 1 or the inclination is outside [0, pi/2). */
+int imageWindowRadius(int k, float inclination);
+
 /** \brief The \a k nearest finite pixels to each query pixel among those of the window of
- * half-width imageWindowRadius(k) centred on it, nearest first (the query itself first), in an
- * organized cloud: \a surface holds its pixels row by row, \a width to a row, a pixel without
- * depth not finite. Neighbourhoods from the image grid, without a tree (as
+ * half-width \a radius (0: imageWindowRadius(k)) centred on it, nearest first (the query itself
+ * first), in an organized cloud: \a surface holds its pixels row by row, \a width to a row, a pixel
+ * without depth not finite. Neighbourhoods from the image grid, without a tree (as
  * pcl::search::OrganizedNeighbor for organized input): where the window holds the k nearest
  * points these are NeighbourSearch::nearest's neighbours. Where it does not, the
  * neighbourhood stays compact in the image: across a depth edge the window holds fewer points
@@ -116,15 +124,16 @@ int imageWindowRadius(int k);
  * grazing angle (a far floor) a tree takes a strip of the row, the window a patch. Ties go to
  * the pixel nearer in the image. A query that is not finite gets no neighbour. Runs on
  * \a threads threads as NeighbourSearch does; thread-safe (no shared state).
- * \throws std::invalid_argument if k < 1, width < 1, surface.cols() is not a multiple of
- * width, or a query is not a pixel of the surface. */
+ * \throws std::invalid_argument if k < 1, radius < 0, width < 1, surface.cols() is not a
+ * multiple of width, or a query is not a pixel of the surface. */
 Neighbourhoods nearestInImage(const Eigen::Matrix3Xf& surface, int width,
-                              const std::vector<int>& queries, int k, int threads = 0);
+                              const std::vector<int>& queries, int k, int threads = 0,
+                              int radius = 0);
 
 /** \brief nearestInImage into \a out, whose storage is reused: a caller that keeps \a out
  * between frames allocates nothing once it has held the largest frame's lists.
  * \throws std::invalid_argument as nearestInImage. */
 void nearestInImage(const Eigen::Matrix3Xf& surface, int width, const std::vector<int>& queries,
-                    int k, Neighbourhoods& out, int threads = 0);
+                    int k, Neighbourhoods& out, int threads = 0, int radius = 0);
 
 } // namespace facyl

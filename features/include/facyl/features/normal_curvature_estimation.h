@@ -11,6 +11,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <stdexcept>
+#include <string>
+
 namespace facyl {
 
 /** \brief Surface normals and principal curvatures (c_max, k_max, k_min; paper III-C2) from a
@@ -111,6 +114,22 @@ public:
   {
     return image_neighbourhoods_;
   }
+  /** \brief Half-width of the image window searched for the k neighbours (nearestInImage); 0
+   * (default): imageWindowRadius(k). A wider window holds the k nearest points on surfaces
+   * seen at a more grazing angle, and costs its area. \throws std::invalid_argument if
+   * negative. */
+  void setImageWindowRadius(int radius)
+  {
+    if (radius < 0)
+      throw std::invalid_argument("facyl::NormalCurvatureEstimation::setImageWindowRadius: " +
+                                  std::to_string(radius) + " is negative");
+    image_window_radius_ = radius;
+  }
+  /** \brief The image window's half-width (0: imageWindowRadius(k)). */
+  int getImageWindowRadius() const
+  {
+    return image_window_radius_;
+  }
 
 protected:
   bool initCompute() override;
@@ -128,6 +147,7 @@ private:
   bool use_sensor_origin_{true};
   bool use_pcl_search_{false};
   bool image_neighbourhoods_{true};
+  int image_window_radius_{0};
   bool use_image_{false};           ///< this compute: neighbours from the image grid
   Eigen::Matrix3Xf surface_points_; ///< this compute: the surface as columns (own search)
   // Working buffers of compute(), kept between calls so that a stream of frames does not

@@ -112,7 +112,7 @@ NormalCurvatureEstimation<PointInT, PointOutT>::neighbourhoods(
   }
   if (use_image_) { // queries are input pixels either way: the surface is the input
     nearestInImage(surface_points_, static_cast<int>(surface.width), surface_queries, this->k_, out,
-                   threads);
+                   threads, image_window_radius_);
     return;
   }
   Eigen::Matrix3Xf queries(3, static_cast<Eigen::Index>(n));
