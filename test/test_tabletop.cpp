@@ -209,6 +209,48 @@ TEST(TabletopGeometry, PinholeFromAnOrganizedCloud)
   EXPECT_FALSE(facyl::estimatePinhole(pts.leftCols(5), px.leftCols(5), 640, 480, cam));
 }
 
+TEST(TabletopGeometry, APixelLatticeKeepsEvenlySpacedPixelsUpToItsCap)
+{
+  // A 30 x 20 block of a 100-pixel-wide image, from column 10 and row 5.
+  pcl::Indices block;
+  for (int v = 5; v < 25; ++v)
+    for (int u = 10; u < 40; ++u)
+      block.push_back(v * 100 + u);
+  // Spacing 3: columns 12, 15, ..., 39 and rows 6, 9, ..., 24 (10 x 7), in the block's order,
+  // each in its cell of the lattice's box (cells 4-13 and 2-8).
+  const facyl::PixelLattice three = facyl::pixelLattice(block, 100, 3.f, 1000);
+  ASSERT_EQ(three.pixels.size(), 70u);
+  EXPECT_EQ(three.columns, 10);
+  EXPECT_EQ(three.rows, 7);
+  EXPECT_EQ(three.pixels.front(), 6 * 100 + 12);
+  EXPECT_EQ(three.pixels.back(), 24 * 100 + 39);
+  ASSERT_EQ(three.cell_of.size(), 70u);
+  for (std::size_t k = 0; k < three.pixels.size(); ++k) {
+    const int u = three.pixels[k] % 100, v = three.pixels[k] / 100;
+    EXPECT_EQ(u % 3, 0);
+    EXPECT_EQ(v % 3, 0);
+    EXPECT_EQ(three.cell_of[k], (v / 3 - 2) * 10 + (u / 3 - 4));
+  }
+  // Capped at 20: a wider lattice, evenly spread over the block (never a stripe of rows).
+  const facyl::PixelLattice capped = facyl::pixelLattice(block, 100, 3.f, 20);
+  EXPECT_LE(capped.pixels.size(), 20u);
+  EXPECT_GE(capped.pixels.size(), 12u);
+  EXPECT_GT(capped.spacing, 3.f);
+  int u_lo = 100, u_hi = 0, v_lo = 100, v_hi = 0;
+  for (const auto i : capped.pixels) {
+    u_lo = std::min(u_lo, i % 100);
+    u_hi = std::max(u_hi, i % 100);
+    v_lo = std::min(v_lo, i / 100);
+    v_hi = std::max(v_hi, i / 100);
+  }
+  EXPECT_GE(u_hi - u_lo, 20);
+  EXPECT_GE(v_hi - v_lo, 12);
+  EXPECT_EQ(facyl::pixelLattice(block, 100, 1.f, 1000).pixels, block);
+  EXPECT_TRUE(facyl::pixelLattice({}, 100, 3.f, 10).pixels.empty());
+  EXPECT_THROW(facyl::pixelLattice(block, 100, 0.5f, 10), std::invalid_argument);
+  EXPECT_THROW(facyl::pixelLattice(block, 0, 3.f, 10), std::invalid_argument);
+}
+
 TEST(TabletopGeometry, EvenSubsampleAndCapPoints)
 {
   pcl::Indices all(1000);

@@ -6,7 +6,13 @@
 
 #include <facyl/features/setting_problem.h>
 
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace facyl {
 
@@ -58,15 +64,63 @@ evenSubsample(const pcl::Indices& indices, std::size_t max_count)
   return out;
 }
 
-pcl::Indices
-pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride)
+namespace {
+
+/** Pixel (u, v)'s lattice cell at \a spacing in \a cell, and whether it is the first pixel of
+ * that cell's column and row. */
+bool
+latticeCell(int u, int v, float spacing, Eigen::Vector2i& cell)
 {
-  pcl::Indices out;
+  cell = Eigen::Vector2i(static_cast<int>(std::floor(static_cast<float>(u) / spacing)),
+                         static_cast<int>(std::floor(static_cast<float>(v) / spacing)));
+  const auto first = [&](int x, int c) {
+    return x == 0 || static_cast<int>(std::floor(static_cast<float>(x - 1) / spacing)) != c;
+  };
+  return first(u, cell.x()) && first(v, cell.y());
+}
+
+} // namespace
+
+PixelLattice
+pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing, std::size_t max_count)
+{
+  if (width == 0 || !(spacing >= 1.f) || max_count == 0)
+    throw std::invalid_argument("facyl::pixelLattice: width " + std::to_string(width) +
+                                ", spacing " + std::to_string(spacing) + " and max_count " +
+                                std::to_string(max_count) + " must be positive (spacing >= 1)");
   const auto w = static_cast<pcl::index_t>(width);
-  for (const auto i : indices)
-    if ((i % w) % stride == 0 && (i / w) % stride == 0)
-      out.push_back(i);
-  return out;
+  PixelLattice lattice;
+  std::vector<Eigen::Vector2i> cells;
+  for (float s = spacing;; s *= 1.05f) {
+    lattice.spacing = s;
+    lattice.pixels.clear();
+    cells.clear();
+    Eigen::Vector2i cell;
+    for (const auto i : indices)
+      if (latticeCell(static_cast<int>(i % w), static_cast<int>(i / w), s, cell)) {
+        lattice.pixels.push_back(i);
+        cells.push_back(cell);
+      }
+    if (lattice.pixels.size() <= max_count)
+      break;
+    // The count falls with the spacing squared: straight to about max_count, then by 5%.
+    s = std::max(
+      s, s * std::sqrt(static_cast<float>(lattice.pixels.size()) / static_cast<float>(max_count)) /
+           1.05f);
+  }
+  if (cells.empty())
+    return lattice;
+  Eigen::Vector2i lo = cells.front(), hi = cells.front();
+  for (const auto& c : cells) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  lattice.columns = hi.x() - lo.x() + 1;
+  lattice.rows = hi.y() - lo.y() + 1;
+  lattice.cell_of.reserve(cells.size());
+  for (const auto& c : cells)
+    lattice.cell_of.push_back((c.y() - lo.y()) * lattice.columns + (c.x() - lo.x()));
+  return lattice;
 }
 
 pcl::Indices

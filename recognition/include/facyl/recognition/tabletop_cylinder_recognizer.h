@@ -26,6 +26,11 @@
 
 namespace facyl {
 
+/** \brief The steepest inclination to the line of sight (rad, 78 degrees) at which the window of
+ * a fit's cues (prepareFit: a lattice of pixels) still holds a point's k nearest points
+ * (imageWindowRadius): all of a cylinder's side in the image but its outer 2% (1 - sin 78). */
+constexpr float kFitCueInclination = 1.3614f;
+
 /** \brief The Hough settings of the recognizer: defaults, with the "mostly vertical" prior
  * (in the table frame), radii in [kDefaultRadiusMin, kDefaultRadiusMax] (0.01-0.25 m),
  * outward normals only, and the best candidate refined on its inliers alone
@@ -76,12 +81,13 @@ struct TabletopRecognizerParameters {
    * at least; 15% of its radius beyond its surface, half its radius beyond its ends). */
   float recovery_margin{0.025f};
   /** The points fitted lie on a grid of directions from the sensor this many radians apart
-   * (organized clouds: of pixels, 3 at a 525 px focal length; other clouds: angularGrid), so
-   * normals and curvatures are estimated at the same angular scale near and far; 0: every
-   * point. In [0, 0.1]. */
+   * (organized clouds searched as images: a lattice of pixels, pixelLattice, 3 pixels apart
+   * at a 525 px focal length; other clouds: angularGrid), so normals and curvatures are
+   * estimated at the same angular scale near and far; 0: every point. In [0, 0.1]. */
   float fit_point_angle{0.006f};
-  std::size_t max_fit_points{
-    1200}; ///< clusters are subsampled evenly to this many points, in [50, 1e6]
+  /** Clusters are subsampled evenly to at most this many points (a wider lattice of pixels),
+   * in [50, 1e6]. */
+  std::size_t max_fit_points{1200};
   /** With a classifier: clusters whose network probability is below this are not fitted
    * (rejected before fitting, paper III-B), in [0, 1]. 0 (default): every cluster is fitted,
    * and the network is one piece of evidence beside the fit's (a network trained on one
@@ -281,6 +287,8 @@ private:
    * functions below change only their fitter: threads with fitters of their own may run them
    * at once. */
   FitInput prepareFit(Fitter& fitter, const TabletopCluster& cluster) const;
+  /** in.points: the input's points at in.subset. */
+  void copySubset(FitInput& in) const;
   /** Fits the points of \a input flagged in \a alive (all when empty) with the configured
    * prior, then (when not accepted) the retries. The evidence is relative to those points. */
   Fit fitWithRetries(Fitter& fitter, const FitInput& input,
@@ -338,13 +346,25 @@ private:
  * when there are fewer). */
 pcl::Indices evenSubsample(const pcl::Indices& indices, std::size_t max_count);
 
-/** \brief The \a indices of an organized cloud \a width pixels wide whose column and row are
- * both multiples of \a stride (>= 1). */
-pcl::Indices pixelGrid(const pcl::Indices& indices, std::uint32_t width, int stride);
+/** \brief A lattice of the pixels of an organized cloud \a width pixels wide, \a spacing (>= 1)
+ * pixels apart: pixel (u, v) is in lattice cell (floor(u / spacing), floor(v / spacing)), and
+ * of \a indices those first in their cell's column and row are kept (an integer spacing keeps
+ * the columns and rows that are its multiples). */
+struct PixelLattice {
+  float spacing{1.f};
+  pcl::Indices pixels;      ///< the pixels kept, in the order of the indices given
+  int columns{0}, rows{0};  ///< cells of the lattice's bounding box
+  std::vector<int> cell_of; ///< per pixel kept, its cell in that box (row by row)
+};
+
+/** \brief The PixelLattice of \a indices (of a cloud \a width pixels wide) at \a spacing, widened
+ * (by factors of at least 1.05) until it keeps at most \a max_count pixels (>= 1). */
+PixelLattice pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing,
+                          std::size_t max_count);
 
 /** \brief Of \a indices (with their coordinates \a points, one column each, in the sensor's
  * frame), the first in each cell of a grid of directions from the sensor \a angle (rad) apart
- * (azimuth about the image's y axis, elevation from the x-z plane): what pixelGrid keeps of an
+ * (azimuth about the image's y axis, elevation from the x-z plane): what pixelLattice keeps of an
  * organized cloud, for a cloud without pixels. All of them for \a angle <= 0; points that are
  * not finite are left out. */
 pcl::Indices angularGrid(const pcl::Indices& indices, const Eigen::Matrix3Xf& points, float angle);

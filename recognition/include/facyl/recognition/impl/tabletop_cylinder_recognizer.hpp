@@ -58,6 +58,11 @@ TabletopCylinderRecognizer<PointT>::makeFitter() const
 {
   auto f = std::make_unique<Fitter>();
   f->cues.setKSearch(params_.neighbours);
+  // The cues come from a lattice of pixels (prepareFit), their neighbours from its grid: a
+  // window that holds the k nearest points wherever a cylinder's side is inclined by up to
+  // kFitCueInclination to the line of sight (all but the outer 1 - sin 78 deg = 2% of its
+  // width in the image), so that they are the nearest in space, as a k-d tree's would be.
+  f->cues.setImageWindowRadius(imageWindowRadius(params_.neighbours, kFitCueInclination));
   // One thread for a cluster's cues while clusters are fitted in parallel; fitClusters gives
   // them the threads no cluster takes.
   f->cues.setNumberOfThreads(1);
@@ -767,37 +772,64 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
 }
 
 template <typename PointT>
-typename TabletopCylinderRecognizer<PointT>::FitInput
-TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopCluster& cluster) const
+void
+TabletopCylinderRecognizer<PointT>::copySubset(FitInput& in) const
 {
-  FitInput in;
-  // Organized clouds: a grid of pixels fit_point_angle apart, so that the neighbourhoods of
-  // the cues span the same angle at every depth: depth noise grows with z^2, and the noise
-  // of a curvature with noise / size^2, so the cues stay as reliable far away as near.
-  const int stride =
-    static_cast<int>(std::lround(params_.fit_point_angle * segmentation_.getFocalLength()));
-  // Clouds without pixels: the same grid of directions from the sensor.
-  if (input_->isOrganized() && stride > 1)
-    in.subset = evenSubsample(pixelGrid(cluster.indices.indices, input_->width, stride),
-                              params_.max_fit_points);
-  else if (!input_->isOrganized() && params_.fit_point_angle > 0.f) {
-    const auto& idx = cluster.indices.indices;
-    Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t k = 0; k < idx.size(); ++k)
-      pts.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
-    in.subset =
-      evenSubsample(angularGrid(idx, pts, params_.fit_point_angle), params_.max_fit_points);
-  }
-  else
-    in.subset = evenSubsample(cluster.indices.indices, params_.max_fit_points);
   in.points.reset(new pcl::PointCloud<pcl::PointXYZ>);
   in.points->reserve(in.subset.size());
   for (const auto i : in.subset) {
     const auto& p = (*input_)[i];
     in.points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
   }
+}
+
+template <typename PointT>
+typename TabletopCylinderRecognizer<PointT>::FitInput
+TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopCluster& cluster) const
+{
+  FitInput in;
   in.cues.reset(new pcl::PointCloud<NormalCurvature>);
-  fitter.cues.setInputCloud(in.points);
+  // Organized clouds searched as images (their focal length known): a lattice of pixels
+  // fit_point_angle apart, so that the neighbourhoods of the cues span the same angle at every
+  // depth: depth noise grows with z^2, and the noise of a curvature with noise / size^2, so the
+  // cues stay as reliable far away as near. A cluster of more than max_fit_points pixels gets a
+  // wider lattice. Narrow organized clouds (a LiDAR's few rings) are point sets.
+  if (input_->isOrganized() && segmentation_.getFocalLength() > 0.f) {
+    const float spacing =
+      std::max(1.f, std::round(params_.fit_point_angle * segmentation_.getFocalLength()));
+    const PixelLattice lattice =
+      pixelLattice(cluster.indices.indices, input_->width, spacing, params_.max_fit_points);
+    in.subset = lattice.pixels;
+    copySubset(in);
+    // The lattice is an organized cloud of its own: the cues' neighbours come from its grid.
+    pcl::PointCloud<pcl::PointXYZ>::Ptr grid(new pcl::PointCloud<pcl::PointXYZ>(
+      static_cast<std::uint32_t>(lattice.columns), static_cast<std::uint32_t>(lattice.rows),
+      pcl::PointXYZ(std::numeric_limits<float>::quiet_NaN(),
+                    std::numeric_limits<float>::quiet_NaN(),
+                    std::numeric_limits<float>::quiet_NaN())));
+    grid->is_dense = false;
+    pcl::IndicesPtr cells(new pcl::Indices(lattice.cell_of.begin(), lattice.cell_of.end()));
+    for (std::size_t k = 0; k < cells->size(); ++k)
+      (*grid)[static_cast<std::size_t>((*cells)[k])] = (*in.points)[k];
+    fitter.cues.setInputCloud(grid);
+    fitter.cues.setIndices(cells);
+  }
+  else {
+    // Point sets: the same grid of directions from the sensor.
+    const auto& idx = cluster.indices.indices;
+    if (params_.fit_point_angle > 0.f) {
+      Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(idx.size()));
+      for (std::size_t k = 0; k < idx.size(); ++k)
+        pts.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
+      in.subset =
+        evenSubsample(angularGrid(idx, pts, params_.fit_point_angle), params_.max_fit_points);
+    }
+    else
+      in.subset = evenSubsample(idx, params_.max_fit_points);
+    copySubset(in);
+    fitter.cues.setInputCloud(in.points);
+    fitter.cues.setIndices(pcl::IndicesPtr());
+  }
   fitter.cues.compute(*in.cues);
   // Points with a normal, as columns (the estimator's inliers skip the rest).
   const auto n = static_cast<Eigen::Index>(in.points->size());
