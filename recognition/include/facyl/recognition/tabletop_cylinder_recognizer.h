@@ -56,9 +56,9 @@ struct TabletopRecognizerParameters {
    * included. */
   HoughCylinderParameters hough{tabletopHoughDefaults()};
   CylinderDecision decision; ///< what makes a fitted object a cylinder
-  /** When the fit with `prior` is not accepted, fit again with an upright (VerticalStrong) and
-   * a lying (Horizontal) prior in the table frame, then (objects on a support) with the axis
-   * fixed along the support's normal, and keep the best. */
+  /** When the fit with `prior` is not accepted, fit again with a lying (Horizontal) prior in
+   * the table frame, then (objects on a support) upright: with the axis fixed along the
+   * support's normal; and keep the best. */
   bool retry_upright_lying{true};
   /** With hough.outward_normals (the default), a last retry accepts inliers whose normals point
    * at the axis: clusters made of the inside of an open container are then fitted, and so are

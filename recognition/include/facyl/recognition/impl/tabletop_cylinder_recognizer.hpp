@@ -66,19 +66,21 @@ TabletopCylinderRecognizer<PointT>::makeFitter() const
   // One thread for a cluster's cues while clusters are fitted in parallel; fitClusters gives
   // them the threads no cluster takes.
   f->cues.setNumberOfThreads(1);
-  // The configured prior, then (when its fit is not accepted) "upright" and "lying" in the
-  // table frame: tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat
-  // face from pulling the axis. Optionally a last try allows any normal sign: the inside of
-  // an open container can make a cluster of its own (so can the inside of a bowl).
+  // The configured prior, then (when its fit is not accepted) "lying" in the table frame:
+  // tabletop objects stand or lie, and a strong prior keeps a domed lid or a flat face from
+  // pulling the axis. Optionally a try that allows any normal sign: the inside of an open
+  // container can make a cluster of its own (so can the inside of a bowl). Standing is asked
+  // last, with the axis held (below): a strongly vertical prior whose axis was refined
+  // afterwards answered it worse (docs/tabletop.md, "The upright retry").
   const bool any_sign =
     params_.retry_upright_lying && params_.hough.outward_normals && params_.retry_any_normal_sign;
   auto& estimators = f->estimators;
-  estimators.assign(params_.retry_upright_lying ? (any_sign ? 4 : 3) : 1, {});
-  const OrientationPrior priors[4] = {params_.hough.prior, OrientationPrior::VerticalStrong,
-                                      OrientationPrior::Horizontal, params_.hough.prior};
+  estimators.assign(params_.retry_upright_lying ? (any_sign ? 3 : 2) : 1, {});
+  const OrientationPrior priors[3] = {params_.hough.prior, OrientationPrior::Horizontal,
+                                      params_.hough.prior};
   for (std::size_t e = 0; e < estimators.size(); ++e) {
     HoughCylinderParameters hp = params_.hough;
-    if (e == 3)
+    if (e == 2)
       hp.outward_normals = false;
     hp.prior = priors[e];
     estimators[e].setParameters(hp);
@@ -919,11 +921,11 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
   return f;
 }
 
-/* A retry of the vertical prior (VerticalStrong) or with the axis fixed along the support's
- * normal (upright) looks where a fit within one accumulator cell of that normal already is, and
- * the lying prior (Horizontal) where one within a cell of the support's plane is: the retry's
- * axis would be that one again, refined alike (its vote cannot tell axes a cell apart). The
- * other retries (any normal sign) ask another question and always run. */
+/* The retry with the axis fixed along the support's normal (upright) looks where a fit within
+ * one accumulator cell of that normal already is, and the lying prior (Horizontal) where one
+ * within a cell of the support's plane is: the retry's axis would be that one again (its vote
+ * cannot tell axes a cell apart). The other retry (any normal sign) asks another question and
+ * always runs. */
 template <typename PointT>
 bool
 TabletopCylinderRecognizer<PointT>::retryRepeats(const Fitter& fitter, std::size_t estimator,
@@ -935,8 +937,7 @@ TabletopCylinderRecognizer<PointT>::retryRepeats(const Fitter& fitter, std::size
   const float cell = OrientationAccumulator::nominalCellRadius(hough.getParameters().orientations);
   const float along = std::abs(fit.model.axis.normalized().dot(fitter.up));
   const float from_up = std::acos(std::min(1.f, along)); // rad, in [0, pi/2]
-  if (estimator == fitter.upright ||
-      hough.getParameters().prior == OrientationPrior::VerticalStrong)
+  if (estimator == fitter.upright)
     return from_up < cell;
   if (hough.getParameters().prior == OrientationPrior::Horizontal)
     return 0.5f * static_cast<float>(M_PI) - from_up < cell;
