@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -66,17 +67,18 @@ evenSubsample(const pcl::Indices& indices, std::size_t max_count)
 
 namespace {
 
-/** Pixel (u, v)'s lattice cell at \a spacing in \a cell, and whether it is the first pixel of
- * that cell's column and row. */
-bool
-latticeCell(int u, int v, float spacing, Eigen::Vector2i& cell)
+/** Per coordinate x in [\a lo, \a hi], its lattice cell at \a spacing when x is the first of
+ * that cell, else -1, at x - lo. */
+std::vector<int>
+firstOfCells(int lo, int hi, float spacing)
 {
-  cell = Eigen::Vector2i(static_cast<int>(std::floor(static_cast<float>(u) / spacing)),
-                         static_cast<int>(std::floor(static_cast<float>(v) / spacing)));
-  const auto first = [&](int x, int c) {
-    return x == 0 || static_cast<int>(std::floor(static_cast<float>(x - 1) / spacing)) != c;
-  };
-  return first(u, cell.x()) && first(v, cell.y());
+  std::vector<int> cell(static_cast<std::size_t>(hi - lo + 1), -1);
+  for (int x = lo; x <= hi; ++x) {
+    const int c = static_cast<int>(std::floor(static_cast<float>(x) / spacing));
+    if (x == 0 || static_cast<int>(std::floor(static_cast<float>(x - 1) / spacing)) != c)
+      cell[static_cast<std::size_t>(x - lo)] = c;
+  }
+  return cell;
 }
 
 } // namespace
@@ -90,17 +92,31 @@ pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing, st
                                 std::to_string(max_count) + " must be positive (spacing >= 1)");
   const auto w = static_cast<pcl::index_t>(width);
   PixelLattice lattice;
-  std::vector<Eigen::Vector2i> cells;
+  std::vector<Eigen::Vector2i> pixels, cells;
+  pixels.reserve(indices.size());
+  Eigen::Vector2i low(std::numeric_limits<int>::max(), std::numeric_limits<int>::max());
+  Eigen::Vector2i high(0, 0);
+  for (const auto i : indices) {
+    pixels.emplace_back(static_cast<int>(i % w), static_cast<int>(i / w));
+    low = low.cwiseMin(pixels.back());
+    high = high.cwiseMax(pixels.back());
+  }
   for (float s = spacing;; s *= 1.05f) {
     lattice.spacing = s;
     lattice.pixels.clear();
     cells.clear();
-    Eigen::Vector2i cell;
-    for (const auto i : indices)
-      if (latticeCell(static_cast<int>(i % w), static_cast<int>(i / w), s, cell)) {
-        lattice.pixels.push_back(i);
-        cells.push_back(cell);
+    if (!pixels.empty()) {
+      const std::vector<int> column = firstOfCells(low.x(), high.x(), s);
+      const std::vector<int> row = firstOfCells(low.y(), high.y(), s);
+      for (std::size_t k = 0; k < pixels.size(); ++k) {
+        const int cu = column[static_cast<std::size_t>(pixels[k].x() - low.x())];
+        const int cv = row[static_cast<std::size_t>(pixels[k].y() - low.y())];
+        if (cu >= 0 && cv >= 0) {
+          lattice.pixels.push_back(indices[k]);
+          cells.emplace_back(cu, cv);
+        }
       }
+    }
     if (lattice.pixels.size() <= max_count)
       break;
     // The count falls with the spacing squared: straight to about max_count, then by 5%.
