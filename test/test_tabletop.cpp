@@ -246,6 +246,21 @@ TEST(TabletopGeometry, APixelLatticeKeepsEvenlySpacedPixelsUpToItsCap)
   EXPECT_GE(u_hi - u_lo, 20);
   EXPECT_GE(v_hi - v_lo, 12);
   EXPECT_EQ(facyl::pixelLattice(block, 100, 1.f, 1000).pixels, block);
+  // As an organized cloud: each kept pixel's point at its cell, the other cells empty.
+  pcl::PointCloud<pcl::PointXYZ> points;
+  for (const auto i : three.pixels)
+    points.push_back(pcl::PointXYZ(static_cast<float>(i % 100), static_cast<float>(i / 100), 1.f));
+  const auto cloud = facyl::latticeCloud(three, points);
+  ASSERT_EQ(cloud->width, 10u);
+  ASSERT_EQ(cloud->height, 7u);
+  EXPECT_FALSE(cloud->is_dense);
+  EXPECT_EQ((*cloud)(0, 0).x, 12.f); // pixel (12, 6)
+  EXPECT_EQ((*cloud)(9, 6).y, 24.f); // pixel (39, 24)
+  EXPECT_EQ(std::count_if(cloud->begin(), cloud->end(),
+                          [](const pcl::PointXYZ& p) { return pcl::isFinite(p); }),
+            70);
+  points.push_back(pcl::PointXYZ(0.f, 0.f, 1.f));
+  EXPECT_THROW(facyl::latticeCloud(three, points), std::invalid_argument);
   EXPECT_TRUE(facyl::pixelLattice({}, 100, 3.f, 10).pixels.empty());
   EXPECT_THROW(facyl::pixelLattice(block, 100, 0.5f, 10), std::invalid_argument);
   EXPECT_THROW(facyl::pixelLattice(block, 0, 3.f, 10), std::invalid_argument);

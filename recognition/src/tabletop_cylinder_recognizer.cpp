@@ -139,6 +139,23 @@ pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing, st
   return lattice;
 }
 
+pcl::PointCloud<pcl::PointXYZ>::Ptr
+latticeCloud(const PixelLattice& lattice, const pcl::PointCloud<pcl::PointXYZ>& points)
+{
+  if (points.size() != lattice.pixels.size() || lattice.cell_of.size() != lattice.pixels.size())
+    throw std::invalid_argument("facyl::latticeCloud: " + std::to_string(points.size()) +
+                                " points for a lattice of " +
+                                std::to_string(lattice.pixels.size()) + " pixels");
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>(
+    static_cast<std::uint32_t>(lattice.columns), static_cast<std::uint32_t>(lattice.rows),
+    pcl::PointXYZ(nan, nan, nan)));
+  cloud->is_dense = false;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    (*cloud)[static_cast<std::size_t>(lattice.cell_of[k])] = points[k];
+  return cloud;
+}
+
 pcl::Indices
 angularGrid(const pcl::Indices& indices, const Eigen::Matrix3Xf& points, float angle)
 {

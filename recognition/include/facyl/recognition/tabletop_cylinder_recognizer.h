@@ -362,6 +362,12 @@ struct PixelLattice {
 PixelLattice pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing,
                           std::size_t max_count);
 
+/** \brief \a lattice as an organized cloud of its columns x rows cells: \a points (one per
+ * pixel kept, in its order) each at its cell, the other cells not finite.
+ * \throws std::invalid_argument if the sizes differ. */
+pcl::PointCloud<pcl::PointXYZ>::Ptr latticeCloud(const PixelLattice& lattice,
+                                                 const pcl::PointCloud<pcl::PointXYZ>& points);
+
 /** \brief Of \a indices (with their coordinates \a points, one column each, in the sensor's
  * frame), the first in each cell of a grid of directions from the sensor \a angle (rad) apart
  * (azimuth about the image's y axis, elevation from the x-z plane): what pixelLattice keeps of an

@@ -71,7 +71,7 @@ TabletopCylinderRecognizer<PointT>::makeFitter() const
   // pulling the axis. Optionally a try that allows any normal sign: the inside of an open
   // container can make a cluster of its own (so can the inside of a bowl). Standing is asked
   // last, with the axis held (below): a strongly vertical prior whose axis was refined
-  // afterwards answered it worse (docs/tabletop.md, "The upright retry").
+  // afterwards answered it worse (docs/tabletop.md, "no strongly vertical retry").
   const bool any_sign =
     params_.retry_upright_lying && params_.hough.outward_normals && params_.retry_any_normal_sign;
   auto& estimators = f->estimators;
@@ -804,17 +804,9 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
     in.subset = lattice.pixels;
     copySubset(in);
     // The lattice is an organized cloud of its own: the cues' neighbours come from its grid.
-    pcl::PointCloud<pcl::PointXYZ>::Ptr grid(new pcl::PointCloud<pcl::PointXYZ>(
-      static_cast<std::uint32_t>(lattice.columns), static_cast<std::uint32_t>(lattice.rows),
-      pcl::PointXYZ(std::numeric_limits<float>::quiet_NaN(),
-                    std::numeric_limits<float>::quiet_NaN(),
-                    std::numeric_limits<float>::quiet_NaN())));
-    grid->is_dense = false;
-    pcl::IndicesPtr cells(new pcl::Indices(lattice.cell_of.begin(), lattice.cell_of.end()));
-    for (std::size_t k = 0; k < cells->size(); ++k)
-      (*grid)[static_cast<std::size_t>((*cells)[k])] = (*in.points)[k];
-    fitter.cues.setInputCloud(grid);
-    fitter.cues.setIndices(cells);
+    fitter.cues.setInputCloud(latticeCloud(lattice, *in.points));
+    fitter.cues.setIndices(
+      pcl::IndicesPtr(new pcl::Indices(lattice.cell_of.begin(), lattice.cell_of.end())));
   }
   else {
     // Point sets: the same grid of directions from the sensor.
