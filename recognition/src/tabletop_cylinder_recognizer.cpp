@@ -101,7 +101,7 @@ pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing, st
     low = low.cwiseMin(pixels.back());
     high = high.cwiseMax(pixels.back());
   }
-  for (float s = spacing;; s *= 1.05f) {
+  for (float s = spacing;;) {
     lattice.spacing = s;
     lattice.pixels.clear();
     cells.clear();
@@ -120,9 +120,8 @@ pixelLattice(const pcl::Indices& indices, std::uint32_t width, float spacing, st
     if (lattice.pixels.size() <= max_count)
       break;
     // The count falls with the spacing squared: straight to about max_count, then by 5%.
-    s = std::max(
-      s, s * std::sqrt(static_cast<float>(lattice.pixels.size()) / static_cast<float>(max_count)) /
-           1.05f);
+    s *= std::max(
+      1.05f, std::sqrt(static_cast<float>(lattice.pixels.size()) / static_cast<float>(max_count)));
   }
   if (cells.empty())
     return lattice;
