@@ -275,7 +275,8 @@ public:
     out_.open(path);
     out_ << "set,scene,object,kind,pose,positive,touching,found,pieces,recovered,iou,merged,"
             "split,fitted,inlier_ratio,surface_ratio,curvature_ratio,coverage,arc_gap,taper,"
-            "radius,true_radius,axis_error_deg,p_network,p_cylinder\n";
+            "radius,true_radius,axis_error_deg,p_network,p_cylinder,points,called,from_lid,seen_"
+            "through,outside_share\n";
   }
   void write(const std::string& set, const std::vector<Row>& rows)
   {
@@ -289,7 +290,8 @@ public:
            << r.segment.split << "," << e.fitted << "," << e.inlier_ratio << "," << e.surface_ratio
            << "," << e.curvature_ratio << "," << e.angular_coverage << "," << e.arc_gap << ","
            << e.taper << "," << r.radius << "," << r.true_radius << "," << r.axis_error_deg << ","
-           << e.p_network << "," << e.p_cylinder << "\n";
+           << e.p_network << "," << e.p_cylinder << "," << r.segment.points << "," << called(r)
+           << "," << e.from_lid << "," << e.seen_through << "," << e.shape.outside_share << "\n";
     }
   }
 

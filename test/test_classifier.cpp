@@ -252,11 +252,24 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
   EXPECT_EQ(info.input.size, 227);
   EXPECT_FALSE(info.softmax);
   EXPECT_FALSE(info.has_fusion);
+  EXPECT_EQ(facyl::parseClassifierModelInfo("channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9 10 "
+                                            "11 12 13 14 15 16 17 18 19 20\n",
+                                            info),
+            "");
+  EXPECT_TRUE(info.has_fusion);
+  EXPECT_TRUE(info.has_lid_fusion);
+  EXPECT_EQ(info.fusion[14], 15.f);
+  EXPECT_EQ(info.fusion[19], 20.f);
+  // A model fitted before lid fits: the side's weights and the network's, none for a lid.
   EXPECT_EQ(facyl::parseClassifierModelInfo(
               "channels depth\nsize 64\nfusion 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15\n", info),
             "");
   EXPECT_TRUE(info.has_fusion);
-  EXPECT_EQ(info.fusion[14], 15.f);
+  EXPECT_FALSE(info.has_lid_fusion);
+  EXPECT_EQ(info.fusion[13], 14.f);
+  EXPECT_EQ(info.fusion[14], 0.f);
+  EXPECT_EQ(info.fusion[18], 0.f);
+  EXPECT_EQ(info.fusion[19], 15.f);
   EXPECT_EQ(facyl::parseClassifierModelInfo("channels depthrgb\nsize 64\n", info), "");
   EXPECT_EQ(info.input.channels, facyl::ClassifierChannels::DepthRgb);
   EXPECT_NE(facyl::parseClassifierModelInfo("size 64\n", info), "");
@@ -267,8 +280,12 @@ TEST(CylinderClassifier, ModelDescriptionIsParsedStrictly)
   // The evidence model of an older facyl (9 weights) is refused, naming what it expects.
   EXPECT_NE(
     facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2 3 4 5 6 7 8 9\n", info)
-      .find("15 finite numbers"),
+      .find("expected 20 (or 15, fitted before lid fits) finite numbers"),
     std::string::npos);
+  EXPECT_NE(facyl::parseClassifierModelInfo("channels rgb\nsize 64\nfusion 1 2 3 4 5 6 7 8 9 10 "
+                                            "11 12 13 14 15 x\n",
+                                            info),
+            "");
   EXPECT_NE(
     facyl::parseClassifierModelInfo("channels rgb\nsize 64\nwidth 3\n", info).find("unknown key"),
     std::string::npos);
@@ -286,20 +303,22 @@ TEST(CylinderEvidence, EvidenceFeaturesAndProbability)
   EXPECT_EQ(f[0], 1.f);
   EXPECT_EQ(f[1], 0.9f);
   EXPECT_EQ(f[2], 0.7f);
-  EXPECT_EQ(f[3], 1.f);           // unknown curvature ratio
-  EXPECT_EQ(f[7], 4.f);           // unknown normal agreement: the worst
-  EXPECT_EQ(f[8], 1.f);           // unknown normal concentration: the worst
-  EXPECT_EQ(f[9], 0.f);           // unknown profile range: no evidence against
-  EXPECT_NEAR(f[14], 0.f, 1e-6f); // logit(0.5)
-  EXPECT_EQ(facyl::evidenceFeatures(std::nanf(""), e)[14], 0.f); // no network
+  EXPECT_EQ(f[3], 1.f); // unknown curvature ratio
+  EXPECT_EQ(f[7], 4.f); // unknown normal agreement: the worst
+  EXPECT_EQ(f[8], 1.f); // unknown normal concentration: the worst
+  EXPECT_EQ(f[9], 0.f); // unknown profile range: no evidence against
+  const std::size_t net = facyl::kEvidenceFeatures - 1;           // the network's logit, last
+  EXPECT_EQ(f[facyl::kLidFeaturesBegin], 0.f);                    // a side's fit: no lid features
+  EXPECT_NEAR(f[net], 0.f, 1e-6f);                                // logit(0.5)
+  EXPECT_EQ(facyl::evidenceFeatures(std::nanf(""), e)[net], 0.f); // no network
   std::array<float, facyl::kEvidenceFeatures> w{};
-  w[14] = 1.f;
+  w[net] = 1.f;
   EXPECT_NEAR(facyl::evidenceProbability(w, 0.8f, e), 0.8f, 1e-5f);
   w = {};
   w[1] = -2.f / 0.9f;
   EXPECT_NEAR(facyl::evidenceProbability(w, 0.8f, e), 1.f / (1.f + std::exp(2.f)), 1e-6f);
-  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(0.f, e)[14]));
-  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(1.f, e)[14]));
+  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(0.f, e)[net]));
+  EXPECT_TRUE(std::isfinite(facyl::evidenceFeatures(1.f, e)[net]));
   // A bowl's inside (shallower than wide) against a cup's.
   e.shape.inner_share = 0.4f;
   e.shape.aspect = 0.25f;

@@ -8,6 +8,7 @@
 
 #include <facyl/features/polygon.h>
 #include <facyl/recognition/cylinder_classifier.h>
+#include <facyl/recognition/cylinder_lid.h>
 #include <facyl/recognition/cylinder_parts.h>
 #include <facyl/recognition/cylinder_stack.h>
 #include <facyl/recognition/tabletop_cylinder_recognizer.h>
@@ -589,6 +590,165 @@ TEST(CylinderStack, TwoSectionsOneAboveTheOther)
   EXPECT_FALSE(sectionsOf(pts, nrm, 0.f).found);
 }
 
+namespace {
+
+/** A lattice of points \a spacing apart on the disc of radius \a r around (\a cx, \a cy) at
+ * height \a z over the plane z = 0 that \a keep(x, y) keeps, normals up. */
+template <typename Keep>
+void
+discOf(float r, float cx, float cy, float z, float spacing, Keep keep, Eigen::Matrix3Xf& pts,
+       Eigen::Matrix3Xf& nrm)
+{
+  std::vector<Eigen::Vector3f> p;
+  for (float x = -r; x <= r; x += spacing)
+    for (float y = -r; y <= r; y += spacing)
+      if (x * x + y * y <= r * r && keep(cx + x, cy + y))
+        p.emplace_back(cx + x, cy + y, z);
+  pts.resize(3, static_cast<Eigen::Index>(p.size()));
+  nrm.resize(3, static_cast<Eigen::Index>(p.size()));
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    pts.col(static_cast<Eigen::Index>(k)) = p[k];
+    nrm.col(static_cast<Eigen::Index>(k)) = Eigen::Vector3f::UnitZ();
+  }
+}
+
+} // namespace
+
+TEST(CylinderLid, TheDiscOfAnUprightTinSeenFromAbove)
+{
+  Eigen::Matrix3Xf pts, nrm;
+  const auto all = [](float, float) { return true; };
+  // A tin (r 5 cm, 10 cm tall) at (0.1, -0.05) on the table z = 0, seen from above.
+  discOf(0.05f, 0.1f, -0.05f, 0.1f, 0.003f, all, pts, nrm);
+  const Eigen::Vector4f table(0.f, 0.f, 1.f, 0.f);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  facyl::LidFit lid = facyl::fitLid(pts, nrm, table, up);
+  ASSERT_TRUE(lid.found);
+  EXPECT_NEAR(lid.model.radius, 0.05f, 0.002f);
+  EXPECT_NEAR(lid.model.height, 0.1f, 1e-4f);
+  EXPECT_LT((lid.model.base - Eigen::Vector3f(0.1f, -0.05f, 0.f)).norm(), 0.002f);
+  EXPECT_LT((lid.model.top - Eigen::Vector3f(0.1f, -0.05f, 0.1f)).norm(), 0.002f);
+  EXPECT_GT(lid.model.axis.dot(up), 0.999f);
+  EXPECT_EQ(lid.lid_points, static_cast<std::size_t>(pts.cols()));
+  EXPECT_GT(lid.rim_coverage, 0.95f);
+  EXPECT_NEAR(lid.rim_band, 1.5f * 0.003f, 0.0005f);
+  // The support's plane of either sign.
+  const facyl::LidFit flipped = facyl::fitLid(pts, nrm, -table, up);
+  ASSERT_TRUE(flipped.found);
+  EXPECT_NEAR(flipped.model.height, 0.1f, 1e-4f);
+  // A nearer object hides the lid beyond x = 0.12: the chord's ends lie on the circle, the
+  // rim is seen over the rest (2 acos(0.4) of it: 0.63).
+  discOf(
+    0.05f, 0.1f, -0.05f, 0.1f, 0.003f, [](float x, float) { return x < 0.12f; }, pts, nrm);
+  lid = facyl::fitLid(pts, nrm, table, up);
+  ASSERT_TRUE(lid.found);
+  EXPECT_NEAR(lid.model.radius, 0.05f, 0.003f);
+  EXPECT_NEAR(lid.rim_coverage, 0.63f, 0.08f);
+  // A third of the disc (beyond x = 0.125, its rim seen over 2 acos(0.5) = a third) is no lid:
+  // the arc fits circles of many radii.
+  discOf(
+    0.05f, 0.1f, -0.05f, 0.1f, 0.003f, [](float x, float) { return x > 0.125f; }, pts, nrm);
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
+  // No lid: too few points, a radius beyond the limits, normals across the axis.
+  discOf(0.008f, 0.f, 0.f, 0.1f, 0.003f, all, pts, nrm);
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
+  discOf(0.3f, 0.f, 0.f, 0.1f, 0.01f, all, pts, nrm);
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
+  discOf(0.05f, 0.f, 0.f, 0.1f, 0.003f, all, pts, nrm);
+  nrm.row(2).setZero();
+  nrm.row(0).setOnes();
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
+  EXPECT_FALSE(facyl::fitLid(pts, Eigen::Matrix3Xf(), table, up).found);
+}
+
+TEST(CylinderLid, AFrameSeesThroughTheDiscFittedToABoxTop)
+{
+  // The sensor at the origin looks down (+z) at a table at z = 1; up is -z. Rays every 1.5 mm
+  // at the lid's range; what each one sees comes from \a depth(x, y) (at the lid's range).
+  const auto frame = [](auto depth) {
+    std::vector<Eigen::Vector3f> seen;
+    for (float x = -0.1f; x <= 0.1f; x += 0.0015f)
+      for (float y = -0.1f; y <= 0.1f; y += 0.0015f) {
+        const float z = depth(x, y); // the ray through (x, y, 0.9) meets it at z
+        seen.push_back(Eigen::Vector3f(x, y, 0.9f) * (z / 0.9f));
+      }
+    Eigen::Matrix3Xf m(3, static_cast<Eigen::Index>(seen.size()));
+    for (std::size_t k = 0; k < seen.size(); ++k)
+      m.col(static_cast<Eigen::Index>(k)) = seen[k];
+    return m;
+  };
+  facyl::CylinderModel lid;
+  lid.axis = -Eigen::Vector3f::UnitZ();
+  lid.base = Eigen::Vector3f(0.f, 0.f, 1.f);
+  lid.top = Eigen::Vector3f(0.f, 0.f, 0.9f);
+  lid.radius = 0.05f;
+  const float band = 0.005f;
+  // A tin's lid hides the table; so does a nearer object over part of it.
+  const auto tin = [](float x, float y) { return x * x + y * y <= 0.05f * 0.05f ? 0.9f : 1.f; };
+  EXPECT_EQ(facyl::seenThroughShare(frame(tin), lid, band), 0.f);
+  const auto occluded = [&](float x, float y) { return x > 0.02f ? 0.5f : tin(x, y); };
+  EXPECT_EQ(facyl::seenThroughShare(frame(occluded), lid, band), 0.f);
+  // A box's top (7 x 7 cm) under the circle through its corners: the table is seen beside it
+  // (the disc within r - band: 1 - 0.0049 / (pi 0.045^2), 0.23).
+  const auto box = [](float x, float y) {
+    return std::abs(x) <= 0.035f && std::abs(y) <= 0.035f ? 0.9f : 1.f;
+  };
+  EXPECT_NEAR(facyl::seenThroughShare(frame(box), lid, band), 0.23f, 0.04f);
+  // No ray crosses the disc.
+  EXPECT_TRUE(std::isnan(facyl::seenThroughShare(Eigen::Matrix3Xf(3, 0), lid, band)));
+  // A cup's floor: its wall rises above the disc all round; a tin's lid beside a taller can
+  // (x > 0.06) is walled on that side alone.
+  const auto cup = [](float x, float y) { // the wall's top: 5.1-5.6 cm from the axis at 0.8 m
+    const float r = std::hypot(x, y);
+    return r <= 0.05f ? 0.9f : r >= 0.0574f && r <= 0.063f ? 0.8f : 1.f;
+  };
+  EXPECT_GT(facyl::walledShare(frame(cup), lid, band), 0.9f);
+  const auto beside = [&](float x, float y) { return x > 0.06f ? 0.75f : tin(x, y); };
+  EXPECT_LT(facyl::walledShare(frame(beside), lid, band), 0.3f);
+  EXPECT_EQ(facyl::walledShare(frame(tin), lid, band), 0.f);
+}
+
+TEST(CylinderLid, TheDenseOutlineTellsABoxTopFromADisc)
+{
+  // A box's top (10 x 12 cm, 5 cm over the table): the rim band follows the spacing of the
+  // outline's points (a lattice 7 mm apart, or its pixels 2 mm apart), and at the pixels' the
+  // box's sides leave the circle over most of it.
+  const auto top = [](float spacing, Eigen::Matrix3Xf& pts, Eigen::Matrix3Xf& nrm) {
+    std::vector<Eigen::Vector3f> p;
+    for (float x = -0.05f; x <= 0.05f; x += spacing)
+      for (float y = -0.06f; y <= 0.06f; y += spacing)
+        p.emplace_back(x, y, 0.05f);
+    pts.resize(3, static_cast<Eigen::Index>(p.size()));
+    for (std::size_t k = 0; k < p.size(); ++k)
+      pts.col(static_cast<Eigen::Index>(k)) = p[k];
+    nrm = Eigen::Vector3f::UnitZ().replicate(1, pts.cols());
+  };
+  Eigen::Matrix3Xf lattice, normals, dense, unused;
+  top(0.007f, lattice, normals);
+  top(0.002f, dense, unused);
+  const Eigen::Vector4f table(0.f, 0.f, 1.f, 0.f);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  facyl::LidSettings any_rim;
+  any_rim.min_rim_coverage = 0.f;
+  const facyl::LidFit coarse = facyl::fitLid(lattice, normals, table, up, any_rim);
+  const facyl::LidFit fine = facyl::fitLid(lattice, normals, table, up, any_rim, dense);
+  ASSERT_TRUE(coarse.found);
+  ASSERT_TRUE(fine.found);
+  EXPECT_GT(coarse.rim_band, 0.009f); // 1.5 spacings
+  EXPECT_LT(fine.rim_band, 0.004f);
+  EXPECT_LT(fine.rim_coverage, 0.5f);
+  EXPECT_FALSE(facyl::fitLid(lattice, normals, table, up, {}, dense).found);
+  // A disc is a disc at either spacing.
+  const auto all = [](float, float) { return true; };
+  discOf(0.05f, 0.f, 0.f, 0.05f, 0.007f, all, lattice, normals);
+  discOf(0.05f, 0.f, 0.f, 0.05f, 0.002f, all, dense, unused);
+  const facyl::LidFit disc = facyl::fitLid(lattice, normals, table, up, {}, dense);
+  ASSERT_TRUE(disc.found);
+  EXPECT_NEAR(disc.model.radius, 0.05f, 0.002f);
+  EXPECT_GT(disc.rim_coverage, 0.95f);
+  EXPECT_EQ(disc.outside_share, 0.f);
+}
+
 TEST(ShapeEvidence, TellsACylinderFromTheShapesItAlsoFits)
 {
   // A half cylinder seen from +x: radius 5 cm, 10 cm tall, normals along the radial line
@@ -713,6 +873,25 @@ TEST(CylinderEvidence, TheDecisionUsesEveryCheck)
   worse = e;
   worse.fitted = false;
   EXPECT_FALSE(facyl::acceptCylinder(worse, d));
+  // A side's fit and a lid fit are two models in one: each kind's features, the other's 0.
+  const auto side = facyl::evidenceFeatures(0.9f, e);
+  auto lid = e;
+  lid.from_lid = true;
+  lid.seen_through = 0.05f;
+  const auto top = facyl::evidenceFeatures(0.9f, lid);
+  const std::size_t l = facyl::kLidFeaturesBegin;
+  EXPECT_EQ(side[0], 1.f);
+  EXPECT_EQ(top[0], 1.f);
+  EXPECT_EQ(side[1], 0.8f);
+  EXPECT_EQ(side[l], 0.f);
+  EXPECT_EQ(top[1], 0.f);
+  EXPECT_EQ(top[3], 0.f);
+  EXPECT_EQ(top[l], 1.f);
+  EXPECT_EQ(top[l + 1], 0.8f);
+  EXPECT_EQ(top[l + 2], 0.4f);
+  EXPECT_EQ(top[l + 3], 0.05f);
+  EXPECT_FLOAT_EQ(top.back(), std::log(0.9f / 0.1f));
+  EXPECT_EQ(top.back(), side.back());
   facyl::CylinderDecision bad;
   bad.min_score = 2.f;
   EXPECT_FALSE(facyl::validate(bad).empty());

@@ -6,6 +6,7 @@
 #include <facyl/features/neighbourhoods.h>
 #include <facyl/features/normal_curvature_estimation.h>
 #include <facyl/features/point_cues.h>
+#include <facyl/features/polygon.h>
 #include <facyl/simulation/cylinder_simulation.h>
 #include <facyl/simulation/tabletop_scene.h>
 
@@ -770,4 +771,34 @@ TEST(PointCues, EverySecondNeighbourhoodSharedKeepsTheCues)
   EXPECT_LT(median(tilt_shared), median(tilt_every) + 0.3f * deg);
   EXPECT_LT(median(apart), 5.f * deg);
   EXPECT_THROW(facyl::estimatePointCues(pts, 0.1f, 64, none, 0), std::invalid_argument);
+}
+
+TEST(Polygon, HullsDropTheirInsideFirst)
+{
+  // A disc's pixels, 2 mm apart: most lie inside the polygon of the extremes and go; every
+  // vertex of the hull stays, and what went lies inside it.
+  std::vector<Eigen::Vector2f> disc;
+  for (float x = -0.05f; x <= 0.05f; x += 0.002f)
+    for (float y = -0.05f; y <= 0.05f; y += 0.002f)
+      if (x * x + y * y <= 0.05f * 0.05f)
+        disc.emplace_back(x + 0.3f, y - 0.1f);
+  std::vector<Eigen::Vector2f> rest = disc;
+  facyl::dropInteriorPoints(rest);
+  EXPECT_LT(rest.size(), disc.size() / 5);
+  const auto hull = facyl::convexHull2D(disc);
+  // Every vertex of the hull survived, and the hull of what is left is the same polygon.
+  for (const auto& v : hull)
+    EXPECT_NE(std::find(rest.begin(), rest.end(), v), rest.end());
+  std::vector<Eigen::Vector2f> inner;
+  for (const auto& p : disc)
+    if (std::find(rest.begin(), rest.end(), p) == rest.end())
+      inner.push_back(p);
+  ASSERT_FALSE(inner.empty());
+  for (const auto& q : inner)
+    EXPECT_TRUE(facyl::insideConvexBy(q, hull, 0.f));
+  // A square's corners and a point inside: too few points to bother.
+  std::vector<Eigen::Vector2f> few = {{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}, {0.5f, 0.5f}};
+  facyl::dropInteriorPoints(few);
+  EXPECT_EQ(few.size(), 5u);
+  EXPECT_EQ(facyl::convexHull2D(few).size(), 4u);
 }

@@ -319,12 +319,19 @@ def test_detect_reports_the_decisions_inputs():
             assert o["features"] is None and o["passes_gates"] is False
             continue
         f = o["features"]
-        assert len(f) == 15 and f[0] == 1.0 and all(math.isfinite(v) for v in f)
-        assert f[1] == pytest.approx(o["surface_ratio"], abs=1e-5)
-        assert f[2] == pytest.approx(o["inlier_ratio"], abs=1e-5)
-        assert f[4] == pytest.approx(o["angular_coverage"], abs=1e-5)
+        assert len(f) == 20 and f[0] == 1.0 and all(math.isfinite(v) for v in f)
+        # A side's fit's features from 1, a lid fit's from 14 (the other kind's are 0).
+        if o["from_lid"]:
+            assert f[14] == 1.0 and all(v == 0.0 for v in f[1:14])
+        else:
+            assert all(v == 0.0 for v in f[14:19])
+        s = 15 if o["from_lid"] else 1
+        assert f[s] == pytest.approx(o["surface_ratio"], abs=1e-5)
+        if not o["from_lid"]:
+            assert f[2] == pytest.approx(o["inlier_ratio"], abs=1e-5)
+        assert f[16 if o["from_lid"] else 4] == pytest.approx(o["angular_coverage"], abs=1e-5)
         p = min(max(o["p_network"], 1e-4), 1 - 1e-4)  # the last: the network's logit
-        assert f[14] == pytest.approx(math.log(p / (1 - p)), abs=1e-3)
+        assert f[19] == pytest.approx(math.log(p / (1 - p)), abs=1e-3)
         if o["is_cylinder"]:
             assert o["passes_gates"]
     # The gates are the recognizer's own: a score gate at 1 lets only a whole surface through.

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <dlfcn.h>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
+#include <vector>
 
 namespace facyl {
 
@@ -62,11 +64,23 @@ parseClassifierModelInfo(const std::string& text, ClassifierModelInfo& info)
       out.softmax = value == "softmax";
     }
     else if (key == "fusion") {
-      for (auto& w : out.fusion)
-        if (!(in >> w) || !std::isfinite(w))
-          return where + "expected " + std::to_string(kEvidenceFeatures) +
-                 " finite numbers (the evidence model of recognition/training/fit_evidence.py)";
+      std::vector<float> w;
+      for (float v; in >> v;)
+        w.push_back(v);
+      const bool all = w.size() == kEvidenceFeatures, side = w.size() == kSideOnlyEvidenceFeatures;
+      if (!in.eof() || !(all || side) ||
+          !std::all_of(w.begin(), w.end(), [](float v) { return std::isfinite(v); }))
+        return where + "expected " + std::to_string(kEvidenceFeatures) + " (or " +
+               std::to_string(kSideOnlyEvidenceFeatures) +
+               ", fitted before lid fits) finite numbers (the evidence model of "
+               "recognition/training/fit_evidence.py)";
+      // A model fitted before lid fits: its side's weights and the network's.
+      out.fusion.fill(0.f);
+      std::copy(w.begin(), w.begin() + (all ? kEvidenceFeatures : kLidFeaturesBegin),
+                out.fusion.begin());
+      out.fusion.back() = w.back();
       out.has_fusion = true;
+      out.has_lid_fusion = all;
     }
     else
       return where + "unknown key";
@@ -289,6 +303,8 @@ CylinderClassifier::fuse(float p_network, const CylinderEvidence& evidence,
     return geometricProbability(evidence, decision);
   if (!info_.has_fusion)
     return p_network;
+  if (evidence.from_lid && !info_.has_lid_fusion)
+    return geometricProbability(evidence, decision);
   return evidenceProbability(info_.fusion, p_network, evidence);
 }
 

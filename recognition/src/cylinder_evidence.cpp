@@ -53,21 +53,34 @@ evidenceFeatures(float p_network, const CylinderEvidence& e)
     logit = std::log(p / (1.f - p));
   }
   const ShapeEvidence& s = e.shape;
-  return {1.f,
-          known(e.surface_ratio, 0.f),
-          known(e.inlier_ratio, 0.f),
-          known(e.curvature_ratio, 1.f),
-          known(e.angular_coverage, 0.f),
-          std::clamp(known(e.taper, 0.f), 0.f, 1.f),
-          known(e.arc_gap, 0.f),
-          std::clamp(known(s.normal_agreement, 4.f), 0.f, 4.f),
-          known(s.normal_concentration, 1.f),
-          std::clamp(known(s.profile_range, 0.f), 0.f, 1.f),
-          std::clamp(known(s.axis_bend, 0.f), 0.f, 1.f),
-          known(s.inner_share, 0.f),
-          known(s.outside_share, 0.f),
-          known(s.inner_share, 0.f) * std::clamp(1.f - known(s.aspect, 1.f), 0.f, 1.f),
-          logit};
+  std::array<float, kEvidenceFeatures> f{};
+  f[0] = 1.f;
+  f[kEvidenceFeatures - 1] = logit;
+  if (e.from_lid) {
+    const std::size_t l = kLidFeaturesBegin;
+    f[l] = 1.f;
+    f[l + 1] = known(e.surface_ratio, 0.f);
+    f[l + 2] = known(e.angular_coverage, 0.f);
+    f[l + 3] = known(e.seen_through, 0.f);
+    f[l + 4] = known(s.outside_share, 0.f);
+    return f;
+  }
+  const std::array<float, kLidFeaturesBegin - 1> side = {
+    known(e.surface_ratio, 0.f),
+    known(e.inlier_ratio, 0.f),
+    known(e.curvature_ratio, 1.f),
+    known(e.angular_coverage, 0.f),
+    std::clamp(known(e.taper, 0.f), 0.f, 1.f),
+    known(e.arc_gap, 0.f),
+    std::clamp(known(s.normal_agreement, 4.f), 0.f, 4.f),
+    known(s.normal_concentration, 1.f),
+    std::clamp(known(s.profile_range, 0.f), 0.f, 1.f),
+    std::clamp(known(s.axis_bend, 0.f), 0.f, 1.f),
+    known(s.inner_share, 0.f),
+    known(s.outside_share, 0.f),
+    known(s.inner_share, 0.f) * std::clamp(1.f - known(s.aspect, 1.f), 0.f, 1.f)};
+  std::copy(side.begin(), side.end(), f.begin() + 1);
+  return f;
 }
 
 float

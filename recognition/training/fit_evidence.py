@@ -43,7 +43,8 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-FEATURES = 15  # facyl::kEvidenceFeatures; the last is the network's logit
+FEATURES = 20  # facyl::kEvidenceFeatures; the last is the network's logit
+LID = 14  # facyl::kLidFeaturesBegin: a lid fit's features (0 for a side's fit) begin here
 NETWORK = FEATURES - 1
 POSITIVE = {"cylinder", "can", "tin", "tube"}
 IGNORED = {"cylinder_handle", "cup_handle", "cup", "cylinder_open", "other", "unknown", "merged",
@@ -234,9 +235,10 @@ def design(rows, network):
     return x
 
 
-def fit_logistic(x, y, weight, l2=0.1):
+def fit_logistic(x, y, weight, l2=0.1, offset=None):
     """Weighted, L2-regularised logistic regression by Newton's method on standardised
-    features; returns the weights of the raw features (bias first, unpenalised)."""
+    features (plus a fixed \a offset per row); returns the weights of the raw features (bias
+    first, unpenalised)."""
     mu = x[:, 1:].mean(0)
     sd = x[:, 1:].std(0) + 1e-6
     z = np.hstack([np.ones((len(x), 1)), (x[:, 1:] - mu) / sd])
@@ -244,8 +246,9 @@ def fit_logistic(x, y, weight, l2=0.1):
     weight = weight / weight.sum()
     reg = np.full(z.shape[1], l2)
     reg[0] = 0.0
+    base = np.zeros(len(x)) if offset is None else np.asarray(offset, float)
     for _ in range(100):
-        p = 1 / (1 + np.exp(-(z @ w)))
+        p = 1 / (1 + np.exp(-(base + z @ w)))
         g = z.T @ ((p - y) * weight) + reg * w
         h = (z * (weight * p * (1 - p))[:, None]).T @ z + np.diag(reg + 1e-12)
         step = np.linalg.solve(h, g)
@@ -263,28 +266,67 @@ def fit_logistic(x, y, weight, l2=0.1):
 # curved profile, a taper, normals that disagree with the radial line or point one way, a bent
 # axis and points beyond the surface against. A weight that comes out the other way (the
 # features overlap) is set to 0 and the rest refitted. The arc gap is a gate only: it is known
-# for the parts of the cylinder-first recovery alone.
-SIGNS = [0, 1, 1, -1, 1, -1, None, -1, -1, -1, -1, None, -1, -1, 1]
+# for the parts of the cylinder-first recovery alone. A lid fit's (from LID): its own offset,
+# more of the surface explained and more of the rim seen for, the disc seen through and points
+# beyond the circle against.
+SIGNS = [0, 1, 1, -1, 1, -1, None, -1, -1, -1, -1, None, -1, -1, 0, 1, 1, -1, -1, 1]
 
 
-def fit_signed(x, y, weight):
-    use = [i for i, s in enumerate(SIGNS[:x.shape[1]]) if s is not None]
+def fit_signed(x, y, weight, signs=SIGNS, offset=None):
+    use = [i for i, s in enumerate(signs[:x.shape[1]]) if s is not None]
     while True:
         w = np.zeros(x.shape[1])
-        w[use] = fit_logistic(x[:, use], y, weight)
-        wrong = [i for i in use if SIGNS[i] and np.sign(w[i]) == -SIGNS[i]]
+        w[use] = fit_logistic(x[:, use], y, weight, offset=offset)
+        wrong = [i for i in use if signs[i] and np.sign(w[i]) == -signs[i]]
         if not wrong:
             return w
         use = [i for i in use if i not in wrong]
 
 
-def train(rows, network):
-    """Each source weighs the same, and within it positives and negatives weigh the same."""
+def is_lid(row):
+    return row["x"][LID] != 0.0  # a lid fit's own offset feature
+
+
+def shipped_weights(model):
+    """The weights of the model the recognizer decides with: kGeometryWeights (none) or the
+    fusion line of the network's .cfg (a fusion of kSideOnlyEvidenceFeatures numbers has no lid
+    weights: 0)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    if model == "none":
+        text = open(os.path.join(here, "..", "include", "facyl", "recognition",
+                                 "cylinder_evidence.h")).read()
+        body = text[text.index("kGeometryWeights = {") + len("kGeometryWeights = {"):]
+        w = [float(v.strip().rstrip("f")) for v in body[:body.index("}")].split(",")]
+    else:
+        cfg = os.path.join(here, "..", "models", "cylinder_net.cfg") if model == "default" \
+            else os.path.splitext(model)[0] + ".cfg"
+        line = [l for l in open(cfg) if l.startswith("fusion ")][0]
+        w = [float(v) for v in line.split()[1:]]
+        if len(w) == LID + 1:
+            w = w[:LID] + [0.0] * (FEATURES - 1 - LID) + w[-1:]
+    if len(w) != FEATURES:
+        sys.exit("fit_evidence: the shipped weights have %d numbers, not %d" % (len(w), FEATURES))
+    return np.array(w)
+
+
+def train(rows, network, keep=None):
+    """Each source weighs the same, and within it positives and negatives weigh the same.
+    With \a keep (weights): only the lid fits' weights are fitted, on the lid fits, the rest
+    (the side's, the shared offset and the network's) kept."""
     data = [r for r in rows if r["gates"] and training_label(r["label"]) is not None]
+    if keep is not None:
+        data = [r for r in data if is_lid(r)]
     y = np.array([training_label(r["label"]) for r in data], float)
     count = Counter((r["source"], training_label(r["label"])) for r in data)
     weight = np.array([1.0 / count[(r["source"], training_label(r["label"]))] for r in data])
-    return fit_signed(design(data, network), y, weight)
+    x = design(data, network)
+    if keep is None:
+        return fit_signed(x, y, weight)
+    w = np.array(keep[:x.shape[1]], float)
+    lid = list(range(LID, FEATURES - 1))
+    fixed = x @ w - x[:, lid] @ w[lid]  # the shared offset and the network's part
+    w[lid] = fit_signed(x[:, lid], y, weight, signs=SIGNS[LID:FEATURES - 1], offset=fixed)
+    return w
 
 
 def decide(rows, w, network):
@@ -418,6 +460,9 @@ def main():
     ap.add_argument("--out", required=True, help="working folder (simulated crops)")
     ap.add_argument("--model", default="none", help="none | default | PATH.onnx (the network)")
     ap.add_argument("--sim-scenes", type=int, default=300, help="scenes per simulated sensor")
+    ap.add_argument("--fit", choices=("all", "lid"), default="all",
+                    help="all weights, or only the lid fits' (the side's and the network's kept as "
+                         "the model in use has them)")
     ap.add_argument("--json", help="write the per-source table and the weights here")
     ap.add_argument("--rows", help="pickle of the collected objects: read when it exists, else "
                     "written (to refit without running the recognizer again)")
@@ -455,8 +500,9 @@ def main():
 
     table = {}
     left_out = {"simulated": [], "real": []}  # (p, is a cylinder) of the fits each model decides
+    keep = shipped_weights(args.model)[:None if network else NETWORK] if args.fit == "lid" else None
     for s in sources:
-        w = train([r for r in rows if r["source"] != s], network)
+        w = train([r for r in rows if r["source"] != s], network, keep)
         judged = [r for r in rows if r["source"] == s and r["gates"] and
                   label_kind(r["label"]) is not None]
         left_out["simulated" if s.startswith("sim") else "real"] += zip(
@@ -482,7 +528,7 @@ def main():
         p, r, f = prf(tp, fp, fn)
         table[s] = {"tp": tp, "fp": fp, "fn": fn, "precision": p, "recall": r, "f1": f,
                     "segmentation_recall": seg}
-    w_all = train(rows, network)
+    w_all = train(rows, network, keep)
     curves = {k: reliability(v) for k, v in left_out.items() if v}
     for k, (t, ece) in curves.items():
         print("reliability, %s sources left out: ECE %.3f; bins (mean p, share cylinders, n): %s" % (

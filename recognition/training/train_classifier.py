@@ -34,7 +34,7 @@ CHANNELS = {"rgb": 3, "depth": 2, "depthrgb": 5}
 # The files of facyl_crops that make each channel set: depthrgb is depth's planes followed by
 # rgb's, as facyl::classifierImage makes it (ClassifierChannels::DepthRgb).
 FILES = {"rgb": ("rgb",), "depth": ("depth",), "depthrgb": ("depth", "rgb")}
-FUSION_FEATURES = 15  # facyl::kEvidenceFeatures; the last is the network's logit
+FUSION_FEATURES = 20  # facyl::kEvidenceFeatures; the last is the network's logit
 
 
 # ----------------------------------------------------------------------------- data
@@ -268,7 +268,7 @@ def calibration_error(p, labels, bins=10):
 # ----------------------------------------------------------------------------- fusion
 
 def fusion_matrix(rows, p_network):
-    """evidenceFeatures of facyl (C++ wrote f0..f13), f14 = logit(p) clamped as C++ does."""
+    """evidenceFeatures of facyl (C++ wrote f0..f18), f19 = logit(p) clamped as C++ does."""
     x = np.array([[float(r[f"f{i}"]) for i in range(FUSION_FEATURES)] for r in rows], float)
     p = np.clip(np.asarray(p_network, float), 1e-4, 1 - 1e-4)
     x[:, FUSION_FEATURES - 1] = np.log(p / (1 - p))

@@ -26,8 +26,10 @@ namespace facyl {
  * mean 127.5              # input value = (byte - mean) * scale
  * scale 0.0078431373
  * output softmax          # softmax: 2 outputs, the second is "cylinder"; sigmoid: 1 logit
- * fusion w0 w1 ... w14    # the evidence model's weights with this network: see
- *                         # evidenceProbability (kEvidenceFeatures numbers)
+ * fusion w0 w1 ... w19    # the evidence model's weights with this network: see
+ *                         # evidenceProbability (kEvidenceFeatures numbers; or the
+ *                         # kSideOnlyEvidenceFeatures of a model fitted before lid fits,
+ *                         # which then has no say on them: has_lid_fusion false)
  * \endcode */
 struct ClassifierModelInfo {
   ClassifierInputSpec input;
@@ -35,6 +37,7 @@ struct ClassifierModelInfo {
   float scale{1.f / 127.5f};
   bool softmax{true};
   bool has_fusion{false};
+  bool has_lid_fusion{false}; ///< the fusion weighs lid fits' features (CylinderEvidence::from_lid)
   std::array<float, kEvidenceFeatures> fusion{};
 };
 
@@ -91,7 +94,7 @@ public:
   std::vector<float> cylinderProbabilities(const std::vector<ObjectView>& views) override;
   /** \brief evidenceProbability with the model's fusion weights; \a p_network when the model
    * has none; the evidence model without a network (geometricProbability) when \a p_network
-   * is NaN. */
+   * is NaN, or for a lid fit when the fusion has no lid features (has_lid_fusion). */
   float fuse(float p_network, const CylinderEvidence& evidence,
              const CylinderDecision& decision) const override;
   /** \brief Network outputs for ready-made input images (channels x size x size bytes each,

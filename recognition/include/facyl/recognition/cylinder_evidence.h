@@ -23,14 +23,20 @@
 namespace facyl {
 
 /** \brief Number of features of the evidence model (see evidenceFeatures). */
-constexpr std::size_t kEvidenceFeatures = 15;
+constexpr std::size_t kEvidenceFeatures = 20;
+/** \brief Where the lid fits' features begin (see evidenceFeatures). */
+constexpr std::size_t kLidFeaturesBegin = 14;
+/** \brief Features of a model fitted before lid fits (CylinderEvidence::from_lid): the side's
+ * and the network's logit, without the lid's (ClassifierModelInfo reads them). */
+constexpr std::size_t kSideOnlyEvidenceFeatures = 15;
 
 /** \brief Weights of the evidence model without a network: a logistic regression of
  * evidenceFeatures fitted by recognition/training/fit_evidence.py on simulated and real labelled
  * objects (docs/classifier.md, "The evidence model"); the network's weight is 0. */
 constexpr std::array<float, kEvidenceFeatures> kGeometryWeights = {
-  1.82662f,  0.843052f, 0.f,       -4.29659f, 0.f,       -6.95642f, 0.f, -0.203624f,
-  -3.09661f, 0.f,       -6.38006f, 0.f,       -2.86157f, -6.59634f, 0.f};
+  1.82662f,   0.843052f, 0.f,      -4.29659f, 0.f,       -6.95642f, 0.f,
+  -0.203624f, -3.09661f, 0.f,      -6.38006f, 0.f,       -2.86157f, -6.59634f,
+  -7.70126f,  6.85517f,  2.62533f, 0.f,       -0.22502f, 0.f};
 
 /** \brief The decision rule's settings. */
 struct CylinderDecision {
@@ -73,6 +79,12 @@ std::string validate(const CylinderDecision& decision, std::string* rule = nullp
 /** \brief What the decision looks at for one object. */
 struct CylinderEvidence {
   bool fitted{false}; ///< a cylinder was fitted
+  /** Fitted to its lid alone (fitLid): an upright object seen from above, whose side shows
+   * too little for the Hough; angular_coverage is then the lid's rim seen. */
+  bool from_lid{false};
+  /** A lid fit's disc: the share of the frame's rays through it that see farther
+   * (seenThroughShare); NaN for other fits. */
+  float seen_through{std::numeric_limits<float>::quiet_NaN()};
   /** The probability that the object is a cylinder: with a classifier, its network's output
    * for the object's view fused with this evidence (ShapeClassifier::fuse; the network's alone
    * when the object was not fitted); NaN without a classifier. */
@@ -115,13 +127,17 @@ struct CylinderEvidence {
  * fits that pass them. */
 bool passesGates(const CylinderEvidence& evidence, const CylinderDecision& decision);
 
-/** \brief What the evidence model sees of a fitted object: 1, surface ratio, inlier ratio,
- * curvature ratio (1 when unknown), angular coverage, taper clamped to [0, 1] (0 when unknown),
- * arc gap (0 when unknown), normal agreement clamped to [0, 4] (4 when unknown),
- * normal concentration (1 when unknown), profile range and axis bend clamped to [0, 1] (0 when
- * unknown), inner share and outside share (0 when unknown), the inner share of a shallow
- * container (inner share x clamp(1 - aspect, 0, 1): a bowl's inside; a cup is deeper than its
- * radius), and logit(p_network) (p clamped to [1e-4, 1 - 1e-4]; 0 without a network). */
+/** \brief What the evidence model sees of a fitted object: 1; then a side's fit's features,
+ * 0 for a lid fit: surface ratio, inlier ratio, curvature ratio (1 when unknown), angular
+ * coverage, taper clamped to [0, 1] (0 when unknown), arc gap (0 when unknown), normal
+ * agreement clamped to [0, 4] (4 when unknown), normal concentration (1 when unknown), profile
+ * range and axis bend clamped to [0, 1] (0 when unknown), inner share and outside share (0 when
+ * unknown), the inner share of a shallow container (inner share x clamp(1 - aspect, 0, 1): a
+ * bowl's inside; a cup is deeper than its radius); from kLidFeaturesBegin a lid fit's, 0 for a
+ * side's fit: 1, surface ratio, angular coverage (its rim seen), seen through and outside share
+ * (0 when unknown); last logit(p_network) (p clamped to [1e-4, 1 - 1e-4]; 0 without a network).
+ * The two kinds of fit are two models in one: a lid's evidence means other things than a
+ * side's. */
 std::array<float, kEvidenceFeatures> evidenceFeatures(float p_network,
                                                       const CylinderEvidence& evidence);
 

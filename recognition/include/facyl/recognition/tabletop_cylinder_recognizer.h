@@ -31,6 +31,10 @@ namespace facyl {
  * (imageWindowRadius): all of a cylinder's side in the image but its outer 2% (1 - sin 78). */
 constexpr float kFitCueInclination = 1.3614f;
 
+/** \brief A lid fit (fitLidOf) is no lid when more of the frame's rays through its disc than
+ * this see something behind it (seenThroughShare). */
+constexpr float kMaxSeenThrough = 0.1f;
+
 /** \brief The Hough settings of the recognizer: defaults, with the "mostly vertical" prior
  * (in the table frame), radii in [kDefaultRadiusMin, kDefaultRadiusMax] (0.01-0.25 m),
  * outward normals only, and the best candidate refined on its inliers alone
@@ -262,6 +266,7 @@ private:
     std::size_t upright{0};   ///< index of the estimator with the axis along the support's normal
     bool with_support{false}; ///< the cluster being fitted has a support
     Eigen::Vector3f up{Eigen::Vector3f::UnitZ()}; ///< z of the prior frame (usePriorFrameOf)
+    Eigen::Vector4f support_plane{Eigen::Vector4f::Zero()}; ///< the support's, with_support
     int retry_threads{1}; ///< threads that run a cluster's first fit and retries at once
   };
   /** Builds a fitter from the settings. */
@@ -295,6 +300,13 @@ private:
                      const std::vector<std::uint8_t>& alive) const;
   Fit fitOnce(Fitter& fitter, const FitInput& input, const std::vector<std::uint8_t>& alive,
               std::size_t estimator) const;
+  /** The cylinder of \a cluster's lid alone (fitLid), on objects with a support in organized
+   * clouds: an upright object seen from above. Not fitted when there is no lid, or the frame
+   * sees through its disc (seenThroughShare above kMaxSeenThrough). */
+  Fit fitLidOf(const Fitter& fitter, const TabletopCluster& cluster, const FitInput& input) const;
+  /** The points of the organized input around pixel box \a box (grown by half its size each
+   * way, every other pixel), as columns. */
+  Eigen::Matrix3Xf pointsAround(const PixelBox& box) const;
   /** Whether retry \a estimator would look where \a fit's axis already is (retryRepeats). */
   bool retryRepeats(const Fitter& fitter, std::size_t estimator, const Fit& fit) const;
   /** Fits and decides one cluster: one object, or several (recovery); the classifier's

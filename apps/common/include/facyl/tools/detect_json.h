@@ -19,7 +19,8 @@
 namespace facyl_cli {
 
 /** One object: id, support (index into "supports"; -1: none under it), centroid, n_points,
- * bbox (pixels; null without), the decision's evidence, "passes_gates" (facyl::passesGates
+ * bbox (pixels; null without), the decision's evidence ("from_lid": fitted to its lid alone,
+ * facyl::fitLid), "passes_gates" (facyl::passesGates
  * under \a decision), "features" (facyl::evidenceFeatures: what p_cylinder is computed from;
  * null when not fitted) and "cylinder" (cylinderObject, null when not fitted). */
 inline Json
@@ -50,6 +51,8 @@ objectJson(std::size_t id, const facyl::RecognizedObject& o,
   j["inner_share"] = num(e.shape.inner_share);
   j["outside_share"] = num(e.shape.outside_share);
   j["aspect"] = num(e.shape.aspect);
+  j["from_lid"] = e.from_lid;
+  j["seen_through"] = num(e.seen_through);
   j["passes_gates"] = facyl::passesGates(e, decision);
   if (e.fitted) {
     j["features"] = Json::array();

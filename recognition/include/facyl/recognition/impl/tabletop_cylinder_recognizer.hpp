@@ -4,6 +4,7 @@
 #pragma once
 
 #include <facyl/features/parallel.h>
+#include <facyl/recognition/cylinder_lid.h>
 #include <facyl/recognition/cylinder_parts.h>
 #include <facyl/recognition/cylinder_stack.h>
 #include <facyl/recognition/impl/classifier_input.hpp>
@@ -287,6 +288,9 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support)
     hough.setReferenceFrame(frame);
   fitter.with_support = support >= 0;
   fitter.up = frame.col(2);
+  fitter.support_plane = support >= 0
+                           ? segmentation_.getSupports()[static_cast<std::size_t>(support)].plane
+                           : Eigen::Vector4f::Zero();
   if (fitter.upright < fitter.estimators.size())
     fitter.estimators[fitter.upright].setAccumulators(
       {OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
@@ -505,14 +509,28 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
   object.cluster = std::move(cluster);
   const FitInput input = prepareFit(fitter, object.cluster);
   Fit best = fitWithRetries(fitter, input, {});
+  // An upright object seen from above: its lid, where the side gave no fit standing (within an
+  // accumulator cell of the support's normal: that one counts the lid as its cap already) or
+  // one that explains less.
+  bool lid = false;
+  if (!best.accepted && fitter.with_support && !retryRepeats(fitter, fitter.upright, best)) {
+    Fit f = fitLidOf(fitter, object.cluster, input);
+    if (f.evidence.fitted && passesGates(f.evidence, params_.decision) &&
+        (!best.evidence.fitted || f.explained_share > best.explained_share))
+      best = std::move(f), lid = true;
+  }
   if (best.evidence.fitted) {
     object.evidence = best.evidence;
     object.cylinder = best.model;
     for (auto& i : object.cylinder.inliers)
       i = input.subset[static_cast<std::size_t>(i)];
     object.is_cylinder = acceptCylinder(object.evidence, params_.decision);
-    if (object.is_cylinder)
+    if (object.is_cylinder && !lid) // a lid's rim is a circle in a plane: no side to refine on
       refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
+  }
+  if (lid) { // no side to cut at a step or to search for other cylinders
+    objects.push_back(std::move(object));
+    return;
   }
   // Objects stacked on each other, one cylinder fitted across them: each on its own.
   if (stacked > 1 && splitStack(fitter, object, input, best, p_network, stacked, objects))
@@ -910,6 +928,92 @@ TabletopCylinderRecognizer<PointT>::fitOnce(Fitter& fitter, const FitInput& inpu
             "p %.2f%s\n",
             estimator, fitted_points, f.model.radius, e.surface_ratio,
             geometricProbability(e, params_.decision), f.accepted ? ", accepted" : "");
+  return f;
+}
+
+template <typename PointT>
+Eigen::Matrix3Xf
+TabletopCylinderRecognizer<PointT>::pointsAround(const PixelBox& box) const
+{
+  // The box grown by half its size each way, every other pixel.
+  const int w = static_cast<int>(input_->width), h = static_cast<int>(input_->height);
+  const int gu = (box[2] - box[0]) / 2 + 1, gv = (box[3] - box[1]) / 2 + 1;
+  std::vector<Eigen::Vector3f> around;
+  for (int v = std::max(0, box[1] - gv); v <= std::min(h - 1, box[3] + gv); v += 2)
+    for (int u = std::max(0, box[0] - gu); u <= std::min(w - 1, box[2] + gu); u += 2) {
+      const auto& p = (*input_)(static_cast<std::size_t>(u), static_cast<std::size_t>(v));
+      if (pcl::isFinite(p))
+        around.push_back(p.getVector3fMap());
+    }
+  Eigen::Matrix3Xf out(3, static_cast<Eigen::Index>(around.size()));
+  for (std::size_t k = 0; k < around.size(); ++k)
+    out.col(static_cast<Eigen::Index>(k)) = around[k];
+  return out;
+}
+
+template <typename PointT>
+typename TabletopCylinderRecognizer<PointT>::Fit
+TabletopCylinderRecognizer<PointT>::fitLidOf(const Fitter& fitter, const TabletopCluster& cluster,
+                                             const FitInput& input) const
+{
+  Fit f;
+  if (!input_->isOrganized())
+    return f;
+  LidSettings s;
+  s.max_normal_angle = params_.hough.normal_angle_threshold;
+  s.min_radius = params_.hough.radius_min;
+  s.max_radius = params_.hough.radius_max;
+  const auto& idx = cluster.indices.indices;
+  Eigen::Matrix3Xf dense(3, static_cast<Eigen::Index>(idx.size()));
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    dense.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
+  const LidFit lid =
+    fitLid(input.columns, input.normals, fitter.support_plane, fitter.up, s, dense);
+  if (!lid.found)
+    return f;
+  // A solid lid hides what lies behind it: the frame around the object must not see through
+  // the disc.
+  const Eigen::Matrix3Xf seen = pointsAround(cluster.box);
+  const float through = seenThroughShare(seen, lid.model, lid.rim_band);
+  // ... and is an object's top: not walled in all round (a container's floor).
+  const float walled = walledShare(seen, lid.model, lid.rim_band);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid of %zu points: radius %.3f, height %.3f, rim "
+            "%.2f, seen through %.2f, walled %.2f\n",
+            lid.lid_points, lid.model.radius, lid.model.height, lid.rim_coverage, through, walled);
+  if (!(through <= kMaxSeenThrough) || walled > 0.5f)
+    return f;
+  f.model = lid.model;
+  // The evidence as for a side's fit, the lid's rim seen as its coverage: what the cylinder
+  // explains of the points (the lid as its cap, any side seen), what lies beyond it.
+  CylinderEvidence& e = f.evidence;
+  e.fitted = true;
+  e.from_lid = true;
+  e.seen_through = through;
+  e.angular_coverage = lid.rim_coverage;
+  const std::vector<Explained> why =
+    explainedPoints(f.model, input.columns, input.normals, explainSettings(f.model));
+  const auto n = static_cast<float>(std::max<std::size_t>(1, input.points->size()));
+  e.inlier_ratio = static_cast<float>(std::count(why.begin(), why.end(), Explained::Lateral)) / n;
+  e.surface_ratio =
+    static_cast<float>(
+      why.size() - static_cast<std::size_t>(std::count(why.begin(), why.end(), Explained::No))) /
+    n;
+  e.shape = shapeEvidence(f.model, input.columns, input.normals, input.scatter, {},
+                          f.model.distance_threshold);
+  e.shape.outside_share = lid.outside_share; // beyond the rim band: the lid's own measure
+  f.explained_share = e.surface_ratio;
+  // The columns' indices to the subset's (as the estimator's inliers).
+  pcl::Indices to_subset(static_cast<std::size_t>(input.columns.cols()));
+  for (std::size_t k = 0; k < input.column_of.size(); ++k)
+    if (input.column_of[k] >= 0)
+      to_subset[static_cast<std::size_t>(input.column_of[k])] = static_cast<pcl::index_t>(k);
+  for (auto& i : f.model.inliers)
+    i = to_subset[static_cast<std::size_t>(i)];
+  f.model.inlier_ratio = e.inlier_ratio;
+  f.accepted = acceptCylinder(e, params_.decision);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid fit: surface %.2f, outside %.2f, p %.2f%s\n",
+            e.surface_ratio, e.shape.outside_share, geometricProbability(e, params_.decision),
+            f.accepted ? ", accepted" : "");
   return f;
 }
 

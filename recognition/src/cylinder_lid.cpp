@@ -1,0 +1,198 @@
+/*
+ * facyl: fast cylinder detection for PCL.
+ */
+#include <facyl/features/polygon.h>
+#include <facyl/recognition/cylinder_lid.h>
+#include <facyl/sample_consensus_alt/cylinder_fitting.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace facyl {
+
+namespace {
+
+float
+medianOf(std::vector<float> v)
+{
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+} // namespace
+
+LidFit
+fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
+       const Eigen::Vector4f& support, const Eigen::Vector3f& up, const LidSettings& s,
+       const Eigen::Matrix3Xf& dense)
+{
+  LidFit out;
+  const Eigen::Vector3f u = up.normalized();
+  const Eigen::Vector3f n = support.head<3>();
+  const float side = u.dot(n) >= 0.f ? 1.f : -1.f; // heights grow towards the objects
+  const float along = side * u.dot(n);             // height per metre along up
+  if (!(along > 0.1f) || normals.cols() != points.cols() || !(s.rim_spacings > 0.f))
+    return out;
+  const auto height = [&](const Eigen::Vector3f& p) { return side * (n.dot(p) + support[3]); };
+  // Flat points above the support.
+  const float cos_max = std::cos(s.max_normal_angle);
+  std::vector<Eigen::Index> flat;
+  std::vector<float> h;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f nn = normals.col(i);
+    if (!nn.allFinite() || !points.col(i).allFinite() || std::abs(nn.dot(u)) < cos_max)
+      continue;
+    const float hi = height(points.col(i));
+    if (hi > 0.f)
+      flat.push_back(i), h.push_back(hi);
+  }
+  if (flat.size() < s.min_points)
+    return out;
+  // The lid's level: the flat points' median height, its band from their spread (at least a
+  // quarter of their spacing in the plane, the spacing of all flat points to begin with).
+  const float level = medianOf(h);
+  std::vector<float> dev(h.size());
+  for (std::size_t k = 0; k < h.size(); ++k)
+    dev[k] = std::abs(h[k] - level);
+  const Eigen::Vector3f e1 = u.unitOrthogonal(), e2 = u.cross(e1);
+  const auto spacing = [](const std::vector<Eigen::Vector2f>& hull, std::size_t count) {
+    return std::sqrt(polygonArea(hull) / static_cast<float>(std::max<std::size_t>(1, count)));
+  };
+  std::vector<Eigen::Vector2f> flat2;
+  for (const auto i : flat)
+    flat2.emplace_back(e1.dot(points.col(i)), e2.dot(points.col(i)));
+  const float band =
+    std::max(3.f * 1.4826f * medianOf(dev), 0.25f * spacing(convexHull2D(flat2), flat2.size()));
+  // The lid's points in the support's plane: of the dense points when given (the outline to
+  // their spacing), else of the flat ones.
+  pcl::Indices lid;
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < flat.size(); ++k)
+    if (dev[k] <= band) {
+      flat2[kept++] = flat2[k];
+      lid.push_back(static_cast<pcl::index_t>(flat[k]));
+    }
+  flat2.resize(kept);
+  if (lid.size() < s.min_points)
+    return out;
+  if (dense.cols() > 0) {
+    flat2.clear();
+    for (Eigen::Index i = 0; i < dense.cols(); ++i) {
+      const Eigen::Vector3f p = dense.col(i);
+      if (p.allFinite() && std::abs(height(p) - level) <= band)
+        flat2.emplace_back(e1.dot(p), e2.dot(p));
+    }
+    if (flat2.size() < s.min_points)
+      return out;
+  }
+  // Its circle, from the outline: the convex hull's vertices lie on the rim, or where an
+  // occluder's cut meets it.
+  const std::vector<Eigen::Vector2f> hull = convexHull2D(flat2);
+  if (hull.size() < 3)
+    return out;
+  out.rim_band = s.rim_spacings * spacing(hull, flat2.size());
+  Eigen::Matrix2Xf vertices(2, static_cast<Eigen::Index>(hull.size()));
+  for (std::size_t k = 0; k < hull.size(); ++k)
+    vertices.col(static_cast<Eigen::Index>(k)) = hull[k];
+  Circle circle;
+  if (!fitCircleAlgebraic(vertices, circle) || !fitCircle(vertices, out.rim_band, circle))
+    return out;
+  std::size_t on_circle = 0;
+  for (const auto& v : hull)
+    on_circle += std::abs((v - circle.center).norm() - circle.radius) <= out.rim_band;
+  if (on_circle < 3 || !(circle.radius >= s.min_radius && circle.radius <= s.max_radius))
+    return out;
+  // The rim seen, and what lies beyond it.
+  const int sectors = std::max(4, s.sectors);
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(sectors), 0);
+  std::size_t outside = 0;
+  for (const auto& q : flat2) {
+    const Eigen::Vector2f d = q - circle.center;
+    const float rho = d.norm();
+    outside += rho > circle.radius + out.rim_band;
+    if (std::abs(rho - circle.radius) <= out.rim_band) {
+      const float a = std::atan2(d.y(), d.x()) + static_cast<float>(M_PI);
+      const int k = std::min(sectors - 1, static_cast<int>(a / (2.f * static_cast<float>(M_PI)) *
+                                                           static_cast<float>(sectors)));
+      seen[static_cast<std::size_t>(k)] = 1;
+    }
+  }
+  // The cylinder: from the support up to the lid.
+  CylinderModel& m = out.model;
+  const Eigen::Vector3f in_plane = e1 * circle.center.x() + e2 * circle.center.y();
+  m.axis = u;
+  m.base = in_plane - u * (height(in_plane) / along);
+  m.top = m.base + u * (level / along);
+  m.point_on_axis = m.base;
+  m.height = (m.top - m.base).norm();
+  m.radius = circle.radius;
+  m.inliers = std::move(lid);
+  m.inlier_ratio = 0.f;
+  m.distance_threshold = band;
+  double sq = 0.0;
+  for (const float d : dev)
+    if (d <= band)
+      sq += static_cast<double>(d) * d;
+  m.rms_error = static_cast<float>(std::sqrt(sq / static_cast<double>(m.inliers.size())));
+  out.lid_points = m.inliers.size();
+  out.rim_coverage =
+    static_cast<float>(std::count(seen.begin(), seen.end(), 1)) / static_cast<float>(sectors);
+  m.angular_coverage = out.rim_coverage;
+  out.outside_share = static_cast<float>(outside) / static_cast<float>(flat2.size());
+  out.found = out.rim_coverage >= s.min_rim_coverage;
+  return out;
+}
+
+float
+seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band)
+{
+  const Eigen::Vector3f a = lid.axis.normalized();
+  const float plane = a.dot(lid.top); // the lid's plane: a . y = plane
+  std::size_t crossing = 0, through = 0;
+  for (Eigen::Index i = 0; i < seen.cols(); ++i) {
+    const Eigen::Vector3f x = seen.col(i);
+    const float along = a.dot(x);
+    if (!x.allFinite() || std::abs(along) < 1e-6f)
+      continue;
+    const float t = plane / along; // the ray's point on the plane: t x
+    if (!(t > 0.f))
+      continue;
+    const Eigen::Vector3f y = t * x - lid.top;
+    if ((y - a * a.dot(y)).norm() > lid.radius - band)
+      continue;
+    ++crossing;
+    through += (1.f - t) * x.norm() > band; // x lies beyond the disc
+  }
+  return crossing == 0 ? std::numeric_limits<float>::quiet_NaN()
+                       : static_cast<float>(through) / static_cast<float>(crossing);
+}
+
+float
+walledShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band)
+{
+  constexpr int sectors = 36;
+  const Eigen::Vector3f a = lid.axis.normalized();
+  const Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
+  const float outer = lid.radius + std::max(3.f * band, 0.2f * lid.radius);
+  std::vector<std::uint8_t> walled(sectors, 0);
+  for (Eigen::Index i = 0; i < seen.cols(); ++i) {
+    const Eigen::Vector3f d = seen.col(i) - lid.top;
+    if (!d.allFinite() || a.dot(d) <= band)
+      continue;
+    const float x = e1.dot(d), y = e2.dot(d), rho = std::hypot(x, y);
+    if (rho <= lid.radius + band || rho > outer)
+      continue;
+    const float angle = std::atan2(y, x) + static_cast<float>(M_PI);
+    walled[static_cast<std::size_t>(std::min(
+      sectors - 1, static_cast<int>(angle / (2.f * static_cast<float>(M_PI)) * sectors)))] = 1;
+  }
+  return static_cast<float>(std::count(walled.begin(), walled.end(), 1)) / sectors;
+}
+
+} // namespace facyl
