@@ -25,6 +25,32 @@ medianOf(std::vector<float> v)
   return *mid;
 }
 
+/** The sector (of \a sectors around the circle) of the direction (x, y). */
+std::size_t
+sectorOf(float x, float y, int sectors)
+{
+  const float a = std::atan2(y, x) + static_cast<float>(M_PI);
+  return static_cast<std::size_t>(
+    std::min(sectors - 1,
+             static_cast<int>(a / (2.f * static_cast<float>(M_PI)) * static_cast<float>(sectors))));
+}
+
+/** The circle through the outline \a hull's vertices: fitCircleAlgebraic, then fitCircle within
+ * \a band; false unless 3 vertices lie within \a band of it. */
+bool
+circleOfOutline(const std::vector<Eigen::Vector2f>& hull, float band, Circle& circle)
+{
+  Eigen::Matrix2Xf vertices(2, static_cast<Eigen::Index>(hull.size()));
+  for (std::size_t k = 0; k < hull.size(); ++k)
+    vertices.col(static_cast<Eigen::Index>(k)) = hull[k];
+  if (!fitCircleAlgebraic(vertices, circle) || !fitCircle(vertices, band, circle))
+    return false;
+  std::size_t on_circle = 0;
+  for (const auto& v : hull)
+    on_circle += std::abs((v - circle.center).norm() - circle.radius) <= band;
+  return on_circle >= 3;
+}
+
 } // namespace
 
 LidFit
@@ -97,16 +123,9 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   if (hull.size() < 3)
     return out;
   out.rim_band = s.rim_spacings * spacing(hull, flat2.size());
-  Eigen::Matrix2Xf vertices(2, static_cast<Eigen::Index>(hull.size()));
-  for (std::size_t k = 0; k < hull.size(); ++k)
-    vertices.col(static_cast<Eigen::Index>(k)) = hull[k];
   Circle circle;
-  if (!fitCircleAlgebraic(vertices, circle) || !fitCircle(vertices, out.rim_band, circle))
-    return out;
-  std::size_t on_circle = 0;
-  for (const auto& v : hull)
-    on_circle += std::abs((v - circle.center).norm() - circle.radius) <= out.rim_band;
-  if (on_circle < 3 || !(circle.radius >= s.min_radius && circle.radius <= s.max_radius))
+  if (!circleOfOutline(hull, out.rim_band, circle) ||
+      !(circle.radius >= s.min_radius && circle.radius <= s.max_radius))
     return out;
   // The rim seen, and what lies beyond it.
   const int sectors = std::max(4, s.sectors);
@@ -116,12 +135,8 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
     const Eigen::Vector2f d = q - circle.center;
     const float rho = d.norm();
     outside += rho > circle.radius + out.rim_band;
-    if (std::abs(rho - circle.radius) <= out.rim_band) {
-      const float a = std::atan2(d.y(), d.x()) + static_cast<float>(M_PI);
-      const int k = std::min(sectors - 1, static_cast<int>(a / (2.f * static_cast<float>(M_PI)) *
-                                                           static_cast<float>(sectors)));
-      seen[static_cast<std::size_t>(k)] = 1;
-    }
+    if (std::abs(rho - circle.radius) <= out.rim_band)
+      seen[sectorOf(d.x(), d.y(), sectors)] = 1;
   }
   // The cylinder: from the support up to the lid.
   CylinderModel& m = out.model;
@@ -188,9 +203,7 @@ walledShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band)
     const float x = e1.dot(d), y = e2.dot(d), rho = std::hypot(x, y);
     if (rho <= lid.radius + band || rho > outer)
       continue;
-    const float angle = std::atan2(y, x) + static_cast<float>(M_PI);
-    walled[static_cast<std::size_t>(std::min(
-      sectors - 1, static_cast<int>(angle / (2.f * static_cast<float>(M_PI)) * sectors)))] = 1;
+    walled[sectorOf(x, y, sectors)] = 1;
   }
   return static_cast<float>(std::count(walled.begin(), walled.end(), 1)) / sectors;
 }
