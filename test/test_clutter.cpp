@@ -825,6 +825,16 @@ TEST(ShapeEvidence, LargestCircularWindowShare)
   EXPECT_FLOAT_EQ(facyl::largestCircularWindowShare({1.f, 1.f, 1.f}, 0.f), 1.f);
 }
 
+TEST(CylinderEvidence, CircleSectorsCountFromMinusXRoundThroughMinusY)
+{
+  EXPECT_EQ(facyl::circleSector(-1.f, -1e-4f, 36), 0u);
+  EXPECT_EQ(facyl::circleSector(0.f, -1.f, 36), 9u);
+  EXPECT_EQ(facyl::circleSector(1.f, 0.f, 36), 18u);
+  EXPECT_EQ(facyl::circleSector(0.f, 1.f, 36), 27u);
+  EXPECT_EQ(facyl::circleSector(-1.f, 0.f, 36), 35u); // pi: the last sector, not past it
+  EXPECT_EQ(facyl::circleSector(1.f, 1.f, 4), 2u);
+}
+
 TEST(CylinderEvidence, TheDecisionUsesEveryCheck)
 {
   facyl::CylinderEvidence e;

@@ -345,6 +345,15 @@ convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& norm
                : std::numeric_limits<float>::quiet_NaN();
 }
 
+std::size_t
+circleSector(float x, float y, int sectors)
+{
+  const float a = std::atan2(y, x) + static_cast<float>(M_PI); // [0, 2 pi]
+  return static_cast<std::size_t>(
+    std::min(sectors - 1,
+             static_cast<int>(a / (2.f * static_cast<float>(M_PI)) * static_cast<float>(sectors))));
+}
+
 float
 arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points)
 {
@@ -354,10 +363,7 @@ arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points)
   int count[sectors] = {0};
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3f d = points.col(i) - model.base;
-    const float angle = std::atan2(d.dot(e2), d.dot(e1)); // (-pi, pi]
-    const int k = static_cast<int>(
-      std::floor((angle + static_cast<float>(M_PI)) / (2.f * static_cast<float>(M_PI)) * sectors));
-    ++count[std::clamp(k, 0, sectors - 1)];
+    ++count[circleSector(d.dot(e1), d.dot(e2), sectors)];
   }
   int occupied = 0;
   for (const int c : count)

@@ -2,6 +2,7 @@
  * facyl: fast cylinder detection for PCL.
  */
 #include <facyl/features/polygon.h>
+#include <facyl/recognition/cylinder_evidence.h>
 #include <facyl/recognition/cylinder_lid.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 
@@ -23,16 +24,6 @@ medianOf(std::vector<float> v)
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
-}
-
-/** The sector (of \a sectors around the circle) of the direction (x, y). */
-std::size_t
-sectorOf(float x, float y, int sectors)
-{
-  const float a = std::atan2(y, x) + static_cast<float>(M_PI);
-  return static_cast<std::size_t>(
-    std::min(sectors - 1,
-             static_cast<int>(a / (2.f * static_cast<float>(M_PI)) * static_cast<float>(sectors))));
 }
 
 /** The circle through the outline \a hull's vertices: fitCircleAlgebraic, then fitCircle within
@@ -136,7 +127,7 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
     const float rho = d.norm();
     outside += rho > circle.radius + out.rim_band;
     if (std::abs(rho - circle.radius) <= out.rim_band)
-      seen[sectorOf(d.x(), d.y(), sectors)] = 1;
+      seen[circleSector(d.x(), d.y(), sectors)] = 1;
   }
   // The cylinder: from the support up to the lid.
   CylinderModel& m = out.model;
@@ -203,7 +194,7 @@ walledShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band)
     const float x = e1.dot(d), y = e2.dot(d), rho = std::hypot(x, y);
     if (rho <= lid.radius + band || rho > outer)
       continue;
-    walled[sectorOf(x, y, sectors)] = 1;
+    walled[circleSector(x, y, sectors)] = 1;
   }
   return static_cast<float>(std::count(walled.begin(), walled.end(), 1)) / sectors;
 }

@@ -238,6 +238,11 @@ float convexJunctionShare(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf
  * 2 occupied sectors. */
 float arcGap(const CylinderModel& model, const Eigen::Matrix3Xf& points);
 
+/** \brief The sector, of \a sectors equal ones counted from the direction -x round through -y,
+ * that the direction (\a x, \a y) lies in: in [0, sectors). What arcGap and the lid's rim
+ * (fitLid, walledShare) count sectors by. */
+std::size_t circleSector(float x, float y, int sectors);
+
 /** \brief Evidence for a cylinder found inside a larger cluster, judged on the points around
  * it: its region holds the columns of \a points flagged in \a alive (all when empty) within
  * radius + max(radial_margin x radius, margin) + 2 x distance of the axis and within
