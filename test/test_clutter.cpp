@@ -1362,6 +1362,24 @@ TEST(ClutterRecognition, ATinAndTheTubeBelowItAreCutWhereTheSectionChanges)
   }
 }
 
+TEST(ClutterRecognition, WhatTheRecoveredCylindersLeaveIsFittedOnItsOwn)
+{
+  // Simulated cluttered scene 1073 (Kinect): 5, a can (r 4.0 cm) standing against 7, a cup,
+  // and 4 are one cluster. Recovery takes the cup and 4's side from it; the rest, the can, is
+  // an object of its own and gets a fit of its own (before: no fit, so no cylinder).
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 1073;
+  const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+  const auto objects = recognize(s);
+  const facyl::RecognizedObject* can = objectOf(objects, s, 5);
+  ASSERT_NE(can, nullptr);
+  ASSERT_TRUE(can->evidence.fitted);
+  EXPECT_NEAR(can->cylinder.radius, 0.0396f, 0.004f);
+  const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, s.scene.objects[5 - 2]);
+  EXPECT_LT(facyl::axisAngle(can->cylinder.axis, t.axis), 0.05f);
+  EXPECT_TRUE(can->is_cylinder);
+}
+
 TEST(ClutterRecognition, SimulatedClutterAgainstGroundTruth)
 {
   // Seeded cluttered scenes (touching, stacked, leaning objects; both sensors): objects seen

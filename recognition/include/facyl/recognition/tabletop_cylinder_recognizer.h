@@ -314,9 +314,10 @@ private:
    * objects). */
   void recognizeCluster(Fitter& fitter, TabletopCluster cluster, float p_network,
                         std::vector<RecognizedObject>& objects) const;
-  /** recognizeCluster for a cluster that may be cut \a stacked - 1 levels deep (splitStack). */
+  /** recognizeCluster for a cluster that may be cut \a stacked - 1 levels deep (splitStack) and
+   * yield up to \a cylinders cylinders by recovery (extractCylinders; 1: no recovery). */
   void recognizeStack(Fitter& fitter, TabletopCluster cluster, float p_network, std::size_t stacked,
-                      std::vector<RecognizedObject>& objects) const;
+                      std::size_t cylinders, std::vector<RecognizedObject>& objects) const;
   /** When \a fit's side is two sections (findSectionStep): \a whole cut at the step, each part
    * recognized (recognizeStack, \a stacked - 1 levels) and appended to \a objects
    * when one of them is a cylinder. \return whether it was cut. */
@@ -325,16 +326,20 @@ private:
                   std::vector<RecognizedObject>& objects) const;
   /** A cluster of \a indices (ascending) cut from \a whole: its support, centroid and box. */
   TabletopCluster partOf(const TabletopCluster& whole, pcl::Indices indices) const;
-  /** Cylinder-first recovery: the cylinders of a cluster, one after another, starting with
-   * its best fit. */
-  std::vector<Fit> extractCylinders(Fitter& fitter, const FitInput& input, Fit first) const;
+  /** Cylinder-first recovery: up to \a cylinders cylinders of a cluster, one after another,
+   * starting with its best fit. */
+  std::vector<Fit> extractCylinders(Fitter& fitter, const FitInput& input, Fit first,
+                                    std::size_t cylinders) const;
   /** Least squares of \a model on the cluster's points (\a indices) near its surface. */
   void refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
   ExplainSettings explainSettings(const CylinderModel& model) const;
-  /** The cluster split into one object per cylinder and the rest. */
-  void splitCluster(const RecognizedObject& whole, const FitInput& input,
-                    const std::vector<Fit>& parts, std::vector<RecognizedObject>& objects) const;
+  /** The cluster split into one object per cylinder (appended to \a objects) and the rest.
+   * \return the rest's indices (ascending) when it is an object of its own, else none (a small
+   * rest goes to the first cylinder's object). */
+  pcl::Indices splitCluster(const RecognizedObject& whole, const FitInput& input,
+                            const std::vector<Fit>& parts,
+                            std::vector<RecognizedObject>& objects) const;
 
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;

@@ -496,13 +496,15 @@ TabletopCylinderRecognizer<PointT>::recognizeCluster(Fitter& fitter, TabletopClu
                                                      float p_network,
                                                      std::vector<RecognizedObject>& objects) const
 {
-  recognizeStack(fitter, std::move(cluster), p_network, params_.max_stacked_objects, objects);
+  recognizeStack(fitter, std::move(cluster), p_network, params_.max_stacked_objects,
+                 params_.max_cylinders_per_cluster, objects);
 }
 
 template <typename PointT>
 void
 TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopCluster cluster,
                                                    float p_network, std::size_t stacked,
+                                                   std::size_t cylinders,
                                                    std::vector<RecognizedObject>& objects) const
 {
   RecognizedObject object;
@@ -539,11 +541,16 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
   // does not see as a cylinder as a whole, may hold several objects (each part is then
   // classified on its own view).
   const bool doubted = classifier_ && p_network < params_.decision.min_probability;
-  if (params_.max_cylinders_per_cluster > 1 && best.evidence.fitted &&
+  if (cylinders > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
-    std::vector<Fit> parts = extractCylinders(fitter, input, std::move(best));
+    std::vector<Fit> parts = extractCylinders(fitter, input, std::move(best), cylinders);
     if (!parts.empty()) {
-      splitCluster(object, input, parts, objects);
+      pcl::Indices rest = splitCluster(object, input, parts, objects);
+      // What no cylinder explains is an object of its own (a can beside the cup found first):
+      // fitted as one, with the cylinders the cluster may still yield.
+      if (!rest.empty())
+        recognizeStack(fitter, partOf(object.cluster, std::move(rest)), p_network, stacked,
+                       std::max<std::size_t>(1, cylinders - parts.size()), objects);
       return;
     }
   }
@@ -580,7 +587,8 @@ TabletopCylinderRecognizer<PointT>::splitStack(Fitter& fitter, const RecognizedO
     return false;
   std::vector<RecognizedObject> parts;
   for (auto& p : part)
-    recognizeStack(fitter, partOf(whole.cluster, std::move(p)), p_network, stacked - 1, parts);
+    recognizeStack(fitter, partOf(whole.cluster, std::move(p)), p_network, stacked - 1,
+                   params_.max_cylinders_per_cluster, parts);
   // Kept when a part is a cylinder (by the fit: the classifier judges each part's view later);
   // else the whole as fitted.
   if (std::none_of(parts.begin(), parts.end(),
@@ -609,8 +617,8 @@ TabletopCylinderRecognizer<PointT>::partOf(const TabletopCluster& whole, pcl::In
 
 template <typename PointT>
 std::vector<typename TabletopCylinderRecognizer<PointT>::Fit>
-TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitInput& input,
-                                                     Fit fit) const
+TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitInput& input, Fit fit,
+                                                     std::size_t cylinders) const
 {
   // Judged on the points around each cylinder; the margins make a sphere's or a cone's band
   // leave the rest of the sphere or cone in its region, and a box edge its faces.
@@ -624,7 +632,7 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
   for (std::size_t k = 0; k < alive.size(); ++k)
     left += alive[k] = input.column_of[k] >= 0;
   const std::size_t min_part = std::max<std::size_t>(30, input.points->size() / 30);
-  for (std::size_t round = 0; round < params_.max_cylinders_per_cluster; ++round) {
+  for (std::size_t round = 0; round < cylinders; ++round) {
     if (round > 0)
       fit = fitWithRetries(fitter, input, alive);
     if (!fit.evidence.fitted)
@@ -738,7 +746,7 @@ TabletopCylinderRecognizer<PointT>::explainSettings(const CylinderModel& model) 
 }
 
 template <typename PointT>
-void
+pcl::Indices
 TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
                                                  const FitInput& input,
                                                  const std::vector<Fit>& parts,
@@ -759,14 +767,12 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
         owner[k] = static_cast<int>(p);
   }
   const auto& seg = segmentation_.getParameters();
-  const auto make = [&](int part) {
+  const auto of = [&](int part) {
     pcl::Indices mine;
     for (std::size_t k = 0; k < idx.size(); ++k)
       if (owner[k] == part)
         mine.push_back(idx[k]);
-    RecognizedObject o;
-    o.cluster = partOf(whole.cluster, std::move(mine));
-    return o;
+    return mine;
   };
   // What no cylinder explains is an object of its own when it is large (a box beside a
   // can); a small rest is the unexplained part of the cylinders found (a handle, a rim) and
@@ -778,7 +784,8 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
   if (!rest_is_object)
     std::replace(owner.begin(), owner.end(), -1, 0);
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    RecognizedObject o = make(static_cast<int>(p));
+    RecognizedObject o;
+    o.cluster = partOf(whole.cluster, of(static_cast<int>(p)));
     o.evidence = parts[p].evidence;
     o.cylinder = parts[p].model;
     for (auto& i : o.cylinder.inliers)
@@ -787,8 +794,7 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     o.is_cylinder = true;
     objects.push_back(std::move(o));
   }
-  if (rest_is_object)
-    objects.push_back(make(-1));
+  return rest_is_object ? of(-1) : pcl::Indices();
 }
 
 template <typename PointT>
