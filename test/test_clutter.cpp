@@ -649,6 +649,14 @@ TEST(CylinderLid, TheDiscOfAnUprightTinSeenFromAbove)
   discOf(
     0.05f, 0.1f, -0.05f, 0.1f, 0.003f, [](float x, float) { return x > 0.125f; }, pts, nrm);
   EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
+  // A dome's top (heights spread over 6 mm) is no lid where the sensor sees flat things to 2 mm.
+  discOf(0.05f, 0.f, 0.f, 0.1f, 0.003f, all, pts, nrm);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i)
+    pts(2, i) -= 2.4f * pts.col(i).head<2>().squaredNorm();
+  facyl::LidSettings flat_to_2mm;
+  flat_to_2mm.max_band = 0.002f;
+  EXPECT_TRUE(facyl::fitLid(pts, nrm, table, up).found);
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up, flat_to_2mm).found);
   // No lid: too few points, a radius beyond the limits, normals across the axis.
   discOf(0.008f, 0.f, 0.f, 0.1f, 0.003f, all, pts, nrm);
   EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);
@@ -685,17 +693,23 @@ TEST(CylinderLid, AFrameSeesThroughTheDiscFittedToABoxTop)
   const float band = 0.005f;
   // A tin's lid hides the table; so does a nearer object over part of it.
   const auto tin = [](float x, float y) { return x * x + y * y <= 0.05f * 0.05f ? 0.9f : 1.f; };
-  EXPECT_EQ(facyl::seenThroughShare(frame(tin), lid, band), 0.f);
+  EXPECT_EQ(facyl::seenThroughShare(frame(tin), lid, band, band), 0.f);
+  // A noisy lid (a stereo sensor's: 4 mm deeper in places) is no hole within the noise.
+  const auto noisy = [&](float x, float y) {
+    return tin(x, y) + (tin(x, y) < 1.f && (static_cast<int>(x * 1000.f) % 3 == 0) ? 0.004f : 0.f);
+  };
+  EXPECT_EQ(facyl::seenThroughShare(frame(noisy), lid, band, 0.006f), 0.f);
+  EXPECT_GT(facyl::seenThroughShare(frame(noisy), lid, band, 0.002f), 0.1f);
   const auto occluded = [&](float x, float y) { return x > 0.02f ? 0.5f : tin(x, y); };
-  EXPECT_EQ(facyl::seenThroughShare(frame(occluded), lid, band), 0.f);
+  EXPECT_EQ(facyl::seenThroughShare(frame(occluded), lid, band, band), 0.f);
   // A box's top (7 x 7 cm) under the circle through its corners: the table is seen beside it
   // (the disc within r - band: 1 - 0.0049 / (pi 0.045^2), 0.23).
   const auto box = [](float x, float y) {
     return std::abs(x) <= 0.035f && std::abs(y) <= 0.035f ? 0.9f : 1.f;
   };
-  EXPECT_NEAR(facyl::seenThroughShare(frame(box), lid, band), 0.23f, 0.04f);
+  EXPECT_NEAR(facyl::seenThroughShare(frame(box), lid, band, band), 0.23f, 0.04f);
   // No ray crosses the disc.
-  EXPECT_TRUE(std::isnan(facyl::seenThroughShare(Eigen::Matrix3Xf(3, 0), lid, band)));
+  EXPECT_TRUE(std::isnan(facyl::seenThroughShare(Eigen::Matrix3Xf(3, 0), lid, band, band)));
   // A cup's floor: its wall rises above the disc all round; a tin's lid beside a taller can
   // (x > 0.06) is walled on that side alone.
   const auto cup = [](float x, float y) { // the wall's top: 5.1-5.6 cm from the axis at 0.8 m

@@ -84,8 +84,10 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   std::vector<Eigen::Vector2f> flat2;
   for (const auto i : flat)
     flat2.emplace_back(e1.dot(points.col(i)), e2.dot(points.col(i)));
-  const float band =
-    std::max(3.f * 1.4826f * medianOf(dev), 0.25f * spacing(convexHull2D(flat2), flat2.size()));
+  const float spread = 3.f * 1.4826f * medianOf(dev);
+  if (!(spread <= s.max_band))
+    return out;
+  const float band = std::max(spread, 0.25f * spacing(convexHull2D(flat2), flat2.size()));
   // The lid's points in the support's plane: of the dense points when given (the outline to
   // their spacing), else of the flat ones.
   pcl::Indices lid;
@@ -156,7 +158,8 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
 }
 
 float
-seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band)
+seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float rim_band,
+                 float depth_band)
 {
   const Eigen::Vector3f a = lid.axis.normalized();
   const float plane = a.dot(lid.top); // the lid's plane: a . y = plane
@@ -170,10 +173,10 @@ seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float b
     if (!(t > 0.f))
       continue;
     const Eigen::Vector3f y = t * x - lid.top;
-    if ((y - a * a.dot(y)).norm() > lid.radius - band)
+    if ((y - a * a.dot(y)).norm() > lid.radius - rim_band)
       continue;
     ++crossing;
-    through += (1.f - t) * x.norm() > band; // x lies beyond the disc
+    through += plane - along > depth_band; // x lies below the disc
   }
   return crossing == 0 ? std::numeric_limits<float>::quiet_NaN()
                        : static_cast<float>(through) / static_cast<float>(crossing);

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <limits>
 
 namespace facyl {
 
@@ -29,6 +30,10 @@ struct LidSettings {
   /** The rim is seen over at least this share of the circle: a shorter arc fits circles of
    * many radii (a flat fragment, a tab, is no lid). */
   float min_rim_coverage{0.5f};
+  /** The lid's height band (3 robust sigmas of its flat points' heights) is at most this: a
+   * lid is as flat as the sensor sees its support at that range (the caller: the support's
+   * band there); a dome's top within max_normal_angle is not. Infinite: no limit. */
+  float max_band{std::numeric_limits<float>::infinity()};
 };
 
 /** \brief What fitLid found. */
@@ -68,11 +73,13 @@ LidFit fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
               const LidSettings& settings = {}, const Eigen::Matrix3Xf& dense = Eigen::Matrix3Xf());
 
 /** \brief Share of the rays of \a seen (points of the frame around the object, the sensor at
- * the origin) that cross the lid of \a lid (its top's disc, within radius - \a band of the
- * axis) and see something farther than it by more than \a band: a solid lid hides what lies
- * behind it, so where the frame sees through the disc, there is none (beside a box top's sides,
- * the table under the circle fitted across its corners). NaN when no ray crosses the disc. */
-float seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float band);
+ * the origin) that cross the lid of \a lid (its top's disc, within radius - \a rim_band of the
+ * axis) and see something lower than it by more than \a depth_band (the sensor's noise there):
+ * a solid lid hides what lies behind it, so where the frame sees through the disc, there is
+ * none (beside a box top's sides, the table under the circle fitted across its corners). NaN
+ * when no ray crosses the disc. */
+float seenThroughShare(const Eigen::Matrix3Xf& seen, const CylinderModel& lid, float rim_band,
+                       float depth_band);
 
 /** \brief Share of the 36 sectors around the lid of \a lid (its top's disc) where a point of
  * \a seen rises above the lid's plane by more than \a band just beyond its rim (between

@@ -291,6 +291,9 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support)
   fitter.support_plane = support >= 0
                            ? segmentation_.getSupports()[static_cast<std::size_t>(support)].plane
                            : Eigen::Vector4f::Zero();
+  fitter.support_band = support >= 0
+                          ? segmentation_.getSupports()[static_cast<std::size_t>(support)].band
+                          : DepthBand();
   if (fitter.upright < fitter.estimators.size())
     fitter.estimators[fitter.upright].setAccumulators(
       {OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
@@ -965,7 +968,14 @@ TabletopCylinderRecognizer<PointT>::fitLidOf(const Fitter& fitter, const Tableto
   Fit f;
   if (!input_->isOrganized())
     return f;
+  // The sensor's noise at the object's range: its support's band there (the same sensor saw
+  // that plane): a lid is as flat, and a ray sees through it when it sees beyond that. A
+  // support without a band (none measured): no flatness limit, the rim's band for depth.
+  const float noise = fitter.support_band.halfWidth(cluster.centroid.norm());
+  const bool known = noise > 0.f && std::isfinite(noise);
   LidSettings s;
+  if (known)
+    s.max_band = noise;
   s.max_normal_angle = params_.hough.normal_angle_threshold;
   s.min_radius = params_.hough.radius_min;
   s.max_radius = params_.hough.radius_max;
@@ -980,7 +990,8 @@ TabletopCylinderRecognizer<PointT>::fitLidOf(const Fitter& fitter, const Tableto
   // A solid lid hides what lies behind it: the frame around the object must not see through
   // the disc.
   const Eigen::Matrix3Xf seen = pointsAround(cluster.box);
-  const float through = seenThroughShare(seen, lid.model, lid.rim_band);
+  const float through =
+    seenThroughShare(seen, lid.model, lid.rim_band, known ? noise : lid.rim_band);
   // ... and is an object's top: not walled in all round (a container's floor).
   const float walled = walledShare(seen, lid.model, lid.rim_band);
   PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid of %zu points: radius %.3f, height %.3f, rim "
