@@ -331,8 +331,10 @@ private:
    * starting with its best fit. */
   std::vector<Fit> extractCylinders(Fitter& fitter, const FitInput& input, Fit first,
                                     std::size_t cylinders) const;
-  /** Least squares of \a model on the cluster's points (\a indices) near its surface. */
-  void refineOnAllPoints(const pcl::Indices& indices, CylinderModel& model) const;
+  /** Least squares of \a model on the cluster's points (\a indices) near its surface: every
+   * pixel of the \a stride x \a stride cells of its inliers (the fit's lattice; organized
+   * clouds, stride > 1). */
+  void refineOnAllPoints(const pcl::Indices& indices, int stride, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
   ExplainSettings explainSettings(const CylinderModel& model) const;
   /** The cluster split into one object per cylinder (appended to \a objects) and the rest.

@@ -33,6 +33,8 @@ template <typename PointT> struct TabletopCylinderRecognizer<PointT>::FitInput {
   Eigen::Matrix3Xf normals;                   ///< their normals
   Eigen::VectorXf scatter;                    ///< their neighbours' normal scatter (k_max + k_min)
   pcl::Indices column_of;                     ///< subset position -> column, -1 without
+  int cell{
+    1}; ///< organized: pixels per side of a lattice cell (a subset pixel stands for its cell)
 };
 
 template <typename PointT> struct TabletopCylinderRecognizer<PointT>::Fit {
@@ -531,7 +533,7 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
       i = input.subset[static_cast<std::size_t>(i)];
     object.is_cylinder = acceptCylinder(object.evidence, params_.decision);
     if (object.is_cylinder && !lid) // a lid's rim is a circle in a plane: no side to refine on
-      refineOnAllPoints(object.cluster.indices.indices, object.cylinder);
+      refineOnAllPoints(object.cluster.indices.indices, input.cell, object.cylinder);
   }
   if (lid) { // no side to cut at a step or to search for other cylinders
     objects.push_back(std::move(object));
@@ -681,14 +683,12 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
 
 template <typename PointT>
 void
-TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluster,
+TabletopCylinderRecognizer<PointT>::refineOnAllPoints(const pcl::Indices& cluster, int stride,
                                                       CylinderModel& model) const
 {
   // The fit saw a pixel grid; the surface is located better with every pixel of the grid
   // cells of its inliers (whose normals were checked: a cup's inner wall, near the surface by
   // position alone, is left out) within the inlier distance of the surface.
-  const int stride =
-    static_cast<int>(std::lround(params_.fit_point_angle * segmentation_.getFocalLength()));
   if (!input_->isOrganized() || stride <= 1 || model.inliers.size() < 20)
     return;
   const Eigen::Vector3f a = model.axis.normalized();
@@ -793,7 +793,7 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     o.cylinder = parts[p].model;
     for (auto& i : o.cylinder.inliers)
       i = input.subset[static_cast<std::size_t>(i)];
-    refineOnAllPoints(o.cluster.indices.indices, o.cylinder);
+    refineOnAllPoints(o.cluster.indices.indices, input.cell, o.cylinder);
     o.is_cylinder = true;
     objects.push_back(std::move(o));
   }
@@ -829,6 +829,7 @@ TabletopCylinderRecognizer<PointT>::prepareFit(Fitter& fitter, const TabletopClu
     const PixelLattice lattice =
       pixelLattice(cluster.indices.indices, input_->width, spacing, params_.max_fit_points);
     in.subset = lattice.pixels;
+    in.cell = static_cast<int>(std::lround(lattice.spacing));
     copySubset(in);
     // The lattice is an organized cloud of its own: the cues' neighbours come from its grid.
     fitter.cues.setInputCloud(latticeCloud(lattice, *in.points));
