@@ -657,6 +657,20 @@ TEST(CylinderLid, TheDiscOfAnUprightTinSeenFromAbove)
   flat_to_2mm.max_band = 0.002f;
   EXPECT_TRUE(facyl::fitLid(pts, nrm, table, up).found);
   EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up, flat_to_2mm).found);
+  // A flat lid with the sensor's noise (sigma 1 mm): its measured band (3 robust sigmas of its
+  // few points) scatters round the support's 3 mm and is a lid within two standard errors of
+  // that measure; at four times the noise it is not.
+  discOf(0.03f, 0.f, 0.f, 0.1f, 0.006f, all, pts, nrm);
+  facyl::Random rng(7);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i)
+    pts(2, i) += 0.001f * rng.normal();
+  facyl::LidSettings sensor;
+  sensor.max_band = 0.003f;
+  const facyl::LidFit noisy = facyl::fitLid(pts, nrm, table, up, sensor);
+  EXPECT_GT(noisy.model.distance_threshold, 0.003f) << "the sample's band is over the support's";
+  EXPECT_TRUE(noisy.found);
+  sensor.max_band = 0.00075f;
+  EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up, sensor).found);
   // No lid: too few points, a radius beyond the limits, normals across the axis.
   discOf(0.008f, 0.f, 0.f, 0.1f, 0.003f, all, pts, nrm);
   EXPECT_FALSE(facyl::fitLid(pts, nrm, table, up).found);

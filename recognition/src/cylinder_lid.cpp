@@ -85,7 +85,12 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   for (const auto i : flat)
     flat2.emplace_back(e1.dot(points.col(i)), e2.dot(points.col(i)));
   const float spread = 3.f * 1.4826f * medianOf(dev);
-  if (!(spread <= s.max_band))
+  // The spread is measured on the flat points alone (a median absolute deviation of n
+  // values: relative standard error 1.167 / sqrt(n) for normal noise): a lid is flatter than the
+  // band unless its spread exceeds it by two standard errors.
+  const float allowed =
+    s.max_band * (1.f + 2.f * 1.167f / std::sqrt(static_cast<float>(flat.size())));
+  if (!(spread <= allowed))
     return out;
   const float band = std::max(spread, 0.25f * spacing(convexHull2D(flat2), flat2.size()));
   // The lid's points in the support's plane: of the dense points when given (the outline to

@@ -30,9 +30,10 @@ struct LidSettings {
   /** The rim is seen over at least this share of the circle: a shorter arc fits circles of
    * many radii (a flat fragment, a tab, is no lid). */
   float min_rim_coverage{0.5f};
-  /** The lid's height band (3 robust sigmas of its flat points' heights) is at most this: a
-   * lid is as flat as the sensor sees its support at that range (the caller: the support's
-   * band there); a dome's top within max_normal_angle is not. Infinite: no limit. */
+  /** The lid's height band (3 robust sigmas of its n flat points' heights) is at most this,
+   * give or take two standard errors of that measure (1.167 / sqrt(n) of it): a lid is as flat
+   * as the sensor sees its support at that range (the caller: the support's band there); a
+   * dome's top within max_normal_angle is not. Infinite: no limit. */
   float max_band{std::numeric_limits<float>::infinity()};
 };
 
