@@ -33,8 +33,8 @@ template <typename PointT> struct TabletopCylinderRecognizer<PointT>::FitInput {
   Eigen::Matrix3Xf normals;                   ///< their normals
   Eigen::VectorXf scatter;                    ///< their neighbours' normal scatter (k_max + k_min)
   pcl::Indices column_of;                     ///< subset position -> column, -1 without
-  int cell{
-    1}; ///< organized: pixels per side of a lattice cell (a subset pixel stands for its cell)
+  /// Organized: pixels per side of the lattice's cells (each subset pixel stands for its cell).
+  int cell{1};
 };
 
 template <typename PointT> struct TabletopCylinderRecognizer<PointT>::Fit {
