@@ -614,6 +614,50 @@ discOf(float r, float cx, float cy, float z, float spacing, Keep keep, Eigen::Ma
 
 } // namespace
 
+TEST(CylinderStack, ALidInsideTheExtentIsWhereTheObjectBelowEnds)
+{
+  // One cylinder (r 5 cm, axis z, base 0, 20 cm) fitted across a tin (8 cm tall) and a box
+  // standing on it: the tin's lid shows round the box at z = 0.08, its normals up.
+  facyl::CylinderModel m;
+  m.axis = Eigen::Vector3f::UnitZ();
+  m.base = m.point_on_axis = Eigen::Vector3f::Zero();
+  m.top = Eigen::Vector3f(0.f, 0.f, 0.2f);
+  m.height = 0.2f;
+  m.radius = 0.05f;
+  const auto ring = [](float z, float sign, std::size_t n, float spread, Eigen::Matrix3Xf& pts,
+                       Eigen::Matrix3Xf& nrm) {
+    pts.resize(3, static_cast<Eigen::Index>(n));
+    nrm.resize(3, static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      const float phi = 6.2832f * static_cast<float>(k) / static_cast<float>(n);
+      const float rho = 0.035f + 0.01f * static_cast<float>(k % 3);
+      const float dz = spread * (static_cast<float>(k % 7) - 3.f);
+      pts.col(static_cast<Eigen::Index>(k)) << rho * std::cos(phi), rho * std::sin(phi), z + dz;
+      nrm.col(static_cast<Eigen::Index>(k)) << 0.f, 0.f, sign;
+    }
+  };
+  Eigen::Matrix3Xf pts, nrm;
+  ring(0.08f, 1.f, 60, 0.f, pts, nrm);
+  facyl::InteriorLid lid = facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f);
+  EXPECT_NEAR(lid.height, 0.08f, 1e-5f);
+  EXPECT_EQ(lid.facing, 1);
+  // Seen from below (normals down): the object above owns it.
+  ring(0.08f, -1.f, 60, 0.f, pts, nrm);
+  EXPECT_EQ(facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f).facing, -1);
+  // None: a cup's floor near its bottom (within 15 % of the extent), too few points, flat
+  // points spread over heights (no one lid), normals across the axis.
+  ring(0.01f, 1.f, 60, 0.f, pts, nrm);
+  EXPECT_TRUE(std::isnan(facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f).height));
+  ring(0.08f, 1.f, 20, 0.f, pts, nrm);
+  EXPECT_TRUE(std::isnan(facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f).height));
+  ring(0.1f, 1.f, 60, 0.01f, pts, nrm);
+  EXPECT_TRUE(std::isnan(facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f).height));
+  ring(0.08f, 1.f, 60, 0.f, pts, nrm);
+  nrm.row(2).setZero();
+  nrm.row(0).setOnes();
+  EXPECT_TRUE(std::isnan(facyl::interiorLid(m, pts, nrm, 0.6f, 0.004f).height));
+}
+
 TEST(CylinderLid, TheDiscOfAnUprightTinSeenFromAbove)
 {
   Eigen::Matrix3Xf pts, nrm;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace facyl {
@@ -263,6 +264,45 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   out.found =
     out.sigma_smooth >= s.min_improvement * out.sigma_step && gap >= s.min_step_sigmas * sigma_step;
   return out;
+}
+
+InteriorLid
+interiorLid(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+            const Eigen::Matrix3Xf& normals, float max_angle, float band,
+            const SectionStepSettings& settings)
+{
+  InteriorLid lid;
+  if (normals.cols() != points.cols() || !(model.radius > 0.f) || !(model.height > 0.f))
+    return lid;
+  const Eigen::Vector3f a = model.axis.normalized();
+  const float cos_max = std::cos(max_angle), margin = settings.min_side_share * model.height;
+  std::vector<float> t;
+  float facing = 0.f;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const Eigen::Vector3f w = points.col(i) - model.base;
+    const float ti = w.dot(a);
+    const float along = normals.col(i).dot(a);
+    if (ti < margin || ti > model.height - margin || !std::isfinite(along) ||
+        std::abs(along) < cos_max || (w - ti * a).norm() > model.radius + band)
+      continue;
+    t.push_back(ti);
+    facing += along;
+  }
+  if (t.size() < settings.min_side_points)
+    return lid;
+  const auto median = [](std::vector<float> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const float level = median(t);
+  std::vector<float> dev(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k)
+    dev[k] = std::abs(t[k] - level);
+  if (median(dev) <= band) {
+    lid.height = level;
+    lid.facing = facing >= 0.f ? 1 : -1;
+  }
+  return lid;
 }
 
 } // namespace facyl

@@ -64,4 +64,24 @@ SectionStep findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& 
                             const Eigen::Matrix3Xf& normals,
                             const SectionStepSettings& settings = {});
 
+/** \brief A lid seen inside a cylinder's extent (interiorLid). */
+struct InteriorLid {
+  /** Along the model's axis from its base; NaN: none. */
+  float height{std::numeric_limits<float>::quiet_NaN()};
+  /** +1 when the lid faces the axis's direction (its object lies below it, towards the base),
+   * -1 when it faces the base. */
+  int facing{0};
+};
+
+/** \brief Where an object's lid shows inside \a model's extent (a box standing on a tin, the
+ * tin's lid seen round it): the median position along the axis (from the base) of the columns of
+ * \a points whose normals (unit, alongside; facing the sensor) lie within \a max_angle (rad) of
+ * the axis, within the radius plus \a band of it and between min_side_share of the extent from
+ * either end, when there are at least min_side_points of them and they lie at one height (their
+ * median absolute deviation at most \a band); which way it faces from their normals' mean.
+ * A solid cylinder shows its lids at its ends only; a cup's floor lies at its bottom. */
+InteriorLid interiorLid(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                        const Eigen::Matrix3Xf& normals, float max_angle, float band,
+                        const SectionStepSettings& settings = {});
+
 } // namespace facyl

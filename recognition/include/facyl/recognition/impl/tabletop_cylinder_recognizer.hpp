@@ -581,12 +581,22 @@ TabletopCylinderRecognizer<PointT>::splitStack(Fitter& fitter, const RecognizedO
             fit.model.radius, step.side_points, step.sigma_smooth, step.sigma_step, step.height,
             step.radius_below, step.radius_above, step.centre_shift, step.gap,
             step.found ? "two" : "one");
-  if (!step.found)
-    return false;
+  // Else a lid inside the extent: the object below ends there (its lid goes with it).
+  float cut = step.height;
+  if (!step.found) {
+    const float band = 2.f * fit.model.distance_threshold;
+    const InteriorLid lid = interiorLid(fit.model, input.columns, input.normals,
+                                        params_.hough.normal_angle_threshold, band);
+    PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid inside the extent: %.3f of %.3f\n",
+              lid.height, fit.model.height);
+    if (!std::isfinite(lid.height))
+      return false;
+    cut = lid.height + static_cast<float>(lid.facing) * band; // the lid below the cut's side
+  }
   const Eigen::Vector3f a = fit.model.axis.normalized();
   std::array<pcl::Indices, 2> part;
   for (const auto i : whole.cluster.indices.indices)
-    part[a.dot((*input_)[i].getVector3fMap() - fit.model.base) >= step.height ? 1 : 0].push_back(i);
+    part[a.dot((*input_)[i].getVector3fMap() - fit.model.base) >= cut ? 1 : 0].push_back(i);
   const std::size_t min_size = params_.segmentation.min_cluster_size;
   if (part[0].size() < min_size || part[1].size() < min_size)
     return false;
