@@ -6,6 +6,8 @@
 #include <facyl/recognition/cylinder_lid.h>
 #include <facyl/sample_consensus_alt/cylinder_fitting.h>
 
+#include "median.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -18,13 +20,7 @@ namespace facyl {
 
 namespace {
 
-float
-medianOf(std::vector<float> v)
-{
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
+using detail::medianOf;
 
 /** The circle through the outline \a hull's vertices: fitCircleAlgebraic, then fitCircle within
  * \a band; false unless 3 vertices lie within \a band of it. */

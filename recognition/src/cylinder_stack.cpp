@@ -4,6 +4,8 @@
  */
 #include <facyl/recognition/cylinder_stack.h>
 
+#include "median.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -290,15 +292,11 @@ interiorLid(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   }
   if (t.size() < settings.min_side_points)
     return lid;
-  const auto median = [](std::vector<float> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  const float level = median(t);
+  const float level = detail::medianOf(t);
   std::vector<float> dev(t.size());
   for (std::size_t k = 0; k < t.size(); ++k)
     dev[k] = std::abs(t[k] - level);
-  if (median(dev) <= band) {
+  if (detail::medianOf(dev) <= band) {
     lid.height = level;
     lid.facing = facing >= 0.f ? 1 : -1;
   }

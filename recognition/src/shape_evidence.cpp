@@ -3,6 +3,8 @@
  */
 #include <facyl/recognition/shape_evidence.h>
 
+#include "median.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -16,15 +18,7 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kPi = static_cast<float>(M_PI);
 
-float
-median(std::vector<float> v)
-{
-  if (v.empty())
-    return kNaN;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
+using detail::medianOf;
 
 /** A point in the cylinder's frame: along the axis from the base, its radial vector and
  * distance, and its normal's parts along the axis and across it. */
@@ -134,7 +128,7 @@ shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   }
   if (deviation.size() >= 10) {
     if (noise.size() >= 10) // a floor far below any sensor's noise: a noiseless surface
-      e.normal_agreement = median(deviation) / std::max(std::sqrt(median(noise)), 1e-3f);
+      e.normal_agreement = medianOf(deviation) / std::max(std::sqrt(medianOf(noise)), 1e-3f);
     e.normal_concentration = largestCircularWindowShare(azimuth, 20.f * kPi / 180.f);
   }
   // The middle slices: a can's rims and a bottle's neck are narrower than its side, but
@@ -142,7 +136,7 @@ shapeEvidence(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   std::vector<float> radii;
   for (std::size_t k = 1; k + 1 < profile.size(); ++k)
     if (profile[k].size() >= 8)
-      radii.push_back(median(profile[k]));
+      radii.push_back(medianOf(profile[k]));
   if (radii.size() >= 3) {
     const auto [lo, hi] = std::minmax_element(radii.begin(), radii.end());
     e.profile_range = (*hi - *lo) / r;

@@ -267,7 +267,6 @@ private:
     bool with_support{false}; ///< the cluster being fitted has a support
     Eigen::Vector3f up{Eigen::Vector3f::UnitZ()}; ///< z of the prior frame (usePriorFrameOf)
     Eigen::Vector4f support_plane{Eigen::Vector4f::Zero()}; ///< the support's, with_support
-    DepthBand support_band;                                 ///< the support's, with_support
     int retry_threads{1}; ///< threads that run a cluster's first fit and retries at once
   };
   /** Builds a fitter from the settings. */

@@ -293,9 +293,6 @@ TabletopCylinderRecognizer<PointT>::usePriorFrameOf(Fitter& fitter, int support)
   fitter.support_plane = support >= 0
                            ? segmentation_.getSupports()[static_cast<std::size_t>(support)].plane
                            : Eigen::Vector4f::Zero();
-  fitter.support_band = support >= 0
-                          ? segmentation_.getSupports()[static_cast<std::size_t>(support)].band
-                          : DepthBand();
   if (fitter.upright < fitter.estimators.size())
     fitter.estimators[fitter.upright].setAccumulators(
       {OrientationAccumulator(Eigen::Matrix3Xf(frame.col(2)))});
@@ -977,12 +974,14 @@ TabletopCylinderRecognizer<PointT>::fitLidOf(const Fitter& fitter, const Tableto
                                              const FitInput& input) const
 {
   Fit f;
-  if (!input_->isOrganized())
+  if (!input_->isOrganized() || cluster.support < 0)
     return f;
   // The sensor's noise at the object's range: its support's band there (the same sensor saw
   // that plane): a lid is as flat, and a ray sees through it when it sees beyond that. A
   // support without a band (none measured): no flatness limit, the rim's band for depth.
-  const float noise = fitter.support_band.halfWidth(cluster.centroid.norm());
+  const float noise =
+    segmentation_.getSupports()[static_cast<std::size_t>(cluster.support)].band.halfWidth(
+      cluster.centroid.norm());
   const bool known = noise > 0.f && std::isfinite(noise);
   LidSettings s;
   if (known)
