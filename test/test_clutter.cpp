@@ -433,6 +433,28 @@ disc(float x, float radius, int n, Eigen::Matrix3Xf& points, Eigen::Matrix3Xf& n
   normals = Eigen::Vector3f(-1.f, 0.f, 0.f).replicate(1, points.cols());
 }
 
+TEST(CylinderEvidence, PointOwnersSkipACylinderTheOnesBeforeItExplain)
+{
+  using E = facyl::Explained;
+  const E n = E::No, l = E::Lateral, c = E::Cap;
+  // Cylinder 0 explains points 0-3, 1 the same and point 4 (a second fit of the same
+  // object), 2 points 5-7: 1 keeps a single point and is no object, so point 4 is left over.
+  std::vector<bool> kept;
+  const std::vector<int> owner = facyl::pointOwners(
+    {{l, l, c, l, n, n, n, n}, {l, l, l, l, l, n, n, n}, {n, n, n, n, n, l, l, l}}, 2, kept);
+  EXPECT_EQ(owner, (std::vector<int>{0, 0, 0, 0, -1, 2, 2, 2}));
+  EXPECT_EQ(kept, (std::vector<bool>{true, false, true}));
+  // With no floor the second keeps what it alone explains.
+  EXPECT_EQ(facyl::pointOwners({{l, n}, {l, l}}, 0, kept), (std::vector<int>{0, 1}));
+  EXPECT_EQ(kept, (std::vector<bool>{true, true}));
+  // A cylinder that explains nothing is never kept; nothing at all is fine.
+  EXPECT_EQ(facyl::pointOwners({{n, n}}, 0, kept), (std::vector<int>{-1, -1}));
+  EXPECT_EQ(kept, (std::vector<bool>{false}));
+  EXPECT_TRUE(facyl::pointOwners({}, 5, kept).empty());
+  EXPECT_TRUE(kept.empty());
+  EXPECT_THROW(facyl::pointOwners({{l, n}, {l}}, 1, kept), std::invalid_argument);
+}
+
 TEST(CylinderParts, AnEndSetIntoTheRimIsAPartOfTheCylinder)
 {
   // The lid of a lying tin set 13 mm into its rim (cut off by the concave crease at the rim,
@@ -1491,8 +1513,13 @@ TEST(ClutterRecognition, SimulatedClutterAgainstGroundTruth)
           wrong += !good;
         }
       }
-      for (const auto& o : out)
+      for (const auto& o : out) {
         called += o.is_cylinder;
+        // Every object output has points of its own (a cylinder the recovery found twice is
+        // one object).
+        EXPECT_GE(o.cluster.indices.indices.size(),
+                  facyl::TabletopSegmentationParameters{}.min_cluster_size);
+      }
     }
   std::printf("[ figures ] 20 cluttered scenes: %zu of %zu objects recovered (%zu of %zu "
               "touching); %zu of %zu cylinders found (%zu off by > 10%% radius or > 5.7 deg); %zu "

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <functional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace facyl {
 
@@ -261,6 +263,32 @@ explainedPoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
       e = Explained::InnerWall;
   }
   return out;
+}
+
+std::vector<int>
+pointOwners(const std::vector<std::vector<Explained>>& explained, std::size_t min_points,
+            std::vector<bool>& kept)
+{
+  const std::size_t n = explained.empty() ? 0 : explained.front().size();
+  for (const auto& e : explained)
+    if (e.size() != n)
+      throw std::invalid_argument("facyl::pointOwners: the cylinders' lists have " +
+                                  std::to_string(e.size()) + " and " + std::to_string(n) +
+                                  " entries; one per point each");
+  std::vector<int> owner(n, -1);
+  kept.assign(explained.size(), false);
+  for (std::size_t c = 0; c < explained.size(); ++c) {
+    std::vector<std::size_t> mine;
+    for (std::size_t k = 0; k < n; ++k)
+      if (owner[k] < 0 && explained[c][k] != Explained::No)
+        mine.push_back(k);
+    if (mine.empty() || mine.size() < min_points)
+      continue;
+    kept[c] = true;
+    for (std::size_t k : mine)
+      owner[k] = static_cast<int>(c);
+  }
+  return owner;
 }
 
 float

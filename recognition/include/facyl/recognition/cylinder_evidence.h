@@ -210,6 +210,16 @@ std::vector<Explained> explainedPoints(const CylinderModel& model, const Eigen::
                                        const Eigen::Matrix3Xf& normals,
                                        const ExplainSettings& settings);
 
+/** \brief Which of several cylinders owns each point, given what each explains
+ * (\a explained: one explainedPoints list per cylinder, all as long as the points). In order,
+ * each cylinder takes the points it explains that no cylinder before it took; one left with
+ * fewer than \a min_points (those before it explain its surface: two fits of one object) takes
+ * none, as if it were not there, and is not \a kept. \return per point the index of its
+ * cylinder, -1 where none took it. \throws std::invalid_argument when the lists' lengths
+ * differ. */
+std::vector<int> pointOwners(const std::vector<std::vector<Explained>>& explained,
+                             std::size_t min_points, std::vector<bool>& kept);
+
 /** \brief How the radius of the side surface around \a model changes along its axis:
  * |slope| of a robust line fit of the distance to the axis against the position along it, over
  * the columns of \a points (flagged in \a alive; all when empty) between 0.5 and 1.5 radii

@@ -336,12 +336,13 @@ private:
   void refineOnAllPoints(const pcl::Indices& indices, int stride, CylinderModel& model) const;
   /** Which points a fitted cylinder explains, from the recognizer's settings. */
   ExplainSettings explainSettings(const CylinderModel& model) const;
-  /** The cluster split into one object per cylinder (appended to \a objects) and the rest.
-   * \return the rest's indices (ascending) when it is an object of its own, else none (a small
-   * rest goes to the first cylinder's object). */
-  pcl::Indices splitCluster(const RecognizedObject& whole, const FitInput& input,
-                            const std::vector<Fit>& parts,
-                            std::vector<RecognizedObject>& objects) const;
+  /** The cluster split into one object per cylinder that keeps points of its own (pointOwners,
+   * appended to \a objects) and the rest: \a rest receives its indices (ascending) when it is an
+   * object of its own, else none (a small rest goes to the first cylinder's object).
+   * \return false, appending nothing, when no cylinder keeps enough points. */
+  bool splitCluster(const RecognizedObject& whole, const FitInput& input,
+                    const std::vector<Fit>& parts, std::vector<RecognizedObject>& objects,
+                    pcl::Indices& rest) const;
 
   TabletopRecognizerParameters params_;
   PinholeCamera camera_;

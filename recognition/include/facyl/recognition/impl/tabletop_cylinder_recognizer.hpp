@@ -546,8 +546,8 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
   if (cylinders > 1 && best.evidence.fitted &&
       (!object.is_cylinder || doubted || best.explained_share < params_.min_explained_share)) {
     std::vector<Fit> parts = extractCylinders(fitter, input, std::move(best), cylinders);
-    if (!parts.empty()) {
-      pcl::Indices rest = splitCluster(object, input, parts, objects);
+    pcl::Indices rest;
+    if (!parts.empty() && splitCluster(object, input, parts, objects, rest)) {
       // What no cylinder explains is an object of its own (a can beside the cup found first):
       // fitted as one, with the cylinders the cluster may still yield.
       if (!rest.empty())
@@ -756,27 +756,31 @@ TabletopCylinderRecognizer<PointT>::explainSettings(const CylinderModel& model) 
 }
 
 template <typename PointT>
-pcl::Indices
+bool
 TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
                                                  const FitInput& input,
                                                  const std::vector<Fit>& parts,
-                                                 std::vector<RecognizedObject>& objects) const
+                                                 std::vector<RecognizedObject>& objects,
+                                                 pcl::Indices& rest) const
 {
-  // Every point of the cluster goes to the first cylinder that explains its position.
+  // Every point of the cluster goes to the first cylinder that explains its position; one
+  // that the cylinders before it leave too few points is not an object.
   const auto& idx = whole.cluster.indices.indices;
   Eigen::Matrix3Xf pts(3, static_cast<Eigen::Index>(idx.size()));
   for (std::size_t k = 0; k < idx.size(); ++k)
     pts.col(static_cast<Eigen::Index>(k)) = (*input_)[idx[k]].getVector3fMap();
-  std::vector<int> owner(idx.size(), -1);
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    ExplainSettings s = explainSettings(parts[p].model);
+  std::vector<std::vector<Explained>> explained;
+  for (const Fit& part : parts) {
+    ExplainSettings s = explainSettings(part.model);
     s.distance *= 2.f; // by position alone: a little wider than the inliers' band
-    const std::vector<Explained> why = explainedPoints(parts[p].model, pts, {}, s);
-    for (std::size_t k = 0; k < idx.size(); ++k)
-      if (owner[k] < 0 && why[k] != Explained::No)
-        owner[k] = static_cast<int>(p);
+    explained.push_back(explainedPoints(part.model, pts, {}, s));
   }
   const auto& seg = segmentation_.getParameters();
+  std::vector<bool> kept;
+  std::vector<int> owner = pointOwners(explained, seg.min_cluster_size, kept);
+  const auto first = std::find(kept.begin(), kept.end(), true);
+  if (first == kept.end())
+    return false;
   const auto of = [&](int part) {
     pcl::Indices mine;
     for (std::size_t k = 0; k < idx.size(); ++k)
@@ -787,13 +791,17 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
   // What no cylinder explains is an object of its own when it is large (a box beside a
   // can); a small rest is the unexplained part of the cylinders found (a handle, a rim) and
   // stays with the first of them.
-  const std::size_t rest = static_cast<std::size_t>(std::count(owner.begin(), owner.end(), -1));
-  const bool rest_is_object = rest >= seg.min_cluster_size &&
-                              static_cast<float>(rest) >= (1.f - params_.min_explained_share) *
-                                                            static_cast<float>(idx.size());
+  const std::size_t unexplained =
+    static_cast<std::size_t>(std::count(owner.begin(), owner.end(), -1));
+  const bool rest_is_object =
+    unexplained >= seg.min_cluster_size &&
+    static_cast<float>(unexplained) >=
+      (1.f - params_.min_explained_share) * static_cast<float>(idx.size());
   if (!rest_is_object)
-    std::replace(owner.begin(), owner.end(), -1, 0);
+    std::replace(owner.begin(), owner.end(), -1, static_cast<int>(first - kept.begin()));
   for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (!kept[p])
+      continue;
     RecognizedObject o;
     o.cluster = partOf(whole.cluster, of(static_cast<int>(p)));
     o.evidence = parts[p].evidence;
@@ -804,7 +812,8 @@ TabletopCylinderRecognizer<PointT>::splitCluster(const RecognizedObject& whole,
     o.is_cylinder = true;
     objects.push_back(std::move(o));
   }
-  return rest_is_object ? of(-1) : pcl::Indices();
+  rest = rest_is_object ? of(-1) : pcl::Indices();
+  return true;
 }
 
 template <typename PointT>
