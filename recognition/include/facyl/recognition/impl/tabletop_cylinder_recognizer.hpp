@@ -670,9 +670,16 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
     if (!acceptCylinder(e, params_.decision) || part.size() < min_part)
       break;
     // Objects that touch meet at a concave crease; a part of one object (a box's edge)
-    // continues into the rest convexly or smoothly.
+    // continues into the rest convexly or smoothly. What lies on the cylinder by its position
+    // is not another object (a rim, whose normals the estimate bends between side and lid).
+    const std::vector<Explained> where =
+      explainedPoints(fit.model, input.columns, {}, explainSettings(fit.model));
+    std::vector<Eigen::Index> beside;
+    for (const Eigen::Index c : rest)
+      if (where[static_cast<std::size_t>(c)] == Explained::No)
+        beside.push_back(c);
     const float convex =
-      convexJunctionShare(input.columns, input.normals, part, rest, junction_distance, 0.1f);
+      convexJunctionShare(input.columns, input.normals, part, beside, junction_distance, 0.1f);
     if (convex > 0.5f)
       break;
     for (std::size_t k = 0; k < alive.size(); ++k)
