@@ -1456,6 +1456,26 @@ TEST(ClutterRecognition, ATinAndTheTubeBelowItAreCutWhereTheSectionChanges)
   }
 }
 
+namespace {
+
+/** Object \a id of scene \a s has an object of its own among \a objects (objectOf), fitted with
+ * its true radius (within 10 %) and axis (within 0.05 rad), and called a cylinder. */
+void
+expectCalledCylinder(const std::vector<facyl::RecognizedObject>& objects,
+                     const facyl::RenderedScene& s, int id)
+{
+  const facyl::RecognizedObject* o = objectOf(objects, s, id);
+  ASSERT_NE(o, nullptr) << "object " << id;
+  ASSERT_TRUE(o->evidence.fitted) << "object " << id;
+  const facyl::CylinderTruth t =
+    facyl::cylinderTruth(s.scene, s.scene.objects[static_cast<std::size_t>(id - 2)]);
+  EXPECT_NEAR(o->cylinder.radius, t.radius, 0.1f * t.radius) << "object " << id;
+  EXPECT_LT(facyl::axisAngle(o->cylinder.axis, t.axis), 0.05f) << "object " << id;
+  EXPECT_TRUE(o->is_cylinder) << "object " << id;
+}
+
+} // namespace
+
 TEST(ClutterRecognition, WhatTheRecoveredCylindersLeaveIsFittedOnItsOwn)
 {
   // Simulated cluttered scene 1073 (Kinect): 5, a can (r 4.0 cm) standing against 7, a cup,
@@ -1464,14 +1484,7 @@ TEST(ClutterRecognition, WhatTheRecoveredCylindersLeaveIsFittedOnItsOwn)
   facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
   p.seed = 1073;
   const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
-  const auto objects = recognize(s);
-  const facyl::RecognizedObject* can = objectOf(objects, s, 5);
-  ASSERT_NE(can, nullptr);
-  ASSERT_TRUE(can->evidence.fitted);
-  EXPECT_NEAR(can->cylinder.radius, 0.0396f, 0.004f);
-  const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, s.scene.objects[5 - 2]);
-  EXPECT_LT(facyl::axisAngle(can->cylinder.axis, t.axis), 0.05f);
-  EXPECT_TRUE(can->is_cylinder);
+  expectCalledCylinder(recognize(s), s, 5);
 }
 
 TEST(ClutterRecognition, ATubeStandingOnABoxIsCutFromItWhereItsRimMeetsItsLid)
@@ -1494,11 +1507,7 @@ TEST(ClutterRecognition, ATubeStandingOnABoxIsCutFromItWhereItsRimMeetsItsLid)
     visible += id == 7;
   EXPECT_GE(mine, 8 * visible / 10);
   EXPECT_GE(mine, 8 * tube->cluster.indices.indices.size() / 10);
-  ASSERT_TRUE(tube->evidence.fitted);
-  const facyl::CylinderTruth t = facyl::cylinderTruth(s.scene, s.scene.objects[7 - 2]);
-  EXPECT_NEAR(tube->cylinder.radius, t.radius, 0.1f * t.radius);
-  EXPECT_LT(facyl::axisAngle(tube->cylinder.axis, t.axis), 0.05f);
-  EXPECT_TRUE(tube->is_cylinder);
+  expectCalledCylinder(objects, s, 7);
 }
 
 TEST(ClutterRecognition, SimulatedClutterAgainstGroundTruth)
