@@ -654,9 +654,10 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
       if (alive[k])
         alive_columns[static_cast<std::size_t>(input.column_of[k])] = 1;
     std::vector<Explained> why;
-    CylinderEvidence e = localEvidence(fit.model, input.columns, input.normals, alive_columns,
-                                       explainSettings(fit.model), radial_margin, axial_margin,
-                                       margin, &why, input.scatter);
+    const ExplainSettings settings = explainSettings(fit.model);
+    CylinderEvidence e =
+      localEvidence(fit.model, input.columns, input.normals, alive_columns, settings, radial_margin,
+                    axial_margin, margin, &why, input.scatter);
     e.curvature_ratio = fit.evidence.curvature_ratio;
     std::vector<Eigen::Index> part, rest;
     for (std::size_t k = 0; k < alive.size(); ++k)
@@ -672,8 +673,7 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
     // Objects that touch meet at a concave crease; a part of one object (a box's edge)
     // continues into the rest convexly or smoothly. What lies on the cylinder by its position
     // is not another object (a rim, whose normals the estimate bends between side and lid).
-    const std::vector<Explained> where =
-      explainedPoints(fit.model, input.columns, {}, explainSettings(fit.model));
+    const std::vector<Explained> where = explainedPoints(fit.model, input.columns, {}, settings);
     std::vector<Eigen::Index> beside;
     for (const Eigen::Index c : rest)
       if (where[static_cast<std::size_t>(c)] == Explained::No)
