@@ -513,11 +513,11 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
   object.cluster = std::move(cluster);
   const FitInput input = prepareFit(fitter, object.cluster);
   Fit best = fitWithRetries(fitter, input, {});
-  // An upright object seen from above: its lid, where the side gave no fit standing (within an
-  // accumulator cell of the support's normal: that one counts the lid as its cap already) or
-  // one that explains less.
+  // An upright object seen from above: its lid, where the side's fit is not accepted and
+  // explains less. A side fit standing counts the lid as its cap only where its extent reaches
+  // it, and a thin band of side seen under a large lid ends short of it.
   bool lid = false;
-  if (!best.accepted && fitter.with_support && !retryRepeats(fitter, fitter.upright, best)) {
+  if (!best.accepted && fitter.with_support) {
     Fit f = fitLidOf(fitter, object.cluster, input);
     if (f.evidence.fitted && passesGates(f.evidence, params_.decision) &&
         (!best.evidence.fitted || f.explained_share > best.explained_share))
