@@ -668,8 +668,14 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
               "points, surface %.2f, p %.2f\n",
               round, fit.model.radius, part.size(), part.size() + rest.size(), e.surface_ratio,
               geometricProbability(e, params_.decision));
-    if (!acceptCylinder(e, params_.decision) || part.size() < min_part)
+    if (!acceptCylinder(e, params_.decision) || part.size() < min_part) {
+      PCL_DEBUG("[facyl::TabletopCylinderRecognizer] recovery round %zu: not taken (gates %s: "
+                "coverage %.2f, arc gap %.2f, curvature %.2f, taper %.2f; %zu points, at least "
+                "%zu)\n",
+                round, passesGates(e, params_.decision) ? "pass" : "fail", e.angular_coverage,
+                e.arc_gap, e.curvature_ratio, e.taper, part.size(), min_part);
       break;
+    }
     // Objects that touch meet at a concave crease; a part of one object (a box's edge)
     // continues into the rest convexly or smoothly. What lies on the cylinder by its position
     // is not another object (a rim, whose normals the estimate bends between side and lid).
@@ -680,6 +686,9 @@ TabletopCylinderRecognizer<PointT>::extractCylinders(Fitter& fitter, const FitIn
         beside.push_back(c);
     const float convex =
       convexJunctionShare(input.columns, input.normals, part, beside, junction_distance, 0.1f);
+    PCL_DEBUG("[facyl::TabletopCylinderRecognizer] recovery round %zu: %zu points beside it, "
+              "junction %.2f convex\n",
+              round, beside.size(), convex);
     if (convex > 0.5f)
       break;
     for (std::size_t k = 0; k < alive.size(); ++k)
