@@ -612,6 +612,55 @@ TEST(CylinderStack, TwoSectionsOneAboveTheOther)
   EXPECT_FALSE(sectionsOf(pts, nrm, 0.f).found);
 }
 
+TEST(CylinderStack, WhereTheSideStopsBeingACircleAndShowsABoxsFaces)
+{
+  facyl::Random rng(11);
+  const float sigma = 0.001f;
+  const auto constant = [](float r) { return [r](float) { return r; }; };
+  facyl::CylinderModel m;
+  m.axis = Eigen::Vector3f::UnitZ();
+  m.base = m.point_on_axis = Eigen::Vector3f::Zero();
+  m.radius = 0.075f; // fitted across both: the box's faces pull it in
+  const auto endOf = [&m](const std::vector<Eigen::Vector3f>& pts,
+                          const std::vector<Eigen::Vector3f>& nrm) {
+    Eigen::Matrix3Xf p(3, static_cast<Eigen::Index>(pts.size())), n(3, p.cols());
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      p.col(static_cast<Eigen::Index>(k)) = pts[k];
+      n.col(static_cast<Eigen::Index>(k)) = nrm[k];
+    }
+    return facyl::findSectionEnd(m, p, n);
+  };
+  // A tin (r 8 cm, 10 cm tall) seen from -y, and a box (12 x 12 cm, rotated 45 degrees about
+  // z: two faces seen, its corner nearest) standing on it from 10 to 20 cm.
+  std::vector<Eigen::Vector3f> pts, nrm;
+  sideOf(constant(0.08f), 0.f, 0.f, 0.f, 0.1f, sigma, rng, pts, nrm);
+  const std::size_t tin = pts.size();
+  for (float z = 0.1f; z < 0.2f; z += 0.002f)
+    for (int face = 0; face < 2; ++face)
+      for (float s = 0.f; s < 0.12f; s += 0.01f) {
+        const Eigen::Vector3f normal =
+          Eigen::Vector3f(face ? 1.f : -1.f, -1.f, 0.f).normalized(); // facing -y
+        const Eigen::Vector3f along = Eigen::Vector3f(face ? 1.f : -1.f, 1.f, 0.f).normalized();
+        const Eigen::Vector3f corner(0.f, -0.06f * std::sqrt(2.f), z);
+        pts.push_back(corner + s * along + sigma * rng.normal() * normal);
+        nrm.push_back(normal);
+      }
+  facyl::SectionEnd end = endOf(pts, nrm);
+  EXPECT_TRUE(end.found);
+  EXPECT_TRUE(end.circle_below);
+  EXPECT_NEAR(end.height, 0.1f, 0.01f);
+  EXPECT_GT(end.faces_share, 0.9f);
+  // Not found: the tin alone; a bottle's shoulder above it (a circle's radius shrinking, its
+  // normals turning); the box's faces with normals spread as a curved surface's are.
+  pts.resize(tin), nrm.resize(tin);
+  sideOf(constant(0.08f), 0.f, 0.f, 0.1f, 0.2f, sigma, rng, pts, nrm);
+  EXPECT_FALSE(endOf(pts, nrm).found);
+  pts.resize(tin), nrm.resize(tin);
+  sideOf([](float z) { return 0.08f - 0.5f * (z - 0.1f); }, 0.f, 0.f, 0.1f, 0.2f, 4.f * sigma, rng,
+         pts, nrm);
+  EXPECT_FALSE(endOf(pts, nrm).found);
+}
+
 namespace {
 
 /** A lattice of points \a spacing apart on the disc of radius \a r around (\a cx, \a cy) at

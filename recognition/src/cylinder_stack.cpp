@@ -18,9 +18,11 @@ namespace facyl {
 
 namespace {
 
-/** A side point: its position t along the axis and (x, y) across it, relative to the axis. */
+/** A side point: its position t along the axis and (x, y) across it, relative to the axis;
+ * its normal. */
 struct SidePoint {
   double t, x, y;
+  Eigen::Vector3f normal;
 };
 
 /** A circle across the axis; ok false when the fit failed. */
@@ -154,18 +156,17 @@ sigmaOf(std::size_t n, Residual residual)
   return robustSigma(r);
 }
 
-} // namespace
-
-SectionStep
-findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
-                const Eigen::Matrix3Xf& normals, const SectionStepSettings& s)
+/** The side points of findSectionStep around \a model, sorted along the axis; false when
+ * the model or the normals do not fit. */
+bool
+sidePointsOf(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+             const Eigen::Matrix3Xf& normals, std::vector<SidePoint>& pts)
 {
-  SectionStep out;
   const Eigen::Vector3f a = model.axis.normalized();
   if (!(model.radius > 0.f) || !a.allFinite() || normals.cols() != points.cols())
-    return out;
+    return false;
   const Eigen::Vector3f e1 = a.unitOrthogonal(), e2 = a.cross(e1);
-  std::vector<SidePoint> pts;
+  pts.clear();
   pts.reserve(static_cast<std::size_t>(points.cols()));
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3f d = points.col(i) - model.base;
@@ -175,17 +176,84 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     if (!std::isfinite(rho) || rho < 0.5f * model.radius || rho > 1.5f * model.radius ||
         !(std::abs(normals.col(i).dot(a)) <= 0.7071f))
       continue;
-    pts.push_back({t, radial.dot(e1), radial.dot(e2)});
+    pts.push_back({t, radial.dot(e1), radial.dot(e2), normals.col(i)});
   }
-  out.side_points = pts.size();
-  const std::size_t n = pts.size();
-  const std::size_t min_side = std::max<std::size_t>(
-    s.min_side_points,
-    static_cast<std::size_t>(std::ceil(s.min_side_share * static_cast<float>(n))));
-  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
-    return out;
   std::sort(pts.begin(), pts.end(),
             [](const SidePoint& p, const SidePoint& q) { return p.t < q.t; });
+  return true;
+}
+
+/** Prefix sums of the circle fit's normal equations over sorted side points: entry k sums the
+ * first k. */
+void
+circlePrefixSums(const std::vector<SidePoint>& pts, std::vector<Eigen::Matrix3d>& ff,
+                 std::vector<Eigen::Vector3d>& fs)
+{
+  const std::size_t n = pts.size();
+  ff.assign(n + 1, Eigen::Matrix3d::Zero());
+  fs.assign(n + 1, Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d f = circleFeatures(pts[k]);
+    ff[k + 1] = ff[k] + f * f.transpose();
+    fs[k + 1] = fs[k] + f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
+  }
+}
+
+/** The least number of side points of a section: min_side_points, and min_side_share of \a n. */
+std::size_t
+minSectionPoints(std::size_t n, const SectionStepSettings& s)
+{
+  return std::max<std::size_t>(s.min_side_points, static_cast<std::size_t>(std::ceil(
+                                                    s.min_side_share * static_cast<float>(n))));
+}
+
+/** Share of the normals of \a pts[begin, end) within \a max_angle of one of two directions
+ * (each the normal with the most others within that angle; the second among those the first
+ * leaves): most of a box's faces seen, little of a curved surface. */
+float
+twoFacesShare(const std::vector<SidePoint>& pts, std::size_t begin, std::size_t end,
+              float max_angle)
+{
+  const float cos_max = std::cos(max_angle);
+  std::vector<std::uint8_t> taken(end - begin, 0);
+  std::size_t on_faces = 0;
+  for (int face = 0; face < 2; ++face) {
+    std::size_t best = 0, best_count = 0;
+    const std::size_t stride = std::max<std::size_t>(1, (end - begin) / 64);
+    for (std::size_t c = begin; c < end; c += stride) {
+      if (taken[c - begin] || !pts[c].normal.allFinite())
+        continue;
+      std::size_t count = 0;
+      for (std::size_t i = begin; i < end; ++i)
+        count += !taken[i - begin] && pts[i].normal.dot(pts[c].normal) >= cos_max;
+      if (count > best_count)
+        best = c, best_count = count;
+    }
+    if (best_count == 0)
+      break;
+    for (std::size_t i = begin; i < end; ++i)
+      if (!taken[i - begin] && pts[i].normal.dot(pts[best].normal) >= cos_max)
+        taken[i - begin] = 1;
+    on_faces += best_count;
+  }
+  return end > begin ? static_cast<float>(on_faces) / static_cast<float>(end - begin) : 0.f;
+}
+
+} // namespace
+
+SectionStep
+findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                const Eigen::Matrix3Xf& normals, const SectionStepSettings& s)
+{
+  SectionStep out;
+  std::vector<SidePoint> pts;
+  if (!sidePointsOf(model, points, normals, pts))
+    return out;
+  out.side_points = pts.size();
+  const std::size_t n = pts.size();
+  const std::size_t min_side = minSectionPoints(n, s);
+  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+    return out;
 
   // One smooth section, fitted twice (the second time without the outliers).
   std::vector<std::uint8_t> use(n, 1);
@@ -202,13 +270,9 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
 
   // Two sections: the split (between sorted points) whose circles leave the smallest median
   // residual; the sums of each side come from prefix sums.
-  std::vector<Eigen::Matrix3d> ff(n + 1, Eigen::Matrix3d::Zero());
-  std::vector<Eigen::Vector3d> fs(n + 1, Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d f = circleFeatures(pts[k]);
-    ff[k + 1] = ff[k] + f * f.transpose();
-    fs[k + 1] = fs[k] + f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
-  }
+  std::vector<Eigen::Matrix3d> ff;
+  std::vector<Eigen::Vector3d> fs;
+  circlePrefixSums(pts, ff, fs);
   constexpr int kSplits = 33;
   double best = std::numeric_limits<double>::infinity();
   std::size_t split = 0;
@@ -265,6 +329,95 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   out.gap = static_cast<float>(gap);
   out.found =
     out.sigma_smooth >= s.min_improvement * out.sigma_step && gap >= s.min_step_sigmas * sigma_step;
+  return out;
+}
+
+SectionEnd
+findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+               const Eigen::Matrix3Xf& normals, const SectionStepSettings& s)
+{
+  SectionEnd out;
+  std::vector<SidePoint> pts;
+  if (!sidePointsOf(model, points, normals, pts))
+    return out;
+  out.side_points = pts.size();
+  const std::size_t n = pts.size();
+  const std::size_t min_side = minSectionPoints(n, s);
+  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+    return out;
+  std::vector<Eigen::Matrix3d> ff;
+  std::vector<Eigen::Vector3d> fs;
+  circlePrefixSums(pts, ff, fs);
+  // The split whose sections differ most in how well a circle fits them.
+  constexpr int kSplits = 33;
+  double best = 0.0;
+  std::size_t split = 0;
+  const double extent = pts.back().t - pts.front().t;
+  for (int j = 0; j < kSplits; ++j) {
+    const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
+                                       static_cast<std::size_t>(kSplits - 1);
+    // Each section spans min_side_share of the extent, too (not a rim's crowded pixels).
+    if (pts[k - 1].t - pts.front().t < s.min_side_share * extent ||
+        pts.back().t - pts[k].t < s.min_side_share * extent)
+      continue;
+    const Circle below = kasaCircle(ff[k], fs[k]);
+    const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
+    if (!below.ok || !above.ok)
+      continue;
+    const double sb = sigmaOf(k, [&](std::size_t i) { return circleResidual(below, pts[i]); });
+    const double sa =
+      sigmaOf(n - k, [&](std::size_t i) { return circleResidual(above, pts[k + i]); });
+    if (!(sb > 0.0) || !(sa > 0.0))
+      continue;
+    const double ratio = std::max(sa / sb, sb / sa);
+    if (ratio > best) {
+      best = ratio;
+      split = k;
+      out.circle_below = sb < sa;
+      out.sigma_circle = static_cast<float>(std::min(sa, sb));
+      out.sigma_other = static_cast<float>(std::max(sa, sb));
+    }
+  }
+  if (split == 0)
+    return out;
+  // The circle's section ends where most points stop lying on its circle (within 3 of its
+  // sigmas): the split with the best ratio may fall short of that or beyond it.
+  const Circle circle = out.circle_below ? kasaCircle(ff[split], fs[split])
+                                         : kasaCircle(ff[n] - ff[split], fs[n] - fs[split]);
+  std::size_t chunk = std::max<std::size_t>(1, (n - 2 * min_side) / (kSplits - 1));
+  const auto onCircle = [&](std::size_t begin, std::size_t end) {
+    std::size_t on = 0;
+    for (std::size_t i = begin; i < end; ++i)
+      on += circleResidual(circle, pts[i]) <= 3.0 * out.sigma_circle;
+    return 2 * on >= end - begin;
+  };
+  // In chunks of the splits' spacing, then finer: back while the circle's last chunk is off
+  // it, on while the next is on it.
+  for (; chunk > 0; chunk /= 4)
+    if (out.circle_below) {
+      while (split >= min_side + chunk && !onCircle(split - chunk, split))
+        split -= chunk;
+      while (split + chunk <= n - min_side && onCircle(split, split + chunk))
+        split += chunk;
+    }
+    else {
+      while (split + chunk <= n - min_side && !onCircle(split, split + chunk))
+        split += chunk;
+      while (split >= min_side + chunk && onCircle(split - chunk, split))
+        split -= chunk;
+    }
+  // The circle's section ends at its last point (the other's first lies beyond a gap: a box's
+  // faces wider than the circle are no side points).
+  out.height = static_cast<float>(out.circle_below ? pts[split - 1].t : pts[split].t);
+  // The other section is a box's faces: its normals on two directions.
+  out.faces_share = out.circle_below ? twoFacesShare(pts, split, n, s.max_face_angle)
+                                     : twoFacesShare(pts, 0, split, s.max_face_angle);
+  // ... and an object's height: at least the circle's radius (a band at an end, where the
+  // support's and the object's pixels mix, is none).
+  const double other =
+    out.circle_below ? pts.back().t - pts[split].t : pts[split - 1].t - pts.front().t;
+  out.found = best >= s.min_end_ratio && out.faces_share >= s.min_faces_share &&
+              other >= static_cast<double>(model.radius);
   return out;
 }
 

@@ -29,6 +29,13 @@ struct SectionStepSettings {
   /** The two sections lie apart (SectionStep::gap) by at least this many of the step's
    * robust sigmas. */
   float min_step_sigmas{3.f};
+  /** findSectionEnd: a circle fits one section this many times better (robust sigma) than
+   * the other. */
+  float min_end_ratio{4.f};
+  /** findSectionEnd: the other section's normals lie within max_face_angle (rad) of two
+   * directions (a box's faces) for at least min_faces_share of its points. */
+  float max_face_angle{0.26f};
+  float min_faces_share{0.7f};
 };
 
 /** \brief What findSectionStep measured. */
@@ -63,6 +70,30 @@ struct SectionStep {
 SectionStep findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
                             const Eigen::Matrix3Xf& normals,
                             const SectionStepSettings& settings = {});
+
+/** \brief What findSectionEnd measured. */
+struct SectionEnd {
+  bool found{false}; ///< the side is a circle on one side of the height and no circle beyond
+  /** Along the model's axis from its base: where the circle's section ends (its last point). */
+  float height{std::numeric_limits<float>::quiet_NaN()};
+  bool circle_below{false};                                    ///< the circle is the lower section
+  float sigma_circle{std::numeric_limits<float>::quiet_NaN()}; ///< robust sigma, the circle's
+  float sigma_other{std::numeric_limits<float>::quiet_NaN()};  ///< ... the other section's
+  float faces_share{0.f};     ///< of the other section's normals, on two directions
+  std::size_t side_points{0}; ///< the points used (see findSectionStep)
+};
+
+/** \brief Where the side around \a model stops being a circle: a box standing on a tin, whose
+ * faces a circle through the tin's side cannot follow. The side points as in findSectionStep;
+ * at each of its 33 heights (each section min_side_share of the points and of their extent), a
+ * circle (Kasa) through each section; the height where one section's robust sigma is the
+ * largest multiple of the other's; the circle's section then ends where most points stop lying
+ * on its circle (3 robust sigmas). Found when that multiple is at least min_end_ratio, the
+ * other section's normals lie on two faces (min_faces_share) and it spans at least the
+ * model's radius along the axis. */
+SectionEnd findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                          const Eigen::Matrix3Xf& normals,
+                          const SectionStepSettings& settings = {});
 
 /** \brief A lid seen inside a cylinder's extent (interiorLid). */
 struct InteriorLid {

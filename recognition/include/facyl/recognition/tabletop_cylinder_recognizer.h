@@ -318,7 +318,11 @@ private:
    * yield up to \a cylinders cylinders by recovery (extractCylinders; 1: no recovery). */
   void recognizeStack(Fitter& fitter, TabletopCluster cluster, float p_network, std::size_t stacked,
                       std::size_t cylinders, std::vector<RecognizedObject>& objects) const;
-  /** When \a fit's side is two sections (findSectionStep): \a whole cut at the step, each part
+  /** Where \a fit's side shows two stacked objects, along its axis from its base: a step
+   * between two sections (findSectionStep), else a lid inside its extent (interiorLid), else
+   * where it stops being a circle and shows a box's faces (findSectionEnd); NaN: none. */
+  float stackCut(const FitInput& input, const Fit& fit) const;
+  /** When \a fit's side shows two stacked objects (stackCut): \a whole cut there, each part
    * recognized (recognizeStack, \a stacked - 1 levels) and appended to \a objects
    * when one of them is a cylinder. \return whether it was cut. */
   bool splitStack(Fitter& fitter, const RecognizedObject& whole, const FitInput& input,

@@ -560,6 +560,39 @@ TabletopCylinderRecognizer<PointT>::recognizeStack(Fitter& fitter, TabletopClust
 }
 
 template <typename PointT>
+float
+TabletopCylinderRecognizer<PointT>::stackCut(const FitInput& input, const Fit& fit) const
+{
+  const SectionStep step = findSectionStep(fit.model, input.columns, input.normals);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] sections of r %.3f (%zu side points): sigma "
+            "smooth %.4f, step %.4f at %.3f (r %.3f / %.3f, shift %.3f, gap %.4f): %s\n",
+            fit.model.radius, step.side_points, step.sigma_smooth, step.sigma_step, step.height,
+            step.radius_below, step.radius_above, step.centre_shift, step.gap,
+            step.found ? "two" : "one");
+  if (step.found)
+    return step.height;
+  // Else a lid inside the extent: the object below ends there (its lid goes with it).
+  const float band = 2.f * fit.model.distance_threshold;
+  const InteriorLid lid = interiorLid(fit.model, input.columns, input.normals,
+                                      params_.hough.normal_angle_threshold, band);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid inside the extent: %.3f of %.3f\n", lid.height,
+            fit.model.height);
+  if (std::isfinite(lid.height))
+    return lid.height + static_cast<float>(lid.facing) * band; // the lid below the cut's side
+  // Else where the side stops being a circle and shows a box's faces (a box standing on a tin
+  // hides its lid). What lies flat at that height is the box's: its top, when the cylinder
+  // stands on it (the cylinder's own lid there is hidden).
+  const SectionEnd end = findSectionEnd(fit.model, input.columns, input.normals);
+  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] side's end: circle %s %.3f, sigma %.4f against "
+            "%.4f, faces %.2f: %s\n",
+            end.circle_below ? "below" : "above", end.height, end.sigma_circle, end.sigma_other,
+            end.faces_share, end.found ? "found" : "none");
+  if (!end.found)
+    return std::numeric_limits<float>::quiet_NaN();
+  return end.height + (end.circle_below ? -band : band);
+}
+
+template <typename PointT>
 bool
 TabletopCylinderRecognizer<PointT>::splitStack(Fitter& fitter, const RecognizedObject& whole,
                                                const FitInput& input, const Fit& fit,
@@ -572,24 +605,9 @@ TabletopCylinderRecognizer<PointT>::splitStack(Fitter& fitter, const RecognizedO
   if (!e.fitted || e.curvature_ratio > d.max_curvature_ratio ||
       e.angular_coverage < d.min_angular_coverage)
     return false;
-  const SectionStep step = findSectionStep(fit.model, input.columns, input.normals);
-  PCL_DEBUG("[facyl::TabletopCylinderRecognizer] sections of r %.3f (%zu side points): sigma "
-            "smooth %.4f, step %.4f at %.3f (r %.3f / %.3f, shift %.3f, gap %.4f): %s\n",
-            fit.model.radius, step.side_points, step.sigma_smooth, step.sigma_step, step.height,
-            step.radius_below, step.radius_above, step.centre_shift, step.gap,
-            step.found ? "two" : "one");
-  // Else a lid inside the extent: the object below ends there (its lid goes with it).
-  float cut = step.height;
-  if (!step.found) {
-    const float band = 2.f * fit.model.distance_threshold;
-    const InteriorLid lid = interiorLid(fit.model, input.columns, input.normals,
-                                        params_.hough.normal_angle_threshold, band);
-    PCL_DEBUG("[facyl::TabletopCylinderRecognizer] lid inside the extent: %.3f of %.3f\n",
-              lid.height, fit.model.height);
-    if (!std::isfinite(lid.height))
-      return false;
-    cut = lid.height + static_cast<float>(lid.facing) * band; // the lid below the cut's side
-  }
+  const float cut = stackCut(input, fit);
+  if (!std::isfinite(cut))
+    return false;
   const Eigen::Vector3f a = fit.model.axis.normalized();
   std::array<pcl::Indices, 2> part;
   for (const auto i : whole.cluster.indices.indices)
