@@ -1559,6 +1559,25 @@ TEST(ClutterRecognition, ATubeStandingOnABoxIsCutFromItWhereItsRimMeetsItsLid)
   expectCalledCylinder(objects, s, 7);
 }
 
+TEST(ClutterRecognition, ABoxStandingOnATinIsCutWhereTheTinsSideStopsBeingACircle)
+{
+  // Simulated cluttered scene 1081 (Kinect): 5, a box (12 x 15 x 17 cm), stands on 3, a tin
+  // (r 8.0 cm) whose lid it hides. One cylinder (r 6.9 cm) was fitted across both, its side
+  // showing no step between two circles, and tin and box stayed one object of 5118 pixels, not
+  // a cylinder. The tin's side is a circle up to where the box's two faces begin.
+  facyl::TabletopSceneParameters p = facyl::clutteredSceneParameters();
+  p.seed = 1081;
+  const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+  const auto objects = recognize(s);
+  expectCalledCylinder(objects, s, 3);
+  const facyl::RecognizedObject* tin = objectOf(objects, s, 3);
+  ASSERT_NE(tin, nullptr);
+  std::size_t mine = 0;
+  for (const auto i : tin->cluster.indices.indices)
+    mine += s.object_id[static_cast<std::size_t>(i)] == 3;
+  EXPECT_GE(mine, 9 * tin->cluster.indices.indices.size() / 10);
+}
+
 TEST(ClutterRecognition, UprightTinsSeenFromAboveAreFittedByTheirLidsWhereTheSideIsAThinBand)
 {
   // Simulated cluttered scene 1193 (Kinect): 7 and 4, upright tins (r 5.7 and 4.8 cm), are
