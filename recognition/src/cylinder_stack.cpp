@@ -276,6 +276,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   constexpr int kSplits = 33;
   double best = std::numeric_limits<double>::infinity();
   std::size_t split = 0;
+  std::vector<double> residuals; // one buffer for every split
+  residuals.reserve(n);
   for (int j = 0; j < kSplits; ++j) {
     const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
                                        static_cast<std::size_t>(kSplits - 1);
@@ -283,8 +285,10 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
     if (!below.ok || !above.ok)
       continue;
-    const double sigma =
-      sigmaOf(n, [&](std::size_t i) { return circleResidual(i < k ? below : above, pts[i]); });
+    residuals.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      residuals.push_back(circleResidual(i < k ? below : above, pts[i]));
+    const double sigma = robustSigma(residuals);
     if (sigma < best) {
       best = sigma;
       split = k;
@@ -353,6 +357,8 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   double best = 0.0;
   std::size_t split = 0;
   const double extent = pts.back().t - pts.front().t;
+  std::vector<double> residuals; // one buffer for every split's sections
+  residuals.reserve(n);
   for (int j = 0; j < kSplits; ++j) {
     const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
                                        static_cast<std::size_t>(kSplits - 1);
@@ -364,9 +370,13 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
     if (!below.ok || !above.ok)
       continue;
-    const double sb = sigmaOf(k, [&](std::size_t i) { return circleResidual(below, pts[i]); });
-    const double sa =
-      sigmaOf(n - k, [&](std::size_t i) { return circleResidual(above, pts[k + i]); });
+    const auto sigma = [&](const Circle& c, std::size_t begin, std::size_t end) {
+      residuals.clear();
+      for (std::size_t i = begin; i < end; ++i)
+        residuals.push_back(circleResidual(c, pts[i]));
+      return robustSigma(residuals);
+    };
+    const double sb = sigma(below, 0, k), sa = sigma(above, k, n);
     if (!(sb > 0.0) || !(sa > 0.0))
       continue;
     const double ratio = std::max(sa / sb, sb / sa);
@@ -378,7 +388,7 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
       out.sigma_other = static_cast<float>(std::max(sa, sb));
     }
   }
-  if (split == 0)
+  if (split == 0 || best < s.min_end_ratio)
     return out;
   // The circle's section ends where most points stop lying on its circle (within 3 of its
   // sigmas): the split with the best ratio may fall short of that or beyond it.

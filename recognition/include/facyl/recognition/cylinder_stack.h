@@ -74,7 +74,8 @@ SectionStep findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& 
 /** \brief What findSectionEnd measured. */
 struct SectionEnd {
   bool found{false}; ///< the side is a circle on one side of the height and no circle beyond
-  /** Along the model's axis from its base: where the circle's section ends (its last point). */
+  /** Along the model's axis from its base: where the circle's section ends (its last point);
+   * NaN when no section fits a circle min_end_ratio times better than the other. */
   float height{std::numeric_limits<float>::quiet_NaN()};
   bool circle_below{false};                                    ///< the circle is the lower section
   float sigma_circle{std::numeric_limits<float>::quiet_NaN()}; ///< robust sigma, the circle's

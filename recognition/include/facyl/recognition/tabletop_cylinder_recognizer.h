@@ -319,8 +319,9 @@ private:
   void recognizeStack(Fitter& fitter, TabletopCluster cluster, float p_network, std::size_t stacked,
                       std::size_t cylinders, std::vector<RecognizedObject>& objects) const;
   /** Where \a fit's side shows two stacked objects, along its axis from its base: a step
-   * between two sections (findSectionStep), else a lid inside its extent (interiorLid), else
-   * where it stops being a circle and shows a box's faces (findSectionEnd); NaN: none. */
+   * between two sections (findSectionStep), else a lid inside its extent (interiorLid), else,
+   * when \a fit explains less than min_explained_share of the cluster, where its side stops
+   * being a circle and shows a box's faces (findSectionEnd); NaN: none. */
   float stackCut(const FitInput& input, const Fit& fit) const;
   /** When \a fit's side shows two stacked objects (stackCut): \a whole cut there, each part
    * recognized (recognizeStack, \a stacked - 1 levels) and appended to \a objects

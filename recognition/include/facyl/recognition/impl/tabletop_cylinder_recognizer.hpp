@@ -579,9 +579,12 @@ TabletopCylinderRecognizer<PointT>::stackCut(const FitInput& input, const Fit& f
             fit.model.height);
   if (std::isfinite(lid.height))
     return lid.height + static_cast<float>(lid.facing) * band; // the lid below the cut's side
-  // Else where the side stops being a circle and shows a box's faces (a box standing on a tin
-  // hides its lid). What lies flat at that height is the box's: its top, when the cylinder
-  // stands on it (the cylinder's own lid there is hidden).
+  // Else, where the fit leaves much of the cluster unexplained, where the side stops being a
+  // circle and shows a box's faces (a box standing on a tin hides its lid). What lies flat at
+  // that height is the box's: its top, when the cylinder stands on it (the cylinder's own lid
+  // there is hidden).
+  if (fit.explained_share >= params_.min_explained_share)
+    return std::numeric_limits<float>::quiet_NaN();
   const SectionEnd end = findSectionEnd(fit.model, input.columns, input.normals);
   PCL_DEBUG("[facyl::TabletopCylinderRecognizer] side's end: circle %s %.3f, sigma %.4f against "
             "%.4f, faces %.2f: %s\n",
