@@ -2,8 +2,10 @@
  * facyl: fast cylinder detection for PCL.
  * Where a cylinder fitted to one segment spans two objects stacked on each other (a can standing
  * on a tin, a tube on a can): the section of the side changes at one height, abruptly, where the
- * section of one object stays the same (a can) or changes smoothly (a cup's taper). A free
- * function of the fitted axis and the segment's points with their normals.
+ * section of one object stays the same (a can) or changes smoothly (a cup's taper); or a lid
+ * shows inside the fitted extent; or the side stops being a circle where a box's faces begin
+ * (a box standing on a tin). Free functions of the fitted axis and the segment's points with
+ * their normals.
  */
 #pragma once
 
