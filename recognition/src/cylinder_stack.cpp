@@ -199,12 +199,25 @@ circlePrefixSums(const std::vector<SidePoint>& pts, std::vector<Eigen::Matrix3d>
   }
 }
 
-/** The least number of side points of a section: min_side_points, and min_side_share of \a n. */
+/** The side points around \a model (sidePointsOf, in \a pts) and the least number of them a
+ * section holds (min_side_points, and min_side_share of them); 0 when there are too few for
+ * two sections. */
 std::size_t
-minSectionPoints(std::size_t n, const SectionStepSettings& s)
+sectionablePoints(const CylinderModel& model, const Eigen::Matrix3Xf& points,
+                  const Eigen::Matrix3Xf& normals, const SectionStepSettings& s,
+                  std::vector<SidePoint>& pts)
 {
-  return std::max<std::size_t>(s.min_side_points, static_cast<std::size_t>(std::ceil(
-                                                    s.min_side_share * static_cast<float>(n))));
+  if (!sidePointsOf(model, points, normals, pts)) {
+    pts.clear();
+    return 0;
+  }
+  const std::size_t n = pts.size();
+  const std::size_t min_side = std::max<std::size_t>(
+    s.min_side_points,
+    static_cast<std::size_t>(std::ceil(s.min_side_share * static_cast<float>(n))));
+  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+    return 0;
+  return min_side;
 }
 
 /** Share of the normals of \a pts[begin, end) within \a max_angle of one of two directions
@@ -247,13 +260,11 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
 {
   SectionStep out;
   std::vector<SidePoint> pts;
-  if (!sidePointsOf(model, points, normals, pts))
-    return out;
+  const std::size_t min_side = sectionablePoints(model, points, normals, s, pts);
   out.side_points = pts.size();
-  const std::size_t n = pts.size();
-  const std::size_t min_side = minSectionPoints(n, s);
-  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+  if (min_side == 0)
     return out;
+  const std::size_t n = pts.size();
 
   // One smooth section, fitted twice (the second time without the outliers).
   std::vector<std::uint8_t> use(n, 1);
@@ -342,13 +353,11 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
 {
   SectionEnd out;
   std::vector<SidePoint> pts;
-  if (!sidePointsOf(model, points, normals, pts))
-    return out;
+  const std::size_t min_side = sectionablePoints(model, points, normals, s, pts);
   out.side_points = pts.size();
-  const std::size_t n = pts.size();
-  const std::size_t min_side = minSectionPoints(n, s);
-  if (n < 2 * std::max<std::size_t>(s.min_side_points, 1) || 2 * min_side > n)
+  if (min_side == 0)
     return out;
+  const std::size_t n = pts.size();
   std::vector<Eigen::Matrix3d> ff;
   std::vector<Eigen::Vector3d> fs;
   circlePrefixSums(pts, ff, fs);
