@@ -183,20 +183,43 @@ sidePointsOf(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   return true;
 }
 
-/** Prefix sums of the circle fit's normal equations over sorted side points: entry k sums the
- * first k. */
-void
-circlePrefixSums(const std::vector<SidePoint>& pts, std::vector<Eigen::Matrix3d>& ff,
-                 std::vector<Eigen::Vector3d>& fs)
-{
-  const std::size_t n = pts.size();
-  ff.assign(n + 1, Eigen::Matrix3d::Zero());
-  fs.assign(n + 1, Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d f = circleFeatures(pts[k]);
-    ff[k + 1] = ff[k] + f * f.transpose();
-    fs[k + 1] = fs[k] + f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
+/** Circles (Kasa) through the sorted side points before a split and from it, from prefix
+ * sums of the fit's normal equations. */
+class SectionCircles {
+public:
+  explicit SectionCircles(const std::vector<SidePoint>& pts)
+      : ff_(pts.size() + 1, Eigen::Matrix3d::Zero())
+      , fs_(pts.size() + 1, Eigen::Vector3d::Zero())
+  {
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const Eigen::Vector3d f = circleFeatures(pts[k]);
+      ff_[k + 1] = ff_[k] + f * f.transpose();
+      fs_[k + 1] = fs_[k] + f * (pts[k].x * pts[k].x + pts[k].y * pts[k].y);
+    }
   }
+  Circle below(std::size_t k) const
+  {
+    return kasaCircle(ff_[k], fs_[k]);
+  }
+  Circle above(std::size_t k) const
+  {
+    const std::size_t n = ff_.size() - 1;
+    return kasaCircle(ff_[n] - ff_[k], fs_[n] - fs_[k]);
+  }
+
+private:
+  std::vector<Eigen::Matrix3d> ff_;
+  std::vector<Eigen::Vector3d> fs_;
+};
+
+/** The heights tried between two sections: kSplits splits of \a n sorted side points, evenly
+ * between \a min_side and n - min_side; the j-th. */
+constexpr int kSplits = 33;
+std::size_t
+splitAt(int j, std::size_t n, std::size_t min_side)
+{
+  return min_side +
+         (n - 2 * min_side) * static_cast<std::size_t>(j) / static_cast<std::size_t>(kSplits - 1);
 }
 
 /** The side points around \a model (sidePointsOf, in \a pts) and the least number of them a
@@ -281,19 +304,14 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
 
   // Two sections: the split (between sorted points) whose circles leave the smallest median
   // residual; the sums of each side come from prefix sums.
-  std::vector<Eigen::Matrix3d> ff;
-  std::vector<Eigen::Vector3d> fs;
-  circlePrefixSums(pts, ff, fs);
-  constexpr int kSplits = 33;
+  const SectionCircles circles(pts);
   double best = std::numeric_limits<double>::infinity();
   std::size_t split = 0;
   std::vector<double> residuals; // one buffer for every split
   residuals.reserve(n);
   for (int j = 0; j < kSplits; ++j) {
-    const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
-                                       static_cast<std::size_t>(kSplits - 1);
-    const Circle below = kasaCircle(ff[k], fs[k]);
-    const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
+    const std::size_t k = splitAt(j, n, min_side);
+    const Circle below = circles.below(k), above = circles.above(k);
     if (!below.ok || !above.ok)
       continue;
     residuals.clear();
@@ -308,8 +326,8 @@ findSectionStep(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   if (split == 0)
     return out;
   // Each section once more without its outliers.
-  Circle below = kasaCircle(ff[split], fs[split]);
-  Circle above = kasaCircle(ff[n] - ff[split], fs[n] - fs[split]);
+  Circle below = circles.below(split);
+  Circle above = circles.above(split);
   trimOutliers(
     n, [&](std::size_t i) { return circleResidual(i < split ? below : above, pts[i]); }, use);
   below = fitCircle(pts, 0, split, use);
@@ -358,25 +376,20 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   if (min_side == 0)
     return out;
   const std::size_t n = pts.size();
-  std::vector<Eigen::Matrix3d> ff;
-  std::vector<Eigen::Vector3d> fs;
-  circlePrefixSums(pts, ff, fs);
+  const SectionCircles circles(pts);
   // The split whose sections differ most in how well a circle fits them.
-  constexpr int kSplits = 33;
   double best = 0.0;
   std::size_t split = 0;
   const double extent = pts.back().t - pts.front().t;
   std::vector<double> residuals; // one buffer for every split's sections
   residuals.reserve(n);
   for (int j = 0; j < kSplits; ++j) {
-    const std::size_t k = min_side + (n - 2 * min_side) * static_cast<std::size_t>(j) /
-                                       static_cast<std::size_t>(kSplits - 1);
+    const std::size_t k = splitAt(j, n, min_side);
     // Each section spans min_side_share of the extent, too (not a rim's crowded pixels).
     if (pts[k - 1].t - pts.front().t < s.min_side_share * extent ||
         pts.back().t - pts[k].t < s.min_side_share * extent)
       continue;
-    const Circle below = kasaCircle(ff[k], fs[k]);
-    const Circle above = kasaCircle(ff[n] - ff[k], fs[n] - fs[k]);
+    const Circle below = circles.below(k), above = circles.above(k);
     if (!below.ok || !above.ok)
       continue;
     const auto sigma = [&](const Circle& c, std::size_t begin, std::size_t end) {
@@ -401,8 +414,7 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
     return out;
   // The circle's section ends where most points stop lying on its circle (within 3 of its
   // sigmas): the split with the best ratio may fall short of that or beyond it.
-  const Circle circle = out.circle_below ? kasaCircle(ff[split], fs[split])
-                                         : kasaCircle(ff[n] - ff[split], fs[n] - fs[split]);
+  const Circle circle = out.circle_below ? circles.below(split) : circles.above(split);
   std::size_t chunk = std::max<std::size_t>(1, (n - 2 * min_side) / (kSplits - 1));
   const auto onCircle = [&](std::size_t begin, std::size_t end) {
     std::size_t on = 0;
