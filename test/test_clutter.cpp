@@ -1227,6 +1227,37 @@ TEST(SupportPlanes, PiecesOfAnotherFamilysSurfaceAreNotObjects)
   EXPECT_NEAR(t[3], s.table_plane[3], 0.03f);
 }
 
+TEST(SupportPlanes, ATopWithoutDepthIsFoundUnderTheObjectsStandingOnIt)
+{
+  // Simulated rooms (realistic layout, a sensor drawn per scene; facyl_tabletop_eval --sim
+  // --layout realistic --sensor random). Seed 1030: the round table's dark top gives depth on 3 %
+  // of its pixels, so the floor was the only support and the objects, 0.7 m above it, beyond
+  // its object band: none was found. Their bottoms share a plane parallel to the floor, whose
+  // rays in view are holes: it is the table, and the objects stand on it. Seed 1022: a robot
+  // arm floats 0.8 m over a table that shows, whose rays under the arm see that table: the
+  // table stays the one found.
+  for (const std::uint64_t seed : {1030u, 1022u}) {
+    facyl::TabletopSceneParameters p = facyl::realisticSceneParameters();
+    ASSERT_TRUE(facyl::parseSensorPreset("random", p.sensor, p.camera));
+    p.seed = seed;
+    const facyl::RenderedScene s = facyl::simulateTabletopScene(p);
+    Cloud::Ptr cloud(new Cloud(s.cloud));
+    facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
+    seg.setInputCloud(cloud);
+    std::vector<facyl::TabletopCluster> clusters;
+    ASSERT_TRUE(seg.segment(clusters)) << seed;
+    const auto& t = seg.getTableCoefficients().values;
+    ASSERT_EQ(t.size(), 4u);
+    EXPECT_GT(Eigen::Vector3f(t[0], t[1], t[2]).dot(s.table_plane.head<3>()), 0.99f) << seed;
+    EXPECT_NEAR(t[3], s.table_plane[3], 0.03f) << seed;
+    EXPECT_FALSE(seg.getSupportPriorResult().given) << seed; // none was given
+    std::size_t on_table = 0;
+    for (const auto& c : clusters)
+      on_table += c.support == static_cast<int>(seg.getTableIndex());
+    EXPECT_GE(on_table, 2u) << seed;
+  }
+}
+
 TEST(SupportPlanes, ASupportPriorKeepsItsPlaneTheTable)
 {
   // The small table above the floor, seen from 1.6 m: alone, the table (the objects stand on

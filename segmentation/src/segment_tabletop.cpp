@@ -189,6 +189,39 @@ sortLargestFirst(std::vector<TabletopCluster>& clusters)
   });
 }
 
+void
+adoptSupportUnderFloatingObjects(const Setup& setup, const FrameCues& cues,
+                                 TabletopWorkspace& workspace, TabletopSegments& out)
+{
+  const std::optional<SupportPrior> under = supportUnderFloatingObjects(setup, out);
+  if (!under)
+    return;
+  Setup again =
+    makeSetup(setup.frame, setup.params, setup.camera, setup.up, &*under, setup.threads);
+  again.prior_inferred = true;
+  if (!priorPlaneInView(again, cues)) {
+    PCL_DEBUG("[facyl::TabletopSegmentation] the support under the floating objects: not in "
+              "view (its rays see beyond it)\n");
+    return;
+  }
+  FrameCues cues_again;
+  TabletopSegments other = segmentFrame(again, cues_again, workspace);
+  const bool kept = other.prior.support >= 0 &&
+                    other.table == static_cast<std::size_t>(other.prior.support) &&
+                    other.table_found;
+  PCL_DEBUG("[facyl::TabletopSegmentation] the support under the floating objects: %s\n",
+            kept ? "the table" : "not kept");
+  SegmentationTiming& t = kept ? other.timing : out.timing;
+  const SegmentationTiming& u = kept ? out.timing : other.timing;
+  t.planes += u.planes;
+  t.points += u.points;
+  t.objects += u.objects;
+  if (kept) {
+    other.prior = SupportPriorResult{}; // none was given
+    out = std::move(other);
+  }
+}
+
 TabletopSegments
 segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace)
 {
@@ -266,6 +299,8 @@ segmentTabletop(const PointFrame& frame, const PinholeCamera& camera, const Eige
   else {
     tabletop::FrameCues cues;
     out = tabletop::segmentFrame(setup, cues, workspace);
+    if (!setup.prior)
+      tabletop::adoptSupportUnderFloatingObjects(setup, cues, workspace, out);
   }
   out.timing.total = tabletop::msSince(t0);
   return out;

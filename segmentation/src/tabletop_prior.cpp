@@ -186,7 +186,60 @@ extentInView(const Setup& setup, const FrameCues& cues, const Eigen::Vector4f& p
   return out;
 }
 
+/** Of the rays of \a view, the points on \a plane (within the noise band of their range) and
+ * the number beyond it (a ray that passed where it would be); whether the plane is there: its
+ * points as many as a plane needs (min_plane_points) or most rays without depth, and fewer than
+ * half of the rays beyond it (a quarter for a prior the frame inferred: Setup::prior_inferred).
+ * A plane hidden behind what is in front of it everywhere (another table) is not there. */
+struct PlaneOnRays {
+  pcl::Indices on;
+  std::size_t beyond{0};
+  bool there{false};
+};
+
+PlaneOnRays
+planeOnRays(const Setup& setup, const FrameCues& cues, const ExtentInView& view,
+            const Eigen::Vector4f& plane)
+{
+  const PointFrame& frame = setup.frame;
+  const Eigen::Vector3f o = frame.viewpoint;
+  PlaneOnRays out;
+  for (const auto i : view.seen) {
+    const Eigen::Vector3f p = frame.point(static_cast<std::size_t>(i));
+    const float d = plane.head<3>().dot(p) + plane[3], half = cues.noise->halfWidth((p - o).norm());
+    if (d < -half)
+      ++out.beyond;
+    else if (d <= half)
+      out.on.push_back(i);
+  }
+  const int step = std::max(1, setup.plane_step);
+  const auto cell = static_cast<std::size_t>(step * step);
+  const std::size_t missing = view.in_view - view.seen.size();
+  const std::size_t beyond_limit = setup.prior_inferred ? 4 : 2; // 1 / limit of the rays
+  out.there =
+    (out.on.size() * cell >= setup.params.min_plane_points || 2 * missing > view.in_view) &&
+    beyond_limit * out.beyond < view.in_view;
+  return out;
+}
+
 } // namespace
+
+bool
+priorPlaneInView(const Setup& setup, const FrameCues& cues)
+{
+  if (!setup.prior || !setup.as_image || setup.prior->extent.size() < 3 || !cues.noise ||
+      !(cues.focal > 0.f))
+    return false;
+  const SupportPrior& prior = *setup.prior;
+  const Eigen::Affine3f plane_to_frame = planeFrame(prior.plane, prior.centre);
+  const std::vector<Eigen::Vector2f> extent =
+    priorExtentHull(prior, prior.plane, plane_to_frame, {});
+  if (extent.size() < 3)
+    return false;
+  const ExtentInView view =
+    extentInView(setup, cues, prior.plane, plane_to_frame.inverse(), extent);
+  return view.valid && planeOnRays(setup, cues, view, prior.plane).there;
+}
 
 std::optional<Candidate>
 priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
@@ -214,34 +267,187 @@ priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
                                         (setup.params.min_plane_points + cell - 1) / cell);
   if (!consistentWithPrior(prior, plane))
     plane = aligned;
-  // Most rays that meet it in view must not see through it,
-  Candidate out;
-  std::size_t beyond = 0;
-  for (const auto i : view.seen) {
-    const Eigen::Vector3f p = frame.point(static_cast<std::size_t>(i));
-    const float d = plane.head<3>().dot(p) + plane[3], half = cues.noise->halfWidth((p - o).norm());
-    if (d < -half)
-      ++beyond;
-    else if (d <= half)
-      out.points.push_back(i);
-  }
-  // And some of it is seen (as many points as a plane needs), or most of it gives no depth: a
-  // plane hidden behind what is in front of it everywhere (another table) is no candidate.
-  const std::size_t missing = view.in_view - view.seen.size();
-  const bool there =
-    (out.points.size() * cell >= setup.params.min_plane_points || 2 * missing > view.in_view) &&
-    2 * beyond < view.in_view;
+  // Most rays that meet it in view must not see through it, and some of it is seen or most of
+  // it gives no depth.
+  PlaneOnRays rays = planeOnRays(setup, cues, view, plane);
   PCL_DEBUG("[facyl::TabletopSegmentation] the support prior's plane, not found: %zu cells of "
             "its extent in view, %zu on (%.3f %.3f %.3f) d %.3f, %zu beyond it: %s\n",
-            view.in_view, out.points.size(), plane[0], plane[1], plane[2], plane[3], beyond,
-            there ? "a candidate" : "not there");
-  if (!there)
+            view.in_view, rays.on.size(), plane[0], plane[1], plane[2], plane[3], rays.beyond,
+            rays.there ? "a candidate" : "not there");
+  if (!rays.there)
     return std::nullopt;
+  Candidate out;
+  out.points = std::move(rays.on);
   out.plane = plane;
   out.band = *cues.noise;
   out.support = out.points.size() * cell;
   out.from_prior = true;
   return out;
+}
+
+namespace {
+
+/** An object's extent on an inferred support: its feet grown to this many times their size
+ * about their centre (the top they stand on reaches beyond them; its rays must show holes). */
+constexpr float kInferredExtentGrowth = 2.f;
+
+/** The cells of the plane grid (every plane_step-th pixel and row) with depth: each its pixel
+ * and height over \a plane (infinite without depth). */
+struct HeightCells {
+  std::size_t width{0}, height{0};
+  std::vector<float> over;
+  std::vector<pcl::index_t> pixel;
+};
+
+HeightCells
+heightCells(const Setup& setup, const Eigen::Vector4f& plane)
+{
+  const PointFrame& frame = setup.frame;
+  const auto step = static_cast<std::size_t>(std::max(1, setup.plane_step));
+  HeightCells g;
+  g.width = (frame.width + step - 1) / step;
+  g.height = (frame.height + step - 1) / step;
+  g.over.assign(g.width * g.height, std::numeric_limits<float>::infinity());
+  g.pixel.assign(g.width * g.height, -1);
+  for (std::size_t v = 0; v < frame.height; v += step)
+    for (std::size_t u = 0; u < frame.width; u += step) {
+      const std::size_t i = v * frame.width + u, c = (v / step) * g.width + u / step;
+      if (!frame.finite(i))
+        continue;
+      g.over[c] = plane.head<3>().dot(frame.point(i)) + plane[3];
+      g.pixel[c] = static_cast<pcl::index_t>(i);
+    }
+  return g;
+}
+
+/** Groups of adjacent cells of \a g (within cluster_tolerance per cell of each other) that are
+ * \a floating, without those that go on into a neighbour below max_height (a chair's back, an
+ * object taller than the band: standing on the plane). */
+template <typename Floating>
+std::vector<std::vector<std::size_t>>
+floatingGroups(const Setup& setup, const HeightCells& g, Floating floating)
+{
+  const PointFrame& frame = setup.frame;
+  const float reach =
+    setup.params.cluster_tolerance * static_cast<float>(std::max(1, setup.plane_step));
+  const auto near = [&](std::size_t a, std::size_t b) {
+    return g.pixel[b] >= 0 && (frame.point(static_cast<std::size_t>(g.pixel[a])) -
+                               frame.point(static_cast<std::size_t>(g.pixel[b])))
+                                  .norm() <= reach;
+  };
+  std::vector<char> grouped(g.over.size(), 0);
+  std::vector<std::vector<std::size_t>> out;
+  for (std::size_t c = 0; c < g.over.size(); ++c) {
+    if (!floating(c) || grouped[c])
+      continue;
+    std::vector<std::size_t> members{c}, todo{c};
+    grouped[c] = 1;
+    bool attached = false;
+    while (!todo.empty()) {
+      const std::size_t a = todo.back();
+      todo.pop_back();
+      const std::size_t u = a % g.width, v = a / g.width;
+      const std::size_t beside[4] = {u > 0 ? a - 1 : a, u + 1 < g.width ? a + 1 : a,
+                                     v > 0 ? a - g.width : a, v + 1 < g.height ? a + g.width : a};
+      for (const std::size_t b : beside) {
+        if (b == a || !near(a, b))
+          continue;
+        if (!floating(b))
+          attached = attached || g.over[b] <= setup.params.max_height;
+        else if (!grouped[b]) {
+          grouped[b] = 1;
+          members.push_back(b);
+          todo.push_back(b);
+        }
+      }
+    }
+    if (!attached)
+      out.push_back(std::move(members));
+  }
+  return out;
+}
+
+} // namespace
+
+std::optional<SupportPrior>
+supportUnderFloatingObjects(const Setup& setup, const TabletopSegments& segments)
+{
+  const PointFrame& frame = setup.frame;
+  const auto& p = setup.params;
+  if (!setup.as_image || frame.indices || segments.supports.empty())
+    return std::nullopt;
+  const SupportPlane& table = segments.supports[segments.table];
+  // Bottoms within two of the table's bands (at 1 m) of each other are one top's.
+  const float slab = 2.f * table.band.halfWidth(1.f);
+  if (!(slab > 0.f))
+    return std::nullopt;
+  const Eigen::Vector3f n = table.plane.head<3>();
+  const HeightCells g = heightCells(setup, table.plane);
+  // Floating: beyond the object band, up to four of its height (a table top over the floor).
+  const auto floating = [&](std::size_t c) {
+    return g.over[c] > p.max_height && g.over[c] < 4.f * p.max_height;
+  };
+  const auto step = static_cast<std::size_t>(std::max(1, setup.plane_step));
+  const std::size_t min_cells = std::max<std::size_t>(4, p.min_cluster_size / (step * step));
+  struct Floater {
+    float bottom;
+    std::vector<std::size_t> cells;
+  };
+  std::vector<Floater> floaters;
+  for (auto& cells : floatingGroups(setup, g, floating)) {
+    if (cells.size() < min_cells)
+      continue;
+    std::vector<float> over;
+    for (const auto c : cells)
+      over.push_back(g.over[c]);
+    std::sort(over.begin(), over.end());
+    const float bottom = over[over.size() / 100], middle = over[over.size() / 2];
+    const Eigen::Vector3f q = frame.point(static_cast<std::size_t>(g.pixel[cells.front()]));
+    // An object standing, not a top lying flat (a far table's).
+    if (middle - bottom > 2.f * table.band.halfWidth((q - frame.viewpoint).norm()))
+      floaters.push_back({bottom, std::move(cells)});
+  }
+  if (floaters.empty())
+    return std::nullopt;
+  // The densest bottoms (by cells), and the lowest of them: an object seen behind another shows
+  // a higher bottom; none stands below the top.
+  std::size_t best = 0, most = 0;
+  for (std::size_t a = 0; a < floaters.size(); ++a) {
+    std::size_t count = 0;
+    for (const auto& b : floaters)
+      if (std::abs(b.bottom - floaters[a].bottom) <= slab)
+        count += b.cells.size();
+    if (count > most)
+      most = count, best = a;
+  }
+  float top = floaters[best].bottom;
+  for (const auto& b : floaters)
+    if (std::abs(b.bottom - floaters[best].bottom) <= slab)
+      top = std::min(top, b.bottom);
+  SupportPrior prior;
+  prior.plane = table.plane;
+  prior.plane[3] -= top;
+  prior.max_angle = 0.05f;
+  prior.max_offset = slab;
+  // Its extent: the feet of the objects on it, projected on it and grown.
+  std::vector<Eigen::Vector3f> feet;
+  for (const auto& b : floaters)
+    if (std::abs(b.bottom - floaters[best].bottom) <= slab)
+      for (const auto c : b.cells)
+        if (g.over[c] <= b.bottom + slab) {
+          const Eigen::Vector3f q = frame.point(static_cast<std::size_t>(g.pixel[c]));
+          feet.push_back(q - (n.dot(q) + prior.plane[3]) * n);
+        }
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+  for (const auto& f : feet)
+    centre += f;
+  prior.centre = centre / static_cast<float>(feet.size());
+  for (const auto& f : feet)
+    prior.extent.push_back(prior.centre + kInferredExtentGrowth * (f - prior.centre));
+  PCL_DEBUG("[facyl::TabletopSegmentation] %zu objects float above the table; their bottoms at "
+            "%.3f m over it: a support there?\n",
+            floaters.size(), top);
+  return prior;
 }
 
 void

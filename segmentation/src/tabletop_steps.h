@@ -34,6 +34,9 @@ struct Setup {
   /** Threads of the per-pixel passes: the workspace's while the helpers find idle cores
    * (threadsForIdleCores), else 1. */
   int threads{1};
+  /** The prior was inferred from this frame's floating objects (supportUnderFloatingObjects),
+   * not carried from the last frames: its plane must show mostly holes, few points beyond it. */
+  bool prior_inferred{false};
 };
 
 /** The block size of the plane search on organized frames: plane_step, or width / 160. */
@@ -202,6 +205,23 @@ void keepPriorCandidate(const Setup& setup, std::vector<Candidate>& candidates, 
 std::optional<Candidate> priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
                                              const std::vector<Candidate>& candidates);
 
+/** True when setup.prior's plane, as given, shows in the image as priorPlaneCandidate requires
+ * (the rays of its extent: on it, without depth, or few beyond it): the check before a frame is
+ * segmented again with an inferred prior. */
+bool priorPlaneInView(const Setup& setup, const FrameCues& cues);
+
+/** Where objects float above the table of \a segments (beyond its object band, up to four of
+ * its height, and nothing of them going on below the band: a top without depth of its own, dark
+ * or glossy), the support their bottoms share, as a prior for segmenting the frame again
+ * (Setup::prior_inferred): parallel to that table, at the lowest bottom (each object's lowest
+ * percent) of the densest slab of bottoms (two of the table's bands at 1 m); an object is a
+ * group of adjacent plane-grid cells, of min_cluster_size pixels, that stands (its median
+ * height two bands above its bottom, not a far top lying flat). Its extent: the objects' feet
+ * grown to twice their size about their centre. Images without indices only; none when nothing
+ * floats. */
+std::optional<SupportPrior> supportUnderFloatingObjects(const Setup& setup,
+                                                        const TabletopSegments& segments);
+
 /** For the candidate of \a sorted that is the prior's plane without a region of its own
  * (Candidate::from_prior): its frame at the prior's centre, its hulls the prior's extent, and
  * no elevated plane (it was the tracks' support). */
@@ -261,6 +281,14 @@ TabletopSegments segmentOnLattice(const Setup& setup, int step, TabletopWorkspac
 
 /** The run on every point of \a setup's frame; \a cues: what its plane search learnt. */
 TabletopSegments segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace);
+
+/** Without a prior: where objects float above the table of \a out over a support the image
+ * shows as holes (supportUnderFloatingObjects, priorPlaneInView with \a cues of the run that
+ * gave \a out), the frame segmented again with that support as an inferred prior; \a out
+ * becomes that segmentation (its timing the sum of both) when the support is its table and
+ * objects stand on it. */
+void adoptSupportUnderFloatingObjects(const Setup& setup, const FrameCues& cues,
+                                      TabletopWorkspace& workspace, TabletopSegments& out);
 
 /** Largest first, like pcl::EuclideanClusterExtraction (stable). */
 void sortLargestFirst(std::vector<TabletopCluster>& clusters);

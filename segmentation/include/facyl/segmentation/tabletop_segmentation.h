@@ -106,9 +106,14 @@ sensorFrameCopy(const pcl::PointCloud<PointT>& cloud, const Eigen::Affine3f& pos
  * only breaks ties. The table is the candidate of that family with the most object points
  * standing on it; when nothing stands on any, the largest one (tableFound() is then false), and
  * the compact segments off the supports are objects too, with support -1 (a table without
- * depth: glossy or dark). A frame without any support (a wall, a close-up) still gets its
- * objects: the compact segments of the frame, with support -1, tableFound() false and empty
- * table coefficients.
+ * depth: glossy or dark). Without a support prior, objects that float above the table found
+ * (beyond its object band, nothing of them going on below it) over a region whose rays show
+ * holes, not what lies beyond, stand on a top without depth: the frame is segmented again with
+ * the plane of their bottoms, parallel to the table found, as an inferred prior
+ * (supportUnderFloatingObjects), and that plane is the table when objects stand on it. Organized
+ * clouds without indices, at full resolution. A frame without any support (a wall, a close-up)
+ * still gets its objects: the compact segments of the frame, with support -1, tableFound() false
+ * and empty table coefficients.
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
