@@ -190,8 +190,8 @@ sortLargestFirst(std::vector<TabletopCluster>& clusters)
 }
 
 void
-adoptSupportUnderFloatingObjects(const Setup& setup, const FrameCues& cues,
-                                 TabletopWorkspace& workspace, TabletopSegments& out)
+adoptSupportUnderFloatingObjects(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace,
+                                 TabletopSegments& out)
 {
   const std::optional<SupportPrior> under = supportUnderFloatingObjects(setup, out);
   if (!under)
@@ -219,6 +219,7 @@ adoptSupportUnderFloatingObjects(const Setup& setup, const FrameCues& cues,
   if (kept) {
     other.prior = SupportPriorResult{}; // none was given
     out = std::move(other);
+    cues = cues_again;
   }
 }
 

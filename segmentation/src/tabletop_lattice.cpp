@@ -242,8 +242,10 @@ segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace)
   const PinholeCamera camera = latticeCamera(setup.camera, step, lattice.width, lattice.height);
   const double t_lattice = ms(t0);
   FrameCues cues;
-  TabletopSegments out = segmentFrame(
-    makeSetup(lattice, params, camera, setup.up, setup.prior, setup.threads), cues, workspace);
+  const Setup on_lattice = makeSetup(lattice, params, camera, setup.up, setup.prior, setup.threads);
+  TabletopSegments out = segmentFrame(on_lattice, cues, workspace);
+  if (!on_lattice.prior)
+    adoptSupportUnderFloatingObjects(on_lattice, cues, workspace, out);
   const auto t1 = Clock::now();
   out.clusters = clustersAtFullResolution(setup, cues, out.clusters, out.supports, lattice, step);
   supportsAtFullResolution(setup.frame, step, out.supports);

@@ -284,10 +284,10 @@ TabletopSegments segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorks
 
 /** Without a prior: where objects float above the table of \a out over a support the image
  * shows as holes (supportUnderFloatingObjects, priorPlaneInView with \a cues of the run that
- * gave \a out), the frame segmented again with that support as an inferred prior; \a out
- * becomes that segmentation (its timing the sum of both) when the support is its table and
+ * gave \a out), the frame segmented again with that support as an inferred prior; \a out and
+ * \a cues become that run's (its timing the sum of both) when the support is its table and
  * objects stand on it. */
-void adoptSupportUnderFloatingObjects(const Setup& setup, const FrameCues& cues,
+void adoptSupportUnderFloatingObjects(const Setup& setup, FrameCues& cues,
                                       TabletopWorkspace& workspace, TabletopSegments& out);
 
 /** Largest first, like pcl::EuclideanClusterExtraction (stable). */
