@@ -110,10 +110,10 @@ sensorFrameCopy(const pcl::PointCloud<PointT>& cloud, const Eigen::Affine3f& pos
  * (beyond its object band, nothing of them going on below it) over a region whose rays show
  * holes, not what lies beyond, stand on a top without depth: the frame is segmented again with
  * the plane of their bottoms, parallel to the table found, as an inferred prior
- * (supportUnderFloatingObjects), and that plane is the table when objects stand on it. Organized
- * clouds without indices, at full resolution. A frame without any support (a wall, a close-up)
- * still gets its objects: the compact segments of the frame, with support -1, tableFound() false
- * and empty table coefficients.
+ * (supportUnderFloatingObjects), and that plane is the table when objects stand on it (organized
+ * clouds without indices; on the lattice_width lattice too). A frame without any support (a wall, a
+ * close-up) still gets its objects: the compact segments of the frame, with support -1,
+ * tableFound() false and empty table coefficients.
  *
  * \code
  * facyl::TabletopSegmentation<pcl::PointXYZRGBA> seg;
