@@ -290,6 +290,9 @@ namespace {
 /** An object's extent on an inferred support: its feet grown to this many times their size
  * about their centre (the top they stand on reaches beyond them; its rays must show holes). */
 constexpr float kInferredExtentGrowth = 2.f;
+/** rad: an inferred support is parallel to the table found by construction; a candidate within
+ * 3 degrees of it is that plane. */
+constexpr float kInferredMaxAngle = 0.05f;
 
 /** The cells of the plane grid (every plane_step-th pixel and row) with depth: each its pixel
  * and height over \a plane (infinite without depth). */
@@ -367,33 +370,26 @@ floatingGroups(const Setup& setup, const HeightCells& g, Floating floating)
   return out;
 }
 
-} // namespace
+/** An object floating over the table found: its cells and its bottom (its lowest percent). */
+struct Floater {
+  float bottom;
+  std::vector<std::size_t> cells;
+};
 
-std::optional<SupportPrior>
-supportUnderFloatingObjects(const Setup& setup, const TabletopSegments& segments)
+/** The objects floating above \a table (floatingGroups beyond its object band, up to four of
+ * its height: a table top over the floor) of min_cluster_size pixels that stand (their median
+ * height two of the table's bands above their bottom; a far table's top lies flat). */
+std::vector<Floater>
+standingFloaters(const Setup& setup, const SupportPlane& table, const HeightCells& g)
 {
   const PointFrame& frame = setup.frame;
   const auto& p = setup.params;
-  if (!setup.as_image || frame.indices || segments.supports.empty())
-    return std::nullopt;
-  const SupportPlane& table = segments.supports[segments.table];
-  // Bottoms within two of the table's bands (at 1 m) of each other are one top's.
-  const float slab = 2.f * table.band.halfWidth(1.f);
-  if (!(slab > 0.f))
-    return std::nullopt;
-  const Eigen::Vector3f n = table.plane.head<3>();
-  const HeightCells g = heightCells(setup, table.plane);
-  // Floating: beyond the object band, up to four of its height (a table top over the floor).
   const auto floating = [&](std::size_t c) {
     return g.over[c] > p.max_height && g.over[c] < 4.f * p.max_height;
   };
   const auto step = static_cast<std::size_t>(std::max(1, setup.plane_step));
   const std::size_t min_cells = std::max<std::size_t>(4, p.min_cluster_size / (step * step));
-  struct Floater {
-    float bottom;
-    std::vector<std::size_t> cells;
-  };
-  std::vector<Floater> floaters;
+  std::vector<Floater> out;
   for (auto& cells : floatingGroups(setup, g, floating)) {
     if (cells.size() < min_cells)
       continue;
@@ -403,14 +399,18 @@ supportUnderFloatingObjects(const Setup& setup, const TabletopSegments& segments
     std::sort(over.begin(), over.end());
     const float bottom = over[over.size() / 100], middle = over[over.size() / 2];
     const Eigen::Vector3f q = frame.point(static_cast<std::size_t>(g.pixel[cells.front()]));
-    // An object standing, not a top lying flat (a far table's).
     if (middle - bottom > 2.f * table.band.halfWidth((q - frame.viewpoint).norm()))
-      floaters.push_back({bottom, std::move(cells)});
+      out.push_back({bottom, std::move(cells)});
   }
-  if (floaters.empty())
-    return std::nullopt;
-  // The densest bottoms (by cells), and the lowest of them: an object seen behind another shows
-  // a higher bottom; none stands below the top.
+  return out;
+}
+
+/** Of \a floaters (not empty), those of the densest slab of bottoms (\a slab wide, by cells);
+ * \a top: the lowest of their bottoms (an object seen behind another shows a higher bottom;
+ * none stands below the top). */
+std::vector<const Floater*>
+densestBottoms(const std::vector<Floater>& floaters, float slab, float& top)
+{
   std::size_t best = 0, most = 0;
   for (std::size_t a = 0; a < floaters.size(); ++a) {
     std::size_t count = 0;
@@ -420,24 +420,49 @@ supportUnderFloatingObjects(const Setup& setup, const TabletopSegments& segments
     if (count > most)
       most = count, best = a;
   }
-  float top = floaters[best].bottom;
+  std::vector<const Floater*> out;
+  top = floaters[best].bottom;
   for (const auto& b : floaters)
-    if (std::abs(b.bottom - floaters[best].bottom) <= slab)
+    if (std::abs(b.bottom - floaters[best].bottom) <= slab) {
+      out.push_back(&b);
       top = std::min(top, b.bottom);
+    }
+  return out;
+}
+
+} // namespace
+
+std::optional<SupportPrior>
+supportUnderFloatingObjects(const Setup& setup, const TabletopSegments& segments)
+{
+  const PointFrame& frame = setup.frame;
+  if (!setup.as_image || frame.indices || segments.supports.empty())
+    return std::nullopt;
+  const SupportPlane& table = segments.supports[segments.table];
+  // Bottoms within two of the table's bands (at 1 m) of each other are one top's.
+  const float slab = 2.f * table.band.halfWidth(1.f);
+  if (!(slab > 0.f))
+    return std::nullopt;
+  const HeightCells g = heightCells(setup, table.plane);
+  const std::vector<Floater> floaters = standingFloaters(setup, table, g);
+  if (floaters.empty())
+    return std::nullopt;
+  float top = 0.f;
+  const std::vector<const Floater*> on_top = densestBottoms(floaters, slab, top);
   SupportPrior prior;
   prior.plane = table.plane;
   prior.plane[3] -= top;
-  prior.max_angle = 0.05f;
+  prior.max_angle = kInferredMaxAngle;
   prior.max_offset = slab;
   // Its extent: the feet of the objects on it, projected on it and grown.
+  const Eigen::Vector3f n = table.plane.head<3>();
   std::vector<Eigen::Vector3f> feet;
-  for (const auto& b : floaters)
-    if (std::abs(b.bottom - floaters[best].bottom) <= slab)
-      for (const auto c : b.cells)
-        if (g.over[c] <= b.bottom + slab) {
-          const Eigen::Vector3f q = frame.point(static_cast<std::size_t>(g.pixel[c]));
-          feet.push_back(q - (n.dot(q) + prior.plane[3]) * n);
-        }
+  for (const Floater* b : on_top)
+    for (const auto c : b->cells)
+      if (g.over[c] <= b->bottom + slab) {
+        const Eigen::Vector3f q = frame.point(static_cast<std::size_t>(g.pixel[c]));
+        feet.push_back(q - (n.dot(q) + prior.plane[3]) * n);
+      }
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();
   for (const auto& f : feet)
     centre += f;
