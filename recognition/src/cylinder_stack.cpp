@@ -447,8 +447,7 @@ findSectionEnd(const CylinderModel& model, const Eigen::Matrix3Xf& points,
   // support's and the object's pixels mix, is none).
   const double other =
     out.circle_below ? pts.back().t - pts[split].t : pts[split - 1].t - pts.front().t;
-  out.found = best >= s.min_end_ratio && out.faces_share >= s.min_faces_share &&
-              other >= static_cast<double>(model.radius);
+  out.found = out.faces_share >= s.min_faces_share && other >= static_cast<double>(model.radius);
   return out;
 }
 
