@@ -188,9 +188,10 @@ extentInView(const Setup& setup, const FrameCues& cues, const Eigen::Vector4f& p
 
 /** Of the rays of \a view, the points on \a plane (within the noise band of their range) and
  * the number beyond it (a ray that passed where it would be); whether the plane is there: its
- * points as many as a plane needs (min_plane_points) or most rays without depth, and fewer than
- * half of the rays beyond it (a quarter for a prior the frame inferred: Setup::prior_inferred).
- * A plane hidden behind what is in front of it everywhere (another table) is not there. */
+ * points as many as a plane needs (min_plane_points) or most rays without depth (of those that meet
+ * nothing in front of it: an object on it shows it neither way), and fewer than half of the rays
+ * beyond it (a quarter for a prior the frame inferred: Setup::prior_inferred). A plane hidden
+ * behind what is in front of it everywhere (another table) is not there. */
 struct PlaneOnRays {
   pcl::Indices on;
   std::size_t beyond{0};
@@ -214,11 +215,13 @@ planeOnRays(const Setup& setup, const FrameCues& cues, const ExtentInView& view,
   }
   const int step = std::max(1, setup.plane_step);
   const auto cell = static_cast<std::size_t>(step * step);
+  // A ray that meets something in front of the plane (an object on it) shows it neither way.
   const std::size_t missing = view.in_view - view.seen.size();
+  const std::size_t in_front = view.seen.size() - out.on.size() - out.beyond;
   const std::size_t beyond_limit = setup.prior_inferred ? 4 : 2; // 1 / limit of the rays
-  out.there =
-    (out.on.size() * cell >= setup.params.min_plane_points || 2 * missing > view.in_view) &&
-    beyond_limit * out.beyond < view.in_view;
+  out.there = (out.on.size() * cell >= setup.params.min_plane_points ||
+               2 * missing > view.in_view - in_front) &&
+              beyond_limit * out.beyond < view.in_view;
   return out;
 }
 
