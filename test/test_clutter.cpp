@@ -851,6 +851,60 @@ TEST(CylinderLid, AFrameSeesThroughTheDiscFittedToABoxTop)
   EXPECT_EQ(facyl::walledShare(frame(tin), lid, band), 0.f);
 }
 
+TEST(CylinderLid, ALidNoisierThanItsSupportIsFlatToItsOwnNoise)
+{
+  // A dark or glossy lid returns less light than a matte table and is noisier: a flat disc
+  // (r 4 cm) with sigma 2 mm, the support's band 3 mm (a table with sigma 1 mm). By the
+  // support's band alone it is no lid; its pixels (2 mm apart, row by row) show its own noise,
+  // to which it is flat.
+  const auto all = [](float, float) { return true; };
+  Eigen::Matrix3Xf lattice, normals, dense, unused;
+  discOf(0.04f, 0.f, 0.f, 0.1f, 0.006f, all, lattice, normals);
+  discOf(0.04f, 0.f, 0.f, 0.1f, 0.002f, all, dense, unused);
+  facyl::Random rng(11);
+  for (Eigen::Index i = 0; i < lattice.cols(); ++i)
+    lattice(2, i) += 0.002f * rng.normal();
+  for (Eigen::Index i = 0; i < dense.cols(); ++i)
+    dense(2, i) += 0.002f * rng.normal();
+  const Eigen::Vector4f table(0.f, 0.f, 1.f, 0.f);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  facyl::LidSettings sensor;
+  sensor.max_band = 0.003f;
+  EXPECT_FALSE(facyl::fitLid(lattice, normals, table, up, sensor).found);
+  const facyl::LidFit lid = facyl::fitLid(lattice, normals, table, up, sensor, dense);
+  ASSERT_TRUE(lid.found);
+  EXPECT_NEAR(lid.model.radius, 0.04f, 0.004f);
+  // A dome's top (heights spread over 6 mm) with little noise (0.2 mm) stays no lid: its
+  // pixels beside each other differ by little.
+  discOf(0.05f, 0.f, 0.f, 0.1f, 0.006f, all, lattice, normals);
+  discOf(0.05f, 0.f, 0.f, 0.1f, 0.002f, all, dense, unused);
+  for (Eigen::Matrix3Xf* m : {&lattice, &dense})
+    for (Eigen::Index i = 0; i < m->cols(); ++i)
+      (*m)(2, i) += -2.4f * m->col(i).head<2>().squaredNorm() + 0.0002f * rng.normal();
+  facyl::LidSettings flat_to_2mm;
+  flat_to_2mm.max_band = 0.002f;
+  EXPECT_FALSE(facyl::fitLid(lattice, normals, table, up, flat_to_2mm, dense).found);
+}
+
+TEST(CylinderLid, AdjacentNoiseIsTheNoiseOfPixelsBesideEachOther)
+{
+  // Heights along rows of 1 mm pixels with sigma 1.5 mm, each row 5 cm above the last: the
+  // estimate within 10 % (a row's step to the next lies beyond reach, NaN heights are no
+  // pair); too few pairs within a shorter reach: NaN.
+  facyl::Random rng(3);
+  std::vector<float> h;
+  std::vector<Eigen::Vector2f> xy;
+  for (int row = 0; row < 40; ++row)
+    for (int col = 0; col < 50; ++col) {
+      h.push_back(col == 7 ? std::numeric_limits<float>::quiet_NaN()
+                           : 0.05f * static_cast<float>(row) + 0.0015f * rng.normal());
+      xy.emplace_back(0.001f * static_cast<float>(col), 0.001f * static_cast<float>(row));
+    }
+  EXPECT_NEAR(facyl::adjacentNoise(h, xy, 0.0015f, 30), 0.0015f, 0.00015f);
+  EXPECT_TRUE(std::isnan(facyl::adjacentNoise(h, xy, 0.0005f, 30)));
+  EXPECT_TRUE(std::isnan(facyl::adjacentNoise({}, {}, 1.f, 1)));
+}
+
 TEST(CylinderLid, TheDenseOutlineTellsABoxTopFromADisc)
 {
   // A box's top (10 x 12 cm, 5 cm over the table): the rim band follows the spacing of the

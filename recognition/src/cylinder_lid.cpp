@@ -40,6 +40,20 @@ circleOfOutline(const std::vector<Eigen::Vector2f>& hull, float band, Circle& ci
 
 } // namespace
 
+float
+adjacentNoise(const std::vector<float>& heights, const std::vector<Eigen::Vector2f>& xy,
+              float reach, std::size_t min_pairs)
+{
+  std::vector<float> d;
+  for (std::size_t k = 1; k < heights.size() && k < xy.size(); ++k)
+    if (std::isfinite(heights[k]) && std::isfinite(heights[k - 1]) &&
+        (xy[k] - xy[k - 1]).norm() <= reach)
+      d.push_back(std::abs(heights[k] - heights[k - 1]));
+  if (d.size() < std::max<std::size_t>(1, min_pairs))
+    return std::numeric_limits<float>::quiet_NaN();
+  return 1.4826f * medianOf(d) / std::sqrt(2.f);
+}
+
 LidFit
 fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
        const Eigen::Vector4f& support, const Eigen::Vector3f& up, const LidSettings& s,
@@ -81,14 +95,32 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   for (const auto i : flat)
     flat2.emplace_back(e1.dot(points.col(i)), e2.dot(points.col(i)));
   const float spread = 3.f * 1.4826f * medianOf(dev);
+  const float flat_spacing = spacing(convexHull2D(flat2), flat2.size());
+  // The sensor's noise on the lid itself (a dark or glossy lid returns less light than its
+  // support and is noisier): from the dense points near its level, pixel beside pixel.
+  float own = 0.f;
+  if (dense.cols() > 1) {
+    std::vector<float> hd;
+    std::vector<Eigen::Vector2f> xy;
+    for (Eigen::Index i = 0; i < dense.cols(); ++i) {
+      const Eigen::Vector3f p = dense.col(i);
+      hd.push_back(p.allFinite() && std::abs(height(p) - level) <= spread
+                     ? height(p)
+                     : std::numeric_limits<float>::quiet_NaN());
+      xy.emplace_back(e1.dot(p), e2.dot(p));
+    }
+    own = 3.f * adjacentNoise(hd, xy, flat_spacing, s.min_points);
+    if (!std::isfinite(own))
+      own = 0.f;
+  }
   // The spread is measured on the flat points alone (a median absolute deviation of n
   // values: relative standard error 1.167 / sqrt(n) for normal noise): a lid is flatter than the
   // band unless its spread exceeds it by two standard errors.
   const float allowed =
-    s.max_band * (1.f + 2.f * 1.167f / std::sqrt(static_cast<float>(flat.size())));
+    std::max(s.max_band, own) * (1.f + 2.f * 1.167f / std::sqrt(static_cast<float>(flat.size())));
   if (!(spread <= allowed))
     return out;
-  const float band = std::max(spread, 0.25f * spacing(convexHull2D(flat2), flat2.size()));
+  const float band = std::max(spread, 0.25f * flat_spacing);
   // The lid's points in the support's plane: of the dense points when given (the outline to
   // their spacing), else of the flat ones.
   pcl::Indices lid;

@@ -32,8 +32,10 @@ struct LidSettings {
   float min_rim_coverage{0.5f};
   /** The lid's height band (3 robust sigmas of its n flat points' heights) is at most this,
    * give or take two standard errors of that measure (1.167 / sqrt(n) of it): a lid is as flat
-   * as the sensor sees its support at that range (the caller: the support's band there); a
-   * dome's top within max_normal_angle is not. Infinite: no limit. */
+   * as the sensor sees its support at that range (the caller: the support's band there), or as
+   * its own pixels show their noise (with dense points: 3 adjacentNoise of those near the lid's
+   * level; a dark or glossy lid returns less light than a matte table and is noisier); a dome's
+   * top within max_normal_angle is not. Infinite: no limit. */
   float max_band{std::numeric_limits<float>::infinity()};
 };
 
@@ -54,6 +56,14 @@ struct LidFit {
    * top's corners. */
   float outside_share{0.f};
 };
+
+/** \brief The noise (a standard deviation) of a surface's \a heights sampled in order along
+ * rows (an organized cloud's pixels), from the differences of consecutive samples whose
+ * positions \a xy lie within \a reach of each other: 1.4826 x the median of their absolute
+ * values over sqrt 2 (the difference of two independent errors). NaN heights are skipped. NaN
+ * with fewer than \a min_pairs such pairs. */
+float adjacentNoise(const std::vector<float>& heights, const std::vector<Eigen::Vector2f>& xy,
+                    float reach, std::size_t min_pairs);
 
 /** \brief The cylinder whose lid the columns of \a points (unit \a normals alongside, NaN where
  * unknown) show, standing on \a support (n . p + d = 0, n unit, either sign) with \a up its
