@@ -188,10 +188,11 @@ extentInView(const Setup& setup, const FrameCues& cues, const Eigen::Vector4f& p
 
 /** Of the rays of \a view, the points on \a plane (within the noise band of their range) and
  * the number beyond it (a ray that passed where it would be); whether the plane is there: its
- * points as many as a plane needs (min_plane_points) or most rays without depth (of those that meet
- * nothing in front of it: an object on it shows it neither way), and fewer than half of the rays
- * beyond it (a quarter for a prior the frame inferred: Setup::prior_inferred). A plane hidden
- * behind what is in front of it everywhere (another table) is not there. */
+ * points as many as a plane needs (min_plane_points) or most rays without depth (of those that
+ * meet nothing in front of it: objects on it show it neither way, and hide less than half of
+ * it), and fewer than half of the rays beyond it (a quarter for a prior the frame inferred:
+ * Setup::prior_inferred). A plane hidden behind what is in front of it everywhere (another
+ * table) is not there. */
 struct PlaneOnRays {
   pcl::Indices on;
   std::size_t beyond{0};
@@ -215,12 +216,13 @@ planeOnRays(const Setup& setup, const FrameCues& cues, const ExtentInView& view,
   }
   const int step = std::max(1, setup.plane_step);
   const auto cell = static_cast<std::size_t>(step * step);
-  // A ray that meets something in front of the plane (an object on it) shows it neither way.
+  // A ray that meets something in front of the plane (an object on it) shows it neither way;
+  // objects on a plane hide less than half of it (another table in front hides all of it).
   const std::size_t missing = view.in_view - view.seen.size();
   const std::size_t in_front = view.seen.size() - out.on.size() - out.beyond;
   const std::size_t beyond_limit = setup.prior_inferred ? 4 : 2; // 1 / limit of the rays
-  out.there = (out.on.size() * cell >= setup.params.min_plane_points ||
-               2 * missing > view.in_view - in_front) &&
+  const bool holes = 2 * in_front < view.in_view && 2 * missing > view.in_view - in_front;
+  out.there = (out.on.size() * cell >= setup.params.min_plane_points || holes) &&
               beyond_limit * out.beyond < view.in_view;
   return out;
 }
