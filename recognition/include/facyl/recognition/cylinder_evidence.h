@@ -34,9 +34,9 @@ constexpr std::size_t kSideOnlyEvidenceFeatures = 15;
  * evidenceFeatures fitted by recognition/training/fit_evidence.py on simulated and real labelled
  * objects (docs/classifier.md, "The evidence model"); the network's weight is 0. */
 constexpr std::array<float, kEvidenceFeatures> kGeometryWeights = {
-  1.82662f,   0.843052f, 0.f,        -4.29659f, 0.f, -6.95642f, 0.f,
-  -0.203624f, -3.09661f, 0.f,        -6.38006f, 0.f, -2.86157f, -6.59634f,
-  -6.34052f,  7.08069f,  0.0440186f, -35.6143f, 0.f, 0.f};
+  1.82662f,   0.843052f, 0.f,      -4.29659f, 0.f, -6.95642f, 0.f,
+  -0.203624f, -3.09661f, 0.f,      -6.38006f, 0.f, -2.86157f, -6.59634f,
+  -7.37701f,  6.78661f,  1.34869f, -33.3564f, 0.f, 0.f};
 
 /** \brief The decision rule's settings. */
 struct CylinderDecision {
