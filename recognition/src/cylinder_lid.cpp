@@ -38,6 +38,29 @@ circleOfOutline(const std::vector<Eigen::Vector2f>& hull, float band, Circle& ci
   return on_circle >= 3;
 }
 
+/** Three robust sigmas of the noise of a lid's \a dense points within \a spread of its \a level
+ * (their heights by \a height, their places in the plane along \a e1, \a e2): adjacentNoise
+ * of pixels beside each other within \a reach; 0 with fewer than \a min_pairs such pairs. */
+template <typename Height>
+float
+ownBand(const Eigen::Matrix3Xf& dense, Height height, float level, float spread,
+        const Eigen::Vector3f& e1, const Eigen::Vector3f& e2, float reach, std::size_t min_pairs)
+{
+  if (dense.cols() < 2)
+    return 0.f;
+  std::vector<float> h;
+  std::vector<Eigen::Vector2f> xy;
+  for (Eigen::Index i = 0; i < dense.cols(); ++i) {
+    const Eigen::Vector3f p = dense.col(i);
+    h.push_back(p.allFinite() && std::abs(height(p) - level) <= spread
+                  ? height(p)
+                  : std::numeric_limits<float>::quiet_NaN());
+    xy.emplace_back(e1.dot(p), e2.dot(p));
+  }
+  const float sigma = adjacentNoise(h, xy, reach, min_pairs);
+  return std::isfinite(sigma) ? 3.f * sigma : 0.f;
+}
+
 } // namespace
 
 float
@@ -98,21 +121,7 @@ fitLid(const Eigen::Matrix3Xf& points, const Eigen::Matrix3Xf& normals,
   const float flat_spacing = spacing(convexHull2D(flat2), flat2.size());
   // The sensor's noise on the lid itself (a dark or glossy lid returns less light than its
   // support and is noisier): from the dense points near its level, pixel beside pixel.
-  float own = 0.f;
-  if (dense.cols() > 1) {
-    std::vector<float> hd;
-    std::vector<Eigen::Vector2f> xy;
-    for (Eigen::Index i = 0; i < dense.cols(); ++i) {
-      const Eigen::Vector3f p = dense.col(i);
-      hd.push_back(p.allFinite() && std::abs(height(p) - level) <= spread
-                     ? height(p)
-                     : std::numeric_limits<float>::quiet_NaN());
-      xy.emplace_back(e1.dot(p), e2.dot(p));
-    }
-    own = 3.f * adjacentNoise(hd, xy, flat_spacing, s.min_points);
-    if (!std::isfinite(own))
-      own = 0.f;
-  }
+  const float own = ownBand(dense, height, level, spread, e1, e2, flat_spacing, s.min_points);
   // The spread is measured on the flat points alone (a median absolute deviation of n
   // values: relative standard error 1.167 / sqrt(n) for normal noise): a lid is flatter than the
   // band unless its spread exceeds it by two standard errors.

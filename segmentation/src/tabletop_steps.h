@@ -199,10 +199,10 @@ void keepPriorCandidate(const Setup& setup, std::vector<Candidate>& candidates, 
  * of the points within max_offset of it, when that is a peak of min_plane_points. Of the rays
  * of every plane_step-th pixel and row that meet it inside the prior's extent, the points on it
  * (band: \a cues.noise) must be min_plane_points or most rays give no depth (of those that meet
- * nothing in front of it first), and fewer than half may see through it (a point beyond its band is
- * a ray that passed where it would be). Its band is cues.noise, its points those rays' points on
- * it. Images only; none without a prior with an extent, a focal length or a noise band, or when the
- * frame has 8 candidates. */
+ * nothing in front of it first, where those are most), and fewer than half may see through it (a
+ * point beyond its band is a ray that passed where it would be). Its band is cues.noise, its points
+ * those rays' points on it. Images only; none without a prior with an extent, a focal length or a
+ * noise band, or when the frame has 8 candidates. */
 std::optional<Candidate> priorPlaneCandidate(const Setup& setup, const FrameCues& cues,
                                              const std::vector<Candidate>& candidates);
 
