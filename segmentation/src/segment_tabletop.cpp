@@ -193,6 +193,8 @@ void
 adoptSupportUnderFloatingObjects(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace,
                                  TabletopSegments& out)
 {
+  if (setup.prior) // a given prior decides the support
+    return;
   const std::optional<SupportPrior> under = supportUnderFloatingObjects(setup, out);
   if (!under)
     return;
@@ -300,8 +302,7 @@ segmentTabletop(const PointFrame& frame, const PinholeCamera& camera, const Eige
   else {
     tabletop::FrameCues cues;
     out = tabletop::segmentFrame(setup, cues, workspace);
-    if (!setup.prior)
-      tabletop::adoptSupportUnderFloatingObjects(setup, cues, workspace, out);
+    tabletop::adoptSupportUnderFloatingObjects(setup, cues, workspace, out);
   }
   out.timing.total = tabletop::msSince(t0);
   return out;

@@ -244,8 +244,7 @@ segmentOnLattice(const Setup& setup, int step, TabletopWorkspace& workspace)
   FrameCues cues;
   const Setup on_lattice = makeSetup(lattice, params, camera, setup.up, setup.prior, setup.threads);
   TabletopSegments out = segmentFrame(on_lattice, cues, workspace);
-  if (!on_lattice.prior)
-    adoptSupportUnderFloatingObjects(on_lattice, cues, workspace, out);
+  adoptSupportUnderFloatingObjects(on_lattice, cues, workspace, out);
   const auto t1 = Clock::now();
   out.clusters = clustersAtFullResolution(setup, cues, out.clusters, out.supports, lattice, step);
   supportsAtFullResolution(setup.frame, step, out.supports);

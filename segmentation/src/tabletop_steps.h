@@ -283,11 +283,11 @@ TabletopSegments segmentOnLattice(const Setup& setup, int step, TabletopWorkspac
 /** The run on every point of \a setup's frame; \a cues: what its plane search learnt. */
 TabletopSegments segmentFrame(const Setup& setup, FrameCues& cues, TabletopWorkspace& workspace);
 
-/** Without a prior: where objects float above the table of \a out over a support the image
- * shows as holes (supportUnderFloatingObjects, priorPlaneInView with \a cues of the run that
- * gave \a out), the frame segmented again with that support as an inferred prior; \a out and
- * \a cues become that run's (its timing the sum of both) when the support is its table and
- * objects stand on it. */
+/** Nothing when setup.prior is given (it decides the support). Else, where objects float above the
+ * table of \a out over a support the image shows as holes (supportUnderFloatingObjects,
+ * priorPlaneInView with \a cues of the run that gave \a out), the frame segmented again with that
+ * support as an inferred prior; \a out and \a cues become that run's (its timing the sum of both)
+ * when the support is its table and objects stand on it. */
 void adoptSupportUnderFloatingObjects(const Setup& setup, FrameCues& cues,
                                       TabletopWorkspace& workspace, TabletopSegments& out);
 
